@@ -1,0 +1,222 @@
+//! Force kernels: interchangeable ways of visiting the pairs of one configuration.
+//!
+//! A kernel owns its scratch memory (buffers, cells, trees), allocated on first use and reused
+//! on every later step, and computes the forces of a [`PairLaw`] on every particle. The
+//! physics lives in the law; kernels contain traversal only. The kernel is chosen once per run
+//! through [`KernelKind::build`] (one dynamic call per step); the pair loops inside are
+//! monomorphized for the law, precision and dimension.
+
+mod cell_list;
+mod naive;
+mod octree;
+mod par;
+mod per_thread;
+pub mod rows;
+mod symmetric;
+
+pub use cell_list::CellList;
+pub use naive::Naive;
+pub use octree::Octree;
+pub use per_thread::PerThread;
+pub use symmetric::Symmetric;
+
+use crate::physics::{LawKind, PairLaw};
+use crate::real::Real;
+use crate::state::{Field, State};
+use serde::Serialize;
+use thiserror::Error;
+
+/// The five kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum KernelKind {
+    /// Every particle against every other (n(n−1) pair evaluations).
+    Naive,
+    /// Each pair once with Newton's third law (n(n−1)/2), single thread.
+    Symmetric,
+    /// Symmetric pairs split over rayon threads, each with its own force buffer, then reduced.
+    PerThread,
+    /// Bins of side ≥ rc, particles sorted by bin, neighbours from adjacent bins (O(n)).
+    CellList,
+    /// Barnes-Hut tree (octree in 3-D, quadtree in 2-D) with opening angle θ (O(n log n)).
+    Octree,
+}
+
+impl KernelKind {
+    pub const ALL: [KernelKind; 5] = [
+        KernelKind::Naive,
+        KernelKind::Symmetric,
+        KernelKind::PerThread,
+        KernelKind::CellList,
+        KernelKind::Octree,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            KernelKind::Naive => "naive",
+            KernelKind::Symmetric => "symmetric",
+            KernelKind::PerThread => "per-thread",
+            KernelKind::CellList => "cell-list",
+            KernelKind::Octree => "octree",
+        }
+    }
+
+    /// Whether the kernel computes the exact pair sum (to rounding) rather than an approximation.
+    pub fn is_exact(self) -> bool {
+        !matches!(self, KernelKind::Octree)
+    }
+
+    /// Whether the kernel can compute forces for a law of this family.
+    pub fn supports(self, law: LawKind) -> bool {
+        match self {
+            KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => true,
+            KernelKind::CellList => law.has_cutoff(),
+            KernelKind::Octree => law.is_inverse_square(),
+        }
+    }
+
+    /// Builds the kernel for `law`, or explains which combinations exist.
+    pub fn build<T: Real, L: PairLaw<T>, const D: usize>(
+        self,
+        law: L,
+        params: &KernelParams,
+    ) -> Result<Box<dyn ForceKernel<T, D>>, KernelError> {
+        if !self.supports(law.kind()) {
+            return Err(KernelError::Incompatible {
+                kernel: self.name(),
+                law: law.kind().name(),
+                supported: supported_for(law.kind()),
+            });
+        }
+        params.validate()?;
+        Ok(match self {
+            KernelKind::Naive => Box::new(Naive::new(law)),
+            KernelKind::Symmetric => Box::new(Symmetric::new(law)),
+            KernelKind::PerThread => Box::new(PerThread::new(law)),
+            KernelKind::CellList => Box::new(CellList::new(law)?),
+            KernelKind::Octree => Box::new(Octree::new(law, params.theta, params.leaf_size)),
+        })
+    }
+}
+
+/// The kernels that support a law, as a readable list.
+pub fn supported_for(law: LawKind) -> String {
+    KernelKind::ALL
+        .iter()
+        .filter(|k| k.supports(law))
+        .map(|k| k.name())
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Tuning parameters shared by the kernels that use them.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct KernelParams {
+    /// Barnes-Hut opening angle: a node of side `s` at distance `d` is used whole when `s/d < θ`.
+    pub theta: f64,
+    /// Most particles in a tree leaf.
+    pub leaf_size: usize,
+}
+
+impl Default for KernelParams {
+    fn default() -> Self {
+        KernelParams {
+            theta: 0.5,
+            leaf_size: 16,
+        }
+    }
+}
+
+impl KernelParams {
+    pub fn validate(&self) -> Result<(), KernelError> {
+        if !(self.theta.is_finite() && self.theta >= 0.0) {
+            return Err(KernelError::BadParam(format!(
+                "theta must be a finite number >= 0 (got {}); 0.5 is the usual choice",
+                self.theta
+            )));
+        }
+        if self.leaf_size == 0 || self.leaf_size > 4096 {
+            return Err(KernelError::BadParam(format!(
+                "leaf size must be between 1 and 4096 (got {})",
+                self.leaf_size
+            )));
+        }
+        Ok(())
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum KernelError {
+    #[error("kernel `{kernel}` does not apply to the {law} law; kernels for {law}: {supported}")]
+    Incompatible {
+        kernel: &'static str,
+        law: &'static str,
+        supported: String,
+    },
+    #[error("{0}")]
+    BadParam(String),
+}
+
+/// Deterministic work done by one force computation.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+pub struct WorkCounters {
+    /// Pair distance evaluations (candidate pairs examined).
+    pub pair_checks: u64,
+    /// Pairs that interact (inside the cutoff / outside the quench); counted on probe steps only.
+    pub pairs_interacting: u64,
+    /// Cells whose particles were visited (cell list).
+    pub cells_visited: u64,
+    /// Tree nodes opened (split into children) during the walk.
+    pub nodes_opened: u64,
+    /// Tree nodes accepted as a monopole.
+    pub nodes_accepted: u64,
+}
+
+impl WorkCounters {
+    pub fn add(&mut self, o: &WorkCounters) {
+        self.pair_checks += o.pair_checks;
+        self.pairs_interacting += o.pairs_interacting;
+        self.cells_visited += o.cells_visited;
+        self.nodes_opened += o.nodes_opened;
+        self.nodes_accepted += o.nodes_accepted;
+    }
+}
+
+/// What a force computation reports besides the forces.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ForceReport {
+    /// Potential energy (probe computations only).
+    pub energy: Option<f64>,
+    /// Seconds spent building cells, trees or sort orders, part of the force phase.
+    pub build_s: f64,
+    pub work: WorkCounters,
+}
+
+/// Computes the forces of one configuration.
+pub trait ForceKernel<T: Real, const D: usize>: Send {
+    fn kind(&self) -> KernelKind;
+
+    /// Overwrites `forces` with the force on every particle. With `probe`, also returns the
+    /// potential energy and counts interacting pairs (slower; used outside the timed steps).
+    fn compute(
+        &mut self,
+        state: &State<T, D>,
+        forces: &mut Field<T, D>,
+        probe: bool,
+    ) -> ForceReport;
+
+    /// A particle order that makes this kernel's memory access local (cell or space-filling
+    /// curve order), as `order[new_slot] = old_slot`, if the kernel benefits from one.
+    fn spatial_order(&mut self, _state: &State<T, D>) -> Option<Vec<u32>> {
+        None
+    }
+}
+
+/// Smallest number of pair evaluations per step for which forking threads pays off
+/// (one rayon fork/join costs ~20 µs on the reference machine; a pair costs ~0.4 ns).
+pub const MIN_PARALLEL_PAIRS: u64 = 400_000;
+
+/// Whether a step of `pairs` evaluations should run on the current rayon pool's threads.
+pub fn worth_parallel(pairs: u64) -> bool {
+    rayon::current_num_threads() > 1 && pairs >= MIN_PARALLEL_PAIRS
+}

@@ -1,0 +1,118 @@
+//! `symmetric`: each pair once (i < j) with Newton's third law, n(n−1)/2 pair evaluations (the
+//! form of the serial source code), single-threaded.
+//!
+//! The reaction is scattered into the sources' force entries, which is a read-modify-write
+//! stream; to keep that stream in L1 the j loop is tiled: targets of one block of `BLOCK`
+//! particles meet sources one block at a time.
+
+use super::rows::{RowSum, Sources, Target, scatter};
+use super::{ForceKernel, ForceReport, KernelKind, WorkCounters};
+use crate::physics::PairLaw;
+use crate::real::Real;
+use crate::simd;
+use crate::state::{Field, State};
+
+/// Particles per tile: positions, source strength and forces of a tile stay inside L1.
+pub const BLOCK: usize = 512;
+
+pub struct Symmetric<L> {
+    law: L,
+}
+
+impl<L> Symmetric<L> {
+    pub fn new(law: L) -> Self {
+        Symmetric { law }
+    }
+}
+
+/// Number of tiles for `n` particles.
+pub fn blocks(n: usize) -> usize {
+    n.div_ceil(BLOCK)
+}
+
+/// Pair evaluations done for target tile `b` (its own triangle plus every later tile).
+pub fn tile_pairs(n: usize, b: usize) -> u64 {
+    let lo = b * BLOCK;
+    let hi = ((b + 1) * BLOCK).min(n);
+    let len = (hi - lo) as u64;
+    len * (len.saturating_sub(1)) / 2 + len * (n - hi) as u64
+}
+
+/// Adds the forces of every pair (i, j) with i in target tiles `tiles` and j > i to `out`
+/// (length n), both ends of each pair.
+#[inline(always)]
+pub fn add_tiles<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+    law: &L,
+    state: &State<T, D>,
+    tiles: std::ops::Range<usize>,
+    out: &mut [&mut [T]; D],
+) -> RowSum<T, D> {
+    let n = state.len();
+    let mut total = RowSum::zero();
+    for bi in tiles {
+        let (ilo, ihi) = (bi * BLOCK, ((bi + 1) * BLOCK).min(n));
+        for bj in bi..blocks(n) {
+            let (jlo, jhi) = (bj * BLOCK, ((bj + 1) * BLOCK).min(n));
+            for i in ilo..ihi {
+                let lo = if bi == bj { i + 1 } else { jlo };
+                let t = Target {
+                    x: state.position(i),
+                    s: state.source[i],
+                };
+                let src = Sources::range(&state.pos, &state.source, lo, jhi);
+                let fsrc: [&mut [T]; D] = {
+                    let mut it = out.iter_mut();
+                    std::array::from_fn(|_| &mut it.next().expect("D components")[lo..jhi])
+                };
+                let sum = scatter::<T, L, D, PROBE>(law, &t, &src, fsrc);
+                for d in 0..D {
+                    out[d][i] += sum.force[d];
+                }
+                total.energy += sum.energy;
+                total.interacting += sum.interacting;
+            }
+        }
+    }
+    total
+}
+
+impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Symmetric<L> {
+    fn kind(&self) -> KernelKind {
+        KernelKind::Symmetric
+    }
+
+    fn compute(
+        &mut self,
+        state: &State<T, D>,
+        forces: &mut Field<T, D>,
+        probe: bool,
+    ) -> ForceReport {
+        let n = state.len();
+        let law = &self.law;
+        for f in forces.iter_mut() {
+            f.fill(T::zero());
+        }
+        let mut out = forces.each_mut().map(|f| f.as_mut_slice());
+        let tiles = 0..blocks(n);
+        let total = if probe {
+            simd::dispatch(
+                #[inline(always)]
+                || add_tiles::<T, L, D, true>(law, state, tiles, &mut out),
+            )
+        } else {
+            simd::dispatch(
+                #[inline(always)]
+                || add_tiles::<T, L, D, false>(law, state, tiles, &mut out),
+            )
+        };
+        ForceReport {
+            energy: probe.then(|| total.energy.as_f64()),
+            build_s: 0.0,
+            work: WorkCounters {
+                pair_checks: (n as u64) * (n.saturating_sub(1) as u64) / 2,
+                pairs_interacting: total.interacting,
+                ..Default::default()
+            },
+        }
+    }
+}

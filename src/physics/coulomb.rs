@@ -1,0 +1,70 @@
+//! Coulomb: force on i is `q_i q_j (x_i − x_j) / r³`, zeroed (quenched) below `r = ε_q`.
+
+use super::{LawKind, PairLaw};
+use crate::real::{Real, select};
+
+#[derive(Clone, Copy, Debug)]
+pub struct Coulomb<T> {
+    quench2: T,
+}
+
+impl<T: Real> Coulomb<T> {
+    /// `quench` is the distance below which the force is zeroed, as in the source code.
+    pub fn new(quench: f64) -> Self {
+        Coulomb {
+            quench2: T::of(quench * quench),
+        }
+    }
+}
+
+impl<T: Real> PairLaw<T> for Coulomb<T> {
+    fn kind(&self) -> LawKind {
+        LawKind::Coulomb
+    }
+
+    #[inline(always)]
+    fn coeff(&self, r2: T, si: T, sj: T) -> T {
+        let inv = T::one() / r2.sqrt();
+        // Like charges repel: the force points from j to i, i.e. a negative coefficient.
+        select(r2 < self.quench2, T::zero(), -(si * sj) * inv * inv * inv)
+    }
+
+    #[inline(always)]
+    fn energy(&self, r2: T, si: T, sj: T) -> T {
+        select(r2 < self.quench2, T::zero(), si * sj / r2.sqrt())
+    }
+
+    #[inline(always)]
+    fn interacts(&self, r2: T) -> bool {
+        r2 >= self.quench2
+    }
+
+    fn cutoff(&self) -> Option<T> {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::fd;
+
+    #[test]
+    fn force_is_minus_gradient_of_energy() {
+        let c = Coulomb::<f64>::new(1e-3);
+        for r in [2e-3, 0.01, 0.3, 1.7] {
+            fd::check(&c, r, 1.0, 1.0, 1e-7);
+            fd::check(&c, r, 1.0, -1.0, 1e-7);
+        }
+    }
+
+    #[test]
+    fn like_charges_repel_and_quench_zeroes() {
+        let c = Coulomb::<f64>::new(1e-3);
+        assert!(c.coeff(0.25, 1.0, 1.0) < 0.0);
+        assert!(c.coeff(0.25, 1.0, -1.0) > 0.0);
+        assert_eq!(c.coeff(1e-7, 1.0, 1.0), 0.0);
+        assert_eq!(c.coeff(0.0, 1.0, 1.0), 0.0);
+        assert!((c.coeff(4.0, 1.0, 1.0) + 1.0 / 8.0).abs() < 1e-15);
+    }
+}

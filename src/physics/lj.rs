@@ -1,0 +1,106 @@
+//! Truncated Lennard-Jones: `V(r) = 4ε[(σ/r)¹² − (σ/r)⁶]` for `r < rc`.
+
+use super::{LawKind, PairLaw};
+use crate::real::{Real, select};
+
+/// Lennard-Jones with a cutoff. The force is truncated (not shifted); the energy used for
+/// monitoring is shifted by `V(rc)` so that it stays continuous when pairs cross the cutoff.
+#[derive(Clone, Copy, Debug)]
+pub struct LennardJones<T> {
+    epsilon24: T,
+    epsilon4: T,
+    sigma2: T,
+    rc: T,
+    rc2: T,
+    /// `u(1 − u)` at the cutoff, for the energy shift.
+    shift: T,
+}
+
+impl<T: Real> LennardJones<T> {
+    pub fn new(epsilon: f64, sigma: f64, rc: f64) -> Self {
+        let uc = (sigma * sigma / (rc * rc)).powi(3);
+        LennardJones {
+            epsilon24: T::of(24.0 * epsilon),
+            epsilon4: T::of(4.0 * epsilon),
+            sigma2: T::of(sigma * sigma),
+            rc: T::of(rc),
+            rc2: T::of(rc * rc),
+            shift: T::of(uc * (1.0 - uc)),
+        }
+    }
+}
+
+impl<T: Real> PairLaw<T> for LennardJones<T> {
+    fn kind(&self) -> LawKind {
+        LawKind::LennardJones
+    }
+
+    #[inline(always)]
+    fn coeff(&self, r2: T, _si: T, _sj: T) -> T {
+        let ir2 = T::one() / r2;
+        let s = self.sigma2 * ir2;
+        let u = s * s * s;
+        let c = self.epsilon24 * ir2 * u * (T::one() - (u + u));
+        select(r2 < self.rc2, c, T::zero())
+    }
+
+    #[inline(always)]
+    fn energy(&self, r2: T, _si: T, _sj: T) -> T {
+        let s = self.sigma2 / r2;
+        let u = s * s * s;
+        select(
+            r2 < self.rc2,
+            self.epsilon4 * (u * (T::one() - u) - self.shift),
+            T::zero(),
+        )
+    }
+
+    #[inline(always)]
+    fn interacts(&self, r2: T) -> bool {
+        r2 < self.rc2
+    }
+
+    fn cutoff(&self) -> Option<T> {
+        Some(self.rc)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::fd;
+
+    #[test]
+    fn force_is_minus_gradient_of_energy() {
+        let lj = LennardJones::<f64>::new(1.0, 0.01, 0.025);
+        for r in [0.009, 0.0105, 0.0112, 0.015, 0.02, 0.0249] {
+            fd::check(&lj, r, 1.0, 1.0, 1e-6);
+        }
+    }
+
+    #[test]
+    fn closed_form_values() {
+        let lj = LennardJones::<f64>::new(1.0, 1.0, 2.5);
+        // Force vanishes at the minimum r = 2^(1/6) σ and is repulsive inside it.
+        let rmin = 2f64.powf(1.0 / 6.0);
+        assert!(lj.coeff(rmin * rmin, 1.0, 1.0).abs() < 1e-12);
+        assert!(lj.coeff(0.9, 1.0, 1.0) < 0.0);
+        assert!(lj.coeff(1.5 * 1.5, 1.0, 1.0) > 0.0);
+        // Unshifted V(σ) = 0, so the shifted energy at σ is minus the shift.
+        let uc = 2.5f64.powi(-6);
+        assert!((lj.energy(1.0, 1.0, 1.0) + 4.0 * uc * (1.0 - uc)).abs() < 1e-15);
+        // Nothing at or beyond the cutoff.
+        assert_eq!(lj.coeff(2.5 * 2.5, 1.0, 1.0), 0.0);
+        assert_eq!(lj.energy(3.0 * 3.0, 1.0, 1.0), 0.0);
+        assert!(lj.energy(2.4999 * 2.4999, 1.0, 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn f32_matches_f64() {
+        let a = LennardJones::<f32>::new(1.0, 0.01, 0.025);
+        let b = LennardJones::<f64>::new(1.0, 0.01, 0.025);
+        let r2 = 0.0121f64 * 0.0121;
+        let (ca, cb) = (a.coeff(r2 as f32, 1.0, 1.0) as f64, b.coeff(r2, 1.0, 1.0));
+        assert!((ca - cb).abs() / cb.abs() < 1e-5);
+    }
+}
