@@ -1,10 +1,25 @@
 //! nbody-bench: an engine of interchangeable N-body force kernels and a harness that measures
 //! how they scale.
+//!
+//! Layers, bottom up: [`real`] and [`simd`] (precision and instruction set), [`state`] and
+//! [`physics`] (particles and pair laws), [`kernels`] (ways of visiting the pairs),
+//! [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
+//! [`run`] and [`validate`] (measured runs and force checks), [`output`], and the CLI.
 
+pub mod boundary;
+pub mod cli;
+pub mod commands;
+pub mod engine;
+pub mod integrator;
 pub mod kernels;
+pub mod output;
 pub mod physics;
 pub mod real;
+pub mod run;
+pub mod scenario;
 pub mod simd;
 pub mod state;
+pub mod stats;
 #[doc(hidden)]
 pub mod testing;
+pub mod validate;

@@ -179,14 +179,21 @@ pub fn scatter<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     let full = n - n % LANES;
     for base in (0..full).step_by(LANES) {
         let (dx, r2, c, ss) = block(law, t, &pos, s, base);
+        // Accumulate and scatter in separate passes over a finished block: interleaving them
+        // makes LLVM's SLP vectorizer shuffle the accumulators through memory.
+        let mut f = [[T::zero(); LANES]; D];
+        for d in 0..D {
+            for l in 0..LANES {
+                f[d][l] = c[l] * dx[d][l];
+                acc[d][l] += f[d][l];
+            }
+        }
         for d in 0..D {
             let fj: &mut [T; LANES] = (&mut fsrc[d][base..base + LANES])
                 .try_into()
                 .expect("block in range");
             for l in 0..LANES {
-                let f = c[l] * dx[d][l];
-                acc[d][l] += f;
-                fj[l] -= f;
+                fj[l] -= f[d][l];
             }
         }
         if PROBE {

@@ -6,6 +6,7 @@ use crate::real::{Real, select};
 #[derive(Clone, Copy, Debug)]
 pub struct Coulomb<T> {
     quench2: T,
+    quench: f64,
 }
 
 impl<T: Real> Coulomb<T> {
@@ -13,11 +14,18 @@ impl<T: Real> Coulomb<T> {
     pub fn new(quench: f64) -> Self {
         Coulomb {
             quench2: T::of(quench * quench),
+            quench,
         }
     }
 }
 
 impl<T: Real> PairLaw<T> for Coulomb<T> {
+    type Wide = Coulomb<f64>;
+
+    fn widen(&self) -> Coulomb<f64> {
+        Coulomb::new(self.quench)
+    }
+
     fn kind(&self) -> LawKind {
         LawKind::Coulomb
     }

@@ -7,6 +7,8 @@ use crate::real::Real;
 pub struct Gravity<T> {
     g: T,
     eps2: T,
+    /// (G, ε) as given, to rebuild the law in another precision.
+    params: (f64, f64),
 }
 
 impl<T: Real> Gravity<T> {
@@ -14,11 +16,18 @@ impl<T: Real> Gravity<T> {
         Gravity {
             g: T::of(g),
             eps2: T::of(softening * softening),
+            params: (g, softening),
         }
     }
 }
 
 impl<T: Real> PairLaw<T> for Gravity<T> {
+    type Wide = Gravity<f64>;
+
+    fn widen(&self) -> Gravity<f64> {
+        Gravity::new(self.params.0, self.params.1)
+    }
+
     fn kind(&self) -> LawKind {
         LawKind::Gravity
     }

@@ -1,4 +1,4 @@
-//! Truncated Lennard-Jones: `V(r) = 4ε[(σ/r)¹² − (σ/r)⁶]` for `r < rc`.
+//! Truncated Lennard-Jones: `V(r) = 4ε[(σ/r)¹² − (σ/r)⁶] = 4ε·u(u − 1)` with `u = (σ/r)⁶`, for `r < rc`.
 
 use super::{LawKind, PairLaw};
 use crate::real::{Real, select};
@@ -12,8 +12,10 @@ pub struct LennardJones<T> {
     sigma2: T,
     rc: T,
     rc2: T,
-    /// `u(1 − u)` at the cutoff, for the energy shift.
+    /// `u(u − 1)` at the cutoff, for the energy shift.
     shift: T,
+    /// (ε, σ, rc) as given, to rebuild the law in another precision.
+    params: (f64, f64, f64),
 }
 
 impl<T: Real> LennardJones<T> {
@@ -25,12 +27,20 @@ impl<T: Real> LennardJones<T> {
             sigma2: T::of(sigma * sigma),
             rc: T::of(rc),
             rc2: T::of(rc * rc),
-            shift: T::of(uc * (1.0 - uc)),
+            shift: T::of(uc * (uc - 1.0)),
+            params: (epsilon, sigma, rc),
         }
     }
 }
 
 impl<T: Real> PairLaw<T> for LennardJones<T> {
+    type Wide = LennardJones<f64>;
+
+    fn widen(&self) -> LennardJones<f64> {
+        let (e, s, rc) = self.params;
+        LennardJones::new(e, s, rc)
+    }
+
     fn kind(&self) -> LawKind {
         LawKind::LennardJones
     }
@@ -50,7 +60,7 @@ impl<T: Real> PairLaw<T> for LennardJones<T> {
         let u = s * s * s;
         select(
             r2 < self.rc2,
-            self.epsilon4 * (u * (T::one() - u) - self.shift),
+            self.epsilon4 * (u * (u - T::one()) - self.shift),
             T::zero(),
         )
     }
@@ -86,13 +96,14 @@ mod tests {
         assert!(lj.coeff(rmin * rmin, 1.0, 1.0).abs() < 1e-12);
         assert!(lj.coeff(0.9, 1.0, 1.0) < 0.0);
         assert!(lj.coeff(1.5 * 1.5, 1.0, 1.0) > 0.0);
-        // Unshifted V(σ) = 0, so the shifted energy at σ is minus the shift.
+        // Unshifted V(σ) = 0, so the shifted energy at σ is minus the shift; V(r_min) = −ε.
         let uc = 2.5f64.powi(-6);
-        assert!((lj.energy(1.0, 1.0, 1.0) + 4.0 * uc * (1.0 - uc)).abs() < 1e-15);
+        assert!((lj.energy(1.0, 1.0, 1.0) + 4.0 * uc * (uc - 1.0)).abs() < 1e-15);
+        assert!((lj.energy(rmin * rmin, 1.0, 1.0) + 1.0 + 4.0 * uc * (uc - 1.0)).abs() < 1e-12);
         // Nothing at or beyond the cutoff.
         assert_eq!(lj.coeff(2.5 * 2.5, 1.0, 1.0), 0.0);
         assert_eq!(lj.energy(3.0 * 3.0, 1.0, 1.0), 0.0);
-        assert!(lj.energy(2.4999 * 2.4999, 1.0, 1.0).abs() < 1e-6);
+        assert!(lj.energy(2.4999 * 2.4999, 1.0, 1.0).abs() < 1e-5);
     }
 
     #[test]

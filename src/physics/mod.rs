@@ -52,7 +52,13 @@ impl LawKind {
 /// `s` is the per-particle source strength (charge, mass; ignored by Lennard-Jones).
 /// A negative coefficient is a repulsion.
 pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
+    /// The same law in f64, for reference computations.
+    type Wide: PairLaw<f64>;
+
     fn kind(&self) -> LawKind;
+
+    /// The same law with the same parameters in f64.
+    fn widen(&self) -> Self::Wide;
 
     /// Force coefficient at squared distance `r2`; zero for pairs that do not interact.
     fn coeff(&self, r2: T, si: T, sj: T) -> T;

@@ -1,0 +1,143 @@
+//! Command-line interface: argument definitions only; the work is in `commands`.
+
+use crate::kernels::KernelKind;
+use crate::output::nbview::NbviewFormat;
+use crate::scenario::{Precision, ScenarioKind};
+use clap::{Args, Parser, Subcommand};
+use std::path::PathBuf;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "nbody-bench",
+    version,
+    about = "Characterize the performance of particle (N-body) simulation codes",
+    long_about = "Characterize the performance of particle (N-body) simulation codes.\n\n\
+        An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, octree) \
+        over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, work counters \
+        and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
+    after_help = "Examples:\n  nbody-bench list\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// List kernels, scenarios and which combinations are supported.
+    List,
+    /// Integrate one scenario with one kernel and report timings, throughput and energy drift.
+    Run(RunArgs),
+    /// Check every applicable kernel's forces against the naive sum in f64 (exit 1 on a mismatch).
+    Validate(ValidateArgs),
+}
+
+/// Options that define the simulated system.
+#[derive(Debug, Args, Clone)]
+pub struct SystemArgs {
+    /// Number of particles [default: the scenario's, see `list`].
+    #[arg(short = 'n', long = "n", value_parser = parse_count)]
+    pub n: Option<usize>,
+    /// Seed of the initial state; the same seed gives the same state for every kernel and thread count.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Time step [default: the scenario's].
+    #[arg(long, value_parser = parse_positive)]
+    pub dt: Option<f64>,
+    /// Particles per unit area (lj-box, lj-liquid): the box side becomes sqrt(n / density).
+    #[arg(long, value_parser = parse_positive)]
+    pub density: Option<f64>,
+    /// Floating-point precision [default: the scenario's: f32 for LJ, f64 otherwise].
+    #[arg(long, value_enum)]
+    pub precision: Option<Precision>,
+    /// Run with fewer particles when the box cannot hold n at the minimum spacing.
+    #[arg(long)]
+    pub allow_fewer: bool,
+}
+
+/// Kernel tuning options.
+#[derive(Debug, Args, Clone)]
+pub struct KernelArgs {
+    /// Barnes-Hut opening angle (octree): a node of side s at distance d is used whole when s/d < theta.
+    #[arg(long, default_value_t = 0.5, value_parser = parse_non_negative)]
+    pub theta: f64,
+    /// Most particles in a tree leaf (octree).
+    #[arg(long, default_value_t = 16, value_parser = parse_count)]
+    pub leaf_size: usize,
+    /// Threads in the rayon pool for this run (the environment's RAYON_NUM_THREADS is not used).
+    #[arg(long, default_value_t = 1, value_parser = parse_count)]
+    pub threads: usize,
+}
+
+#[derive(Debug, Args)]
+pub struct RunArgs {
+    /// Scenario to simulate.
+    #[arg(long, value_enum)]
+    pub scenario: ScenarioKind,
+    /// Force kernel.
+    #[arg(long, value_enum)]
+    pub kernel: KernelKind,
+    /// Time steps to integrate.
+    #[arg(long, default_value_t = 100, value_parser = parse_count)]
+    pub steps: usize,
+    #[command(flatten)]
+    pub system: SystemArgs,
+    #[command(flatten)]
+    pub kernel_args: KernelArgs,
+    /// Write a machine-readable result (schema nbody-bench/run/v1) to this file.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Write an NBView trajectory (x, y; 3-D scenarios projected) to this file.
+    #[arg(long, value_name = "FILE")]
+    pub trajectory: Option<PathBuf>,
+    /// Trajectory format.
+    #[arg(long, value_enum, default_value = "nbview-bin", requires = "trajectory")]
+    pub format: NbviewFormat,
+    /// Write a trajectory frame every K steps.
+    #[arg(long, default_value_t = 10, value_parser = parse_count, requires = "trajectory")]
+    pub every: usize,
+    /// Write the final positions, velocities and forces (text, id order, nothing run-dependent).
+    #[arg(long, value_name = "FILE")]
+    pub dump_state: Option<PathBuf>,
+}
+
+#[derive(Debug, Args)]
+pub struct ValidateArgs {
+    /// Scenario to check [default: all].
+    #[arg(long, value_enum)]
+    pub scenario: Option<ScenarioKind>,
+    #[command(flatten)]
+    pub system: SystemArgs,
+    #[command(flatten)]
+    pub kernel_args: KernelArgs,
+    /// Write positions, reference forces and every kernel's forces (text) to this file;
+    /// with several scenarios, one file per scenario named FILE.<scenario>.
+    #[arg(long, value_name = "FILE")]
+    pub dump: Option<PathBuf>,
+    /// Print the result as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_count(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(0) => Err("must be at least 1".into()),
+        Ok(v) => Ok(v),
+        Err(_) => Err(format!("`{s}` is not a whole number")),
+    }
+}
+
+fn parse_float(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
+    if v.is_finite() { Ok(v) } else { Err("must be finite".into()) }
+}
+
+fn parse_positive(s: &str) -> Result<f64, String> {
+    let v = parse_float(s)?;
+    if v > 0.0 { Ok(v) } else { Err(format!("must be greater than 0 (got {v})")) }
+}
+
+fn parse_non_negative(s: &str) -> Result<f64, String> {
+    let v = parse_float(s)?;
+    if v >= 0.0 { Ok(v) } else { Err(format!("must be 0 or greater (got {v})")) }
+}

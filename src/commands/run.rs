@@ -1,0 +1,105 @@
+use super::{kernel_params, setup};
+use crate::cli::RunArgs;
+use crate::run::{RunJob, RunOutcome, RunSpec, TrajectorySpec, logical_cpus};
+use anyhow::Context;
+
+pub fn run(args: RunArgs) -> anyhow::Result<i32> {
+    let setup = setup(args.scenario, &args.system);
+    let spec = RunSpec {
+        kernel: args.kernel,
+        params: kernel_params(&args.kernel_args),
+        steps: args.steps as u64,
+        threads: args.kernel_args.threads,
+        trajectory: args.trajectory.map(|path| TrajectorySpec { path, format: args.format, every: args.every as u64 }),
+        dump_state: args.dump_state,
+    };
+    if spec.threads > logical_cpus() {
+        eprintln!(
+            "warning: {} threads on {} logical CPUs: oversubscribed; timings do not show real parallel speedup",
+            spec.threads,
+            logical_cpus()
+        );
+    }
+    let outcome = setup.dispatch(RunJob(&spec))??;
+    print_summary(&outcome);
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
+        crate::output::write_atomic(path, text.as_bytes())?;
+        println!("result written to {}", path.display());
+    }
+    Ok(0)
+}
+
+fn print_summary(r: &RunOutcome) {
+    let t = &r.timing;
+    println!(
+        "{} / {}: n = {}, {} steps, {} thread{}{}, {}-D {}, seed {}, simd {}",
+        r.scenario,
+        r.kernel,
+        r.n,
+        r.steps,
+        r.threads,
+        if r.threads == 1 { "" } else { "s" },
+        if r.oversubscribed { " (oversubscribed)" } else { "" },
+        r.dim,
+        r.precision,
+        r.seed,
+        r.simd
+    );
+    if r.n < r.n_requested {
+        println!("note: placed {} of the {} particles requested (--allow-fewer)", r.n, r.n_requested);
+    }
+    let p = &t.per_step_ns;
+    println!(
+        "time per step     p50 {}  p90 {}  p99 {}  max {}",
+        fmt_ns(p.p50 as f64),
+        fmt_ns(p.p90 as f64),
+        fmt_ns(p.p99 as f64),
+        fmt_ns(p.max as f64)
+    );
+    println!("per particle-step {}", fmt_ns(t.ns_per_particle_step));
+    println!(
+        "throughput        {:.3e} particle-steps/s, {:.3e} pair-evaluations/s",
+        r.throughput.particle_steps_per_s, r.throughput.pair_evals_per_s
+    );
+    let ph = &t.phases;
+    let total = ph.total().max(f64::MIN_POSITIVE);
+    let pct = |x: f64| 100.0 * x / total;
+    println!(
+        "phases            force build {:.1}%  interact {:.1}%  integrate {:.1}%  boundary {:.1}%  output {:.1}%",
+        pct(ph.force_build),
+        pct(ph.force_interact),
+        pct(ph.integrate),
+        pct(ph.boundary),
+        pct(ph.output)
+    );
+    let c = &r.counters;
+    print!("work per step     {:.4e} pair checks", c.pair_checks_per_step);
+    let steps = r.steps.max(1) as f64;
+    if c.total.nodes_opened > 0 {
+        print!(", {:.4e} nodes opened, {:.4e} accepted", c.total.nodes_opened as f64 / steps, c.total.nodes_accepted as f64 / steps);
+    }
+    if c.total.cells_visited > 0 {
+        print!(", {:.4e} cells visited", c.total.cells_visited as f64 / steps);
+    }
+    println!("; {} interacting pairs at the end", c.pairs_interacting_final);
+    println!(
+        "energy            {:.6e} -> {:.6e}, relative drift {:+.3e}",
+        r.energy.initial.total(),
+        r.energy.last.total(),
+        r.energy.rel_drift
+    );
+}
+
+/// A duration in ns, printed with a readable unit.
+pub fn fmt_ns(ns: f64) -> String {
+    if ns >= 1e9 {
+        format!("{:.3} s", ns * 1e-9)
+    } else if ns >= 1e6 {
+        format!("{:.3} ms", ns * 1e-6)
+    } else if ns >= 1e3 {
+        format!("{:.3} us", ns * 1e-3)
+    } else {
+        format!("{ns:.2} ns")
+    }
+}

@@ -1,0 +1,67 @@
+use super::{kernel_params, setup};
+use crate::cli::ValidateArgs;
+use crate::scenario::ScenarioKind;
+use crate::validate::{ScenarioCheck, ValidateJob};
+use std::path::PathBuf;
+
+pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
+    let scenarios: Vec<ScenarioKind> = match args.scenario {
+        Some(s) => vec![s],
+        None => ScenarioKind::ALL.to_vec(),
+    };
+    let params = kernel_params(&args.kernel_args);
+    let mut results: Vec<ScenarioCheck> = Vec::new();
+    for &scenario in &scenarios {
+        let mut s = setup(scenario, &args.system);
+        if args.scenario.is_none() && args.system.density.is_some() && scenario.defaults().density.is_none() {
+            // --density applies to the scenarios that have one.
+            s.density = None;
+        }
+        let job = ValidateJob { params, threads: args.kernel_args.threads, want_dump: args.dump.is_some() };
+        let check = s.dispatch(job)??;
+        if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
+            let path = if scenarios.len() > 1 { dump_path(path, scenario) } else { path.clone() };
+            crate::output::write_atomic(&path, text.as_bytes())?;
+            if !args.json {
+                println!("forces written to {}", path.display());
+            }
+        }
+        if !args.json {
+            print_check(&check);
+        }
+        results.push(check);
+    }
+    let failed: Vec<String> = results
+        .iter()
+        .flat_map(|c| c.kernels.iter().filter(|k| !k.passed).map(move |k| format!("{}/{}", c.scenario, k.kernel)))
+        .collect();
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&results)?);
+    } else if failed.is_empty() {
+        println!("all kernels agree with the reference");
+    } else {
+        println!("FAILED: {}", failed.join(", "));
+    }
+    Ok(if failed.is_empty() { 0 } else { 1 })
+}
+
+fn dump_path(path: &std::path::Path, scenario: ScenarioKind) -> PathBuf {
+    let mut p = path.as_os_str().to_owned();
+    p.push(format!(".{}", scenario.name()));
+    PathBuf::from(p)
+}
+
+fn print_check(c: &ScenarioCheck) {
+    println!("{}: n = {}, {}, reference = naive in f64, theta = {}", c.scenario, c.n, c.precision, c.theta);
+    println!("  {:<11} {:>12} {:>12}  {:<6} criterion", "kernel", "max rel err", "median", "result");
+    for k in &c.kernels {
+        println!(
+            "  {:<11} {:>12.3e} {:>12.3e}  {:<6} {}",
+            k.kernel,
+            k.max_rel_error,
+            k.median_rel_error,
+            if k.passed { "ok" } else { "FAIL" },
+            k.criterion
+        );
+    }
+}

@@ -1,0 +1,151 @@
+//! The simulation loop: one kernel, one system, velocity Verlet, phase timers and counters.
+
+use crate::boundary::{Boundary, BoundaryError};
+use crate::integrator::{drift, kick};
+use crate::kernels::{ForceKernel, WorkCounters};
+use crate::real::Real;
+use crate::scenario::System;
+use crate::state::{Field, State, zero_field};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order).
+pub const SORT_EVERY: u64 = 20;
+
+/// Seconds spent in each phase of the step, summed over steps.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct PhaseTimes {
+    /// Force: building cells, trees and sort orders (including the periodic re-ordering).
+    pub force_build: f64,
+    /// Force: evaluating interactions.
+    pub force_interact: f64,
+    /// Kicks and drift.
+    pub integrate: f64,
+    /// Walls or bounding box.
+    pub boundary: f64,
+    /// Trajectory frames written by the driver.
+    pub output: f64,
+}
+
+impl PhaseTimes {
+    pub fn total(&self) -> f64 {
+        self.force_build + self.force_interact + self.integrate + self.boundary + self.output
+    }
+}
+
+/// Energies of the current state.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub potential: f64,
+    /// Potential energy in the external field.
+    pub external: f64,
+}
+
+impl Energy {
+    pub fn total(&self) -> f64 {
+        self.kinetic + self.potential + self.external
+    }
+}
+
+/// A system being integrated with one kernel.
+pub struct Simulation<T: Real, const D: usize> {
+    pub state: State<T, D>,
+    pub forces: Field<T, D>,
+    kernel: Box<dyn ForceKernel<T, D>>,
+    boundary: Boundary<T, D>,
+    external: [T; D],
+    dt: T,
+    /// Steps taken so far.
+    pub step: u64,
+    pub phases: PhaseTimes,
+    /// Work summed over the steps taken (probe computations excluded).
+    pub work: WorkCounters,
+    /// Bounding box after the last boundary phase.
+    pub bounds: ([T; D], [T; D]),
+    /// Energy and work of the last probe.
+    last_probe: (f64, WorkCounters),
+}
+
+impl<T: Real, const D: usize> Simulation<T, D> {
+    /// Prepares the run: spatial order for the kernel, initial forces (untimed).
+    pub fn new<L>(system: System<T, L, D>, kernel: Box<dyn ForceKernel<T, D>>) -> Self {
+        let n = system.state.len();
+        let bounds = system.state.bounding_box();
+        let mut sim = Simulation {
+            state: system.state,
+            forces: zero_field(n),
+            kernel,
+            boundary: system.boundary,
+            external: system.external,
+            dt: system.dt,
+            step: 0,
+            phases: PhaseTimes::default(),
+            work: WorkCounters::default(),
+            bounds,
+            last_probe: (0.0, WorkCounters::default()),
+        };
+        if let Some(order) = sim.kernel.spatial_order(&sim.state) {
+            sim.state.permute(&order, &mut [&mut sim.forces]);
+        }
+        sim.probe();
+        sim
+    }
+
+    /// Recomputes the forces with energy accounting (outside the timed steps) and returns the
+    /// energies. The forces are the same as the timed path's.
+    pub fn probe(&mut self) -> Energy {
+        let report = self.kernel.compute(&self.state, &mut self.forces, true);
+        let potential = report.energy.unwrap_or(f64::NAN);
+        self.last_probe = (potential, report.work);
+        self.energy_with(potential)
+    }
+
+    /// Work counters of the last probe (including interacting pairs).
+    pub fn probe_work(&self) -> WorkCounters {
+        self.last_probe.1
+    }
+
+    fn energy_with(&self, potential: f64) -> Energy {
+        let s = &self.state;
+        let mut external = 0.0;
+        for d in 0..D {
+            let g = self.external[d].as_f64();
+            if g != 0.0 {
+                external -= g * s.pos[d].iter().zip(&s.mass).map(|(x, m)| x.as_f64() * m.as_f64()).sum::<f64>();
+            }
+        }
+        Energy { kinetic: s.kinetic_energy(), potential, external }
+    }
+
+    /// One velocity-Verlet step.
+    pub fn step(&mut self) -> Result<(), BoundaryError> {
+        let half = self.dt * T::of(0.5);
+        let t0 = Instant::now();
+        kick(&mut self.state, &self.forces, self.external, half);
+        drift(&mut self.state, self.dt);
+        let t1 = Instant::now();
+        self.bounds = self.boundary.apply(&mut self.state, self.step + 1)?;
+        let t2 = Instant::now();
+        let mut reorder_s = 0.0;
+        if (self.step + 1) % SORT_EVERY == 0 {
+            if let Some(order) = self.kernel.spatial_order(&self.state) {
+                self.state.permute(&order, &mut [&mut self.forces]);
+            }
+            reorder_s = t2.elapsed().as_secs_f64();
+        }
+        let t3 = Instant::now();
+        let report = self.kernel.compute(&self.state, &mut self.forces, false);
+        let t4 = Instant::now();
+        kick(&mut self.state, &self.forces, self.external, half);
+        let t5 = Instant::now();
+        self.step += 1;
+        self.work.add(&report.work);
+        let force = (t4 - t3).as_secs_f64();
+        self.phases.integrate += (t1 - t0).as_secs_f64() + (t5 - t4).as_secs_f64();
+        self.phases.boundary += (t2 - t1).as_secs_f64();
+        self.phases.force_build += reorder_s + report.build_s;
+        self.phases.force_interact += (force - report.build_s).max(0.0);
+        Ok(())
+    }
+}
