@@ -42,10 +42,10 @@ pub struct SystemArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Time step [default: the scenario's].
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     pub dt: Option<f64>,
     /// Particles per unit area (lj-box, lj-liquid): the box side becomes sqrt(n / density).
-    #[arg(long, value_parser = parse_positive)]
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     pub density: Option<f64>,
     /// Floating-point precision [default: the scenario's: f32 for LJ, f64 otherwise].
     #[arg(long, value_enum)]
@@ -59,7 +59,7 @@ pub struct SystemArgs {
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
     /// Barnes-Hut opening angle (octree): a node of side s at distance d is used whole when s/d < theta.
-    #[arg(long, default_value_t = 0.5, value_parser = parse_non_negative)]
+    #[arg(long, default_value_t = 0.5, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub theta: f64,
     /// Most particles in a tree leaf (octree).
     #[arg(long, default_value_t = 16, value_parser = parse_count)]

@@ -159,7 +159,7 @@ fn measure<T: Real, const D: usize>(
     let e0 = sim.probe();
     let p0 = sim.state.momentum().to_vec();
     let mut trajectory = match &spec.trajectory {
-        Some(t) => Some(Trajectory::start(t, &sim)?),
+        Some(t) => Some(Trajectory::start(t, &sim, info.box_side)?),
         None => None,
     };
     let mut step_ns = Vec::with_capacity(spec.steps as usize);
@@ -256,11 +256,18 @@ struct Trajectory {
 }
 
 impl Trajectory {
-    fn start<T: Real, const D: usize>(spec: &TrajectorySpec, sim: &Simulation<T, D>) -> Result<Self, WriteError> {
+    fn start<T: Real, const D: usize>(
+        spec: &TrajectorySpec,
+        sim: &Simulation<T, D>,
+        box_side: Option<f64>,
+    ) -> Result<Self, WriteError> {
         let mut file = AtomicFile::create(&spec.path)?;
         // The viewer shows [0, scale]²: the box side, or the initial extent of an open system.
         let (lo, hi) = sim.state.bounding_box();
-        let scale = (0..D.min(2)).map(|d| hi[d].as_f64().abs().max(lo[d].as_f64().abs())).fold(0.0, f64::max);
+        let extent = (0..D.min(2))
+            .map(|d| hi[d].as_f64().abs().max(lo[d].as_f64().abs()))
+            .fold(0.0, f64::max);
+        let scale = box_side.unwrap_or(extent);
         let n = sim.state.len();
         nbview::write_header(file.writer(), spec.format, n as u32, scale as f32).map_err(|e| file.error(e))?;
         let mut t = Trajectory { file, format: spec.format, every: spec.every.max(1), frame: vec![[0.0; 2]; n] };

@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# Runs every check of the project: formatting, lints, unit and integration tests, and the
+# force validation of every scenario. Works on a fresh machine with a Rust toolchain.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if ! command -v cargo >/dev/null 2>&1; then
+    echo "cargo not found: install Rust from https://rustup.rs" >&2
+    exit 2
+fi
+rustup component add rustfmt clippy >/dev/null 2>&1 || true
+
+cargo fmt --all -- --check
+cargo clippy --all-targets --release -- -D warnings
+cargo test --release
+cargo build --release
+./target/release/nbody-bench validate --threads 2
