@@ -128,7 +128,7 @@ impl<T: Real, const D: usize> Simulation<T, D> {
         self.bounds = self.boundary.apply(&mut self.state, self.step + 1)?;
         let t2 = Instant::now();
         let mut reorder_s = 0.0;
-        if (self.step + 1) % SORT_EVERY == 0 {
+        if (self.step + 1).is_multiple_of(SORT_EVERY) {
             if let Some(order) = self.kernel.spatial_order(&self.state) {
                 self.state.permute(&order, &mut [&mut self.forces]);
             }

@@ -168,12 +168,10 @@ fn measure<T: Real, const D: usize>(
         let t = Instant::now();
         sim.step()?;
         step_ns.push(t.elapsed().as_nanos() as u64);
-        if let Some(tr) = trajectory.as_mut() {
-            if sim.step % tr.every == 0 {
-                let t = Instant::now();
-                tr.frame(&sim)?;
-                sim.phases.output += t.elapsed().as_secs_f64();
-            }
+        if let Some(tr) = trajectory.as_mut().filter(|tr| sim.step.is_multiple_of(tr.every)) {
+            let t = Instant::now();
+            tr.frame(&sim)?;
+            sim.phases.output += t.elapsed().as_secs_f64();
         }
     }
     let total_s = start.elapsed().as_secs_f64();

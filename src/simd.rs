@@ -84,3 +84,6 @@ pub fn dispatch<R>(f: impl FnOnce() -> R) -> R {
         _ => f(),
     }
 }
+
+/// Lanes per block of the pair loops; a multiple of the vector width for both precisions.
+pub const LANES: usize = 16;

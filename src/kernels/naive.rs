@@ -2,7 +2,7 @@
 //! MPI source code). Targets are independent, so it parallelizes over them without races.
 
 use super::par::{chunk_len, for_chunks};
-use super::rows::{RowSum, Sources, Target, gather};
+use super::rows::{Exclude, RowSum, Sources, Target, gather_excluding};
 use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -35,13 +35,10 @@ fn rows<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
             x: state.position(i),
             s: state.source[i],
         };
-        let mut sum =
-            gather::<T, L, D, PROBE>(law, &t, &Sources::range(&state.pos, &state.source, 0, i));
-        sum.add(&gather::<T, L, D, PROBE>(
-            law,
-            &t,
-            &Sources::range(&state.pos, &state.source, i + 1, n),
-        ));
+        // One run over all particles with the target's own slot masked: no scalar tails
+        // around the diagonal.
+        let all = Sources::range(&state.pos, &state.source, 0, n);
+        let sum = gather_excluding::<T, L, D, PROBE>(law, &t, &all, Exclude::index(i));
         for d in 0..D {
             out[d][k] = sum.force[d];
         }

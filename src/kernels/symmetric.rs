@@ -5,7 +5,7 @@
 //! stream; to keep that stream in L1 the j loop is tiled: targets of one block of `BLOCK`
 //! particles meet sources one block at a time.
 
-use super::rows::{RowSum, Sources, Target, scatter};
+use super::rows::{Exclude, LANES, RowSum, Sources, Target, scatter};
 use super::{ForceKernel, ForceReport, KernelKind, WorkCounters};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -54,7 +54,18 @@ pub fn add_tiles<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
         for bj in bi..blocks(n) {
             let (jlo, jhi) = (bj * BLOCK, ((bj + 1) * BLOCK).min(n));
             for i in ilo..ihi {
-                let lo = if bi == bj { i + 1 } else { jlo };
+                // On the diagonal tile row i meets j > i only. Start the run early enough that
+                // it is a whole number of SIMD blocks and mask the sources up to i, instead of
+                // finishing every row with a scalar tail.
+                let (lo, exclude) = if bi == bj {
+                    let len = (jhi - i - 1).next_multiple_of(LANES);
+                    match jhi.checked_sub(len).filter(|&lo| lo >= ilo) {
+                        Some(lo) => (lo, Exclude::below(i + 1 - lo)),
+                        None => (i + 1, Exclude::NONE),
+                    }
+                } else {
+                    (jlo, Exclude::NONE)
+                };
                 let t = Target {
                     x: state.position(i),
                     s: state.source[i],
@@ -64,7 +75,7 @@ pub fn add_tiles<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
                     let mut it = out.iter_mut();
                     std::array::from_fn(|_| &mut it.next().expect("D components")[lo..jhi])
                 };
-                let sum = scatter::<T, L, D, PROBE>(law, &t, &src, fsrc);
+                let sum = scatter::<T, L, D, PROBE>(law, &t, &src, fsrc, exclude);
                 for d in 0..D {
                     out[d][i] += sum.force[d];
                 }
