@@ -15,7 +15,7 @@ use std::path::PathBuf;
         An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, octree) \
         over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, work counters \
         and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
-    after_help = "Examples:\n  nbody-bench list\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
+    after_help = "Examples:\n  nbody-bench list\n  nbody-bench sweep --config configs/quick.toml\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -30,6 +30,9 @@ pub enum Command {
     Run(RunArgs),
     /// Check every applicable kernel's forces against the naive sum in f64 (exit 1 on a mismatch).
     Validate(ValidateArgs),
+    /// Measure every case of a TOML config (n, threads, kernels, scenarios) with statistics and
+    /// machine calibration; writes <out>/<name>/results.json after every case.
+    Sweep(SweepArgs),
 }
 
 /// Options that define the simulated system.
@@ -62,7 +65,7 @@ pub struct KernelArgs {
     #[arg(long, default_value_t = 0.5, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub theta: f64,
     /// Most particles in a tree leaf (octree).
-    #[arg(long, default_value_t = 16, value_parser = parse_count)]
+    #[arg(long, default_value_t = 8, value_parser = parse_count)]
     pub leaf_size: usize,
     /// Threads in the rayon pool for this run (the environment's RAYON_NUM_THREADS is not used).
     #[arg(long, default_value_t = 1, value_parser = parse_count)]
@@ -91,7 +94,12 @@ pub struct RunArgs {
     #[arg(long, value_name = "FILE")]
     pub trajectory: Option<PathBuf>,
     /// Trajectory format.
-    #[arg(long, value_enum, default_value = "nbview-bin", requires = "trajectory")]
+    #[arg(
+        long,
+        value_enum,
+        default_value = "nbview-bin",
+        requires = "trajectory"
+    )]
     pub format: NbviewFormat,
     /// Write a trajectory frame every K steps.
     #[arg(long, default_value_t = 10, value_parser = parse_count, requires = "trajectory")]
@@ -129,15 +137,49 @@ fn parse_count(s: &str) -> Result<usize, String> {
 
 fn parse_float(s: &str) -> Result<f64, String> {
     let v: f64 = s.parse().map_err(|_| format!("`{s}` is not a number"))?;
-    if v.is_finite() { Ok(v) } else { Err("must be finite".into()) }
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err("must be finite".into())
+    }
 }
 
 fn parse_positive(s: &str) -> Result<f64, String> {
     let v = parse_float(s)?;
-    if v > 0.0 { Ok(v) } else { Err(format!("must be greater than 0 (got {v})")) }
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be greater than 0 (got {v})"))
+    }
 }
 
 fn parse_non_negative(s: &str) -> Result<f64, String> {
     let v = parse_float(s)?;
-    if v >= 0.0 { Ok(v) } else { Err(format!("must be 0 or greater (got {v})")) }
+    if v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!("must be 0 or greater (got {v})"))
+    }
+}
+
+#[derive(Debug, Args)]
+pub struct SweepArgs {
+    /// The sweep config (TOML), e.g. configs/quick.toml.
+    #[arg(long, value_name = "FILE")]
+    pub config: PathBuf,
+    /// Continue an interrupted sweep: cases already measured are kept and not repeated.
+    #[arg(long, conflicts_with = "fresh")]
+    pub resume: bool,
+    /// With --resume: accept a results file from a different config or commit.
+    #[arg(long, requires = "resume")]
+    pub force: bool,
+    /// Start over; an existing results file is kept under a .bak name.
+    #[arg(long)]
+    pub fresh: bool,
+    /// Output directory instead of the config's `out` (results go to DIR/<name>/results.json).
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
+    /// Skip the machine calibration at the start and end (faster; speedups then have no ceiling).
+    #[arg(long)]
+    pub no_calibration: bool,
 }

@@ -13,7 +13,7 @@ use std::time::Instant;
 pub const SORT_EVERY: u64 = 20;
 
 /// Seconds spent in each phase of the step, summed over steps.
-#[derive(Clone, Copy, Debug, Default, Serialize)]
+#[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize, PartialEq)]
 pub struct PhaseTimes {
     /// Force: building cells, trees and sort orders (including the periodic re-ordering).
     pub force_build: f64,
@@ -112,10 +112,18 @@ impl<T: Real, const D: usize> Simulation<T, D> {
         for d in 0..D {
             let g = self.external[d].as_f64();
             if g != 0.0 {
-                external -= g * s.pos[d].iter().zip(&s.mass).map(|(x, m)| x.as_f64() * m.as_f64()).sum::<f64>();
+                external -= g * s.pos[d]
+                    .iter()
+                    .zip(&s.mass)
+                    .map(|(x, m)| x.as_f64() * m.as_f64())
+                    .sum::<f64>();
             }
         }
-        Energy { kinetic: s.kinetic_energy(), potential, external }
+        Energy {
+            kinetic: s.kinetic_energy(),
+            potential,
+            external,
+        }
     }
 
     /// One velocity-Verlet step.

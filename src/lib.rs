@@ -7,9 +7,11 @@
 //! [`run`] and [`validate`] (measured runs and force checks), [`output`], and the CLI.
 
 pub mod boundary;
+pub mod calibrate;
 pub mod cli;
 pub mod commands;
 pub mod engine;
+pub mod experiment;
 pub mod integrator;
 pub mod kernels;
 pub mod output;

@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 /// Order statistics of per-step times in nanoseconds.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct StepPercentiles {
     pub min: u64,
     pub p50: u64,
@@ -41,7 +41,39 @@ pub fn median(values: &[f64]) -> Option<f64> {
     let mut v = values.to_vec();
     v.sort_by(f64::total_cmp);
     let m = v.len() / 2;
-    Some(if v.len() % 2 == 1 { v[m] } else { 0.5 * (v[m - 1] + v[m]) })
+    Some(if v.len() % 2 == 1 {
+        v[m]
+    } else {
+        0.5 * (v[m - 1] + v[m])
+    })
+}
+
+/// Median absolute deviation from the median; `None` when empty.
+pub fn mad(values: &[f64]) -> Option<f64> {
+    let m = median(values)?;
+    let dev: Vec<f64> = values.iter().map(|v| (v - m).abs()).collect();
+    median(&dev)
+}
+
+/// Percentile bootstrap 95% confidence interval of the median: `resamples` resamples with
+/// replacement drawn from a generator seeded with `seed`, so the interval is reproducible.
+pub fn bootstrap_median_ci(values: &[f64], resamples: usize, seed: u64) -> Option<[f64; 2]> {
+    use rand::{Rng, SeedableRng};
+    if values.is_empty() {
+        return None;
+    }
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    let mut medians = Vec::with_capacity(resamples);
+    let mut buf = vec![0.0; values.len()];
+    for _ in 0..resamples.max(1) {
+        for b in buf.iter_mut() {
+            *b = values[rng.random_range(0..values.len())];
+        }
+        medians.push(median(&buf).expect("non-empty"));
+    }
+    medians.sort_by(f64::total_cmp);
+    let at = |q: f64| medians[((q * medians.len() as f64) as usize).min(medians.len() - 1)];
+    Some([at(0.025), at(0.975)])
 }
 
 #[cfg(test)]
@@ -57,6 +89,23 @@ mod tests {
         let one = StepPercentiles::of(&[7]).unwrap();
         assert_eq!((one.p50, one.p99, one.max), (7, 7, 7));
         assert!(StepPercentiles::of(&[]).is_none());
+    }
+
+    #[test]
+    fn mad_and_bootstrap() {
+        assert_eq!(mad(&[1.0, 2.0, 3.0, 4.0, 100.0]), Some(1.0));
+        let v: Vec<f64> = (0..101).map(|i| i as f64).collect();
+        let ci = bootstrap_median_ci(&v, 2000, 7).unwrap();
+        assert!(
+            ci[0] < 50.0 && ci[1] > 50.0 && ci[0] > 35.0 && ci[1] < 65.0,
+            "{ci:?}"
+        );
+        assert_eq!(
+            ci,
+            bootstrap_median_ci(&v, 2000, 7).unwrap(),
+            "seeded: reproducible"
+        );
+        assert_eq!(bootstrap_median_ci(&[3.0], 100, 1), Some([3.0, 3.0]));
     }
 
     #[test]

@@ -71,14 +71,28 @@ impl SystemJob for ValidateJob {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()
-            .map_err(|source| crate::run::RunError::Pool { threads: self.threads, source })?;
+            .map_err(|source| crate::run::RunError::Pool {
+                threads: self.threads,
+                source,
+            })?;
         let mut checks = Vec::new();
         let mut dumped = Vec::new();
-        for kind in KernelKind::ALL.into_iter().filter(|k| k.supports(system.law.kind())) {
-            let mut kernel: Box<dyn ForceKernel<T, D>> = kind.build::<T, L, D>(system.law, &self.params)?;
+        for kind in KernelKind::ALL
+            .into_iter()
+            .filter(|k| k.supports(system.law.kind()))
+        {
+            let mut kernel: Box<dyn ForceKernel<T, D>> =
+                kind.build::<T, L, D>(system.law, &self.params)?;
             let mut forces = zero_field::<T, D>(n);
             pool.install(|| kernel.compute(state, &mut forces, false));
-            checks.push(check(kind, system.law.kind(), self.params.theta, &forces, &reference, &abs_sum));
+            checks.push(check(
+                kind,
+                system.law.kind(),
+                self.params.theta,
+                &forces,
+                &reference,
+                &abs_sum,
+            ));
             if self.want_dump {
                 dumped.push((kind.name(), forces));
             }
@@ -106,7 +120,10 @@ impl SystemJob for ValidateJob {
 
 /// The naive pair sum in f64, and per particle the sum of the magnitudes of its pair forces
 /// (the scale of the rounding error any summation order can make).
-pub fn reference_forces<L: PairLaw<f64>, const D: usize>(law: &L, state: &State<f64, D>) -> (Field<f64, D>, Vec<f64>) {
+pub fn reference_forces<L: PairLaw<f64>, const D: usize>(
+    law: &L,
+    state: &State<f64, D>,
+) -> (Field<f64, D>, Vec<f64>) {
     let n = state.len();
     let mut forces = zero_field::<f64, D>(n);
     Naive::new(*law).compute(state, &mut forces, false);
@@ -139,15 +156,25 @@ fn check<T: Real, const D: usize>(
     abs_sum: &[f64],
 ) -> KernelCheck {
     let n = abs_sum.len();
-    let ref_norm: Vec<f64> = (0..n).map(|i| norm::<D>(std::array::from_fn(|d| reference[d][i]))).collect();
+    let ref_norm: Vec<f64> = (0..n)
+        .map(|i| norm::<D>(std::array::from_fn(|d| reference[d][i])))
+        .collect();
     let rms = (ref_norm.iter().map(|x| x * x).sum::<f64>() / n.max(1) as f64).sqrt();
     let floor = (1e-6 * rms).max(f64::MIN_POSITIVE);
     let mut rel = Vec::with_capacity(n);
     let mut max_ratio = 0.0f64;
     for i in 0..n {
-        let err = norm::<D>(std::array::from_fn(|d| forces[d][i].as_f64() - reference[d][i]));
+        let err = norm::<D>(std::array::from_fn(|d| {
+            forces[d][i].as_f64() - reference[d][i]
+        }));
         rel.push(err / ref_norm[i].max(floor));
-        let ratio = if abs_sum[i] > 0.0 { err / abs_sum[i] } else if err > 0.0 { f64::INFINITY } else { 0.0 };
+        let ratio = if abs_sum[i] > 0.0 {
+            err / abs_sum[i]
+        } else if err > 0.0 {
+            f64::INFINITY
+        } else {
+            0.0
+        };
         max_ratio = max_ratio.max(ratio);
     }
     let max_rel = rel.iter().copied().fold(0.0, f64::max);
@@ -156,11 +183,16 @@ fn check<T: Real, const D: usize>(
     let (passed, criterion) = if kind.is_exact() || theta == 0.0 {
         (
             max_ratio <= exact_bound,
-            format!("exact: |dF| <= {exact_bound:.1e} x sum|F_ij| per particle (worst {max_ratio:.2e})"),
+            format!(
+                "exact: |dF| <= {exact_bound:.1e} x sum|F_ij| per particle (worst {max_ratio:.2e})"
+            ),
         )
     } else {
         let tol = octree_tolerance(law, theta);
-        (median_rel <= tol, format!("approximate: median relative error <= {tol:.1e} at theta = {theta}"))
+        (
+            median_rel <= tol,
+            format!("approximate: median relative error <= {tol:.1e} at theta = {theta}"),
+        )
     };
     KernelCheck {
         kernel: kind.name(),
@@ -170,4 +202,45 @@ fn check<T: Real, const D: usize>(
         passed,
         criterion,
     }
+}
+
+/// Relative force error against the f64 direct sum on `m` particles drawn with `seed`
+/// (all particles when m ≥ n): (median, max) of |F − F_ref| / |F_ref|. O(m·n), for checking
+/// large runs where the full reference would be too slow.
+pub fn sampled_force_error<T: Real, L: PairLaw<T>, const D: usize>(
+    law: &L,
+    state: &State<T, D>,
+    forces: &Field<T, D>,
+    m: usize,
+    seed: u64,
+) -> (f64, f64) {
+    use crate::kernels::rows::{Exclude, Sources, Target, gather_excluding};
+    use rand::{Rng, SeedableRng};
+    let n = state.len();
+    let wide = state.convert::<f64>();
+    let law = law.widen();
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    let picks: Vec<usize> = if m >= n {
+        (0..n).collect()
+    } else {
+        (0..m).map(|_| rng.random_range(0..n)).collect()
+    };
+    let all = Sources::range(&wide.pos, &wide.source, 0, n);
+    let rel: Vec<f64> = picks
+        .iter()
+        .filter_map(|&i| {
+            let t = Target {
+                x: wide.position(i),
+                s: wide.source[i],
+            };
+            let f = gather_excluding::<f64, _, D, false>(&law, &t, &all, Exclude::index(i)).force;
+            let size = norm::<D>(f);
+            let err = norm::<D>(std::array::from_fn(|d| forces[d][i].as_f64() - f[d]));
+            (size > 0.0).then_some(err / size)
+        })
+        .collect();
+    (
+        median(&rel).unwrap_or(0.0),
+        rel.iter().copied().fold(0.0, f64::max),
+    )
 }

@@ -5,7 +5,10 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn bin(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_nbody-bench")).args(args).output().expect("binary runs")
+    Command::new(env!("CARGO_BIN_EXE_nbody-bench"))
+        .args(args)
+        .output()
+        .expect("binary runs")
 }
 
 fn stderr(o: &Output) -> String {
@@ -14,7 +17,12 @@ fn stderr(o: &Output) -> String {
 
 #[test]
 fn help_and_list() {
-    for args in [&["--help"][..], &["run", "--help"], &["validate", "--help"], &["list", "--help"]] {
+    for args in [
+        &["--help"][..],
+        &["run", "--help"],
+        &["validate", "--help"],
+        &["list", "--help"],
+    ] {
         let o = bin(args);
         assert!(o.status.success(), "{args:?}");
         assert!(String::from_utf8_lossy(&o.stdout).contains("Usage"));
@@ -22,7 +30,17 @@ fn help_and_list() {
     let o = bin(&["list"]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success());
-    for word in ["naive", "symmetric", "per-thread", "cell-list", "octree", "lj-box", "lj-liquid", "coulomb", "galaxy"] {
+    for word in [
+        "naive",
+        "symmetric",
+        "per-thread",
+        "cell-list",
+        "octree",
+        "lj-box",
+        "lj-liquid",
+        "coulomb",
+        "galaxy",
+    ] {
         assert!(out.contains(word), "list lacks {word}");
     }
     assert!(out.contains("galaxy     (gravity): naive, symmetric, per-thread, octree"));
@@ -31,29 +49,182 @@ fn help_and_list() {
 #[test]
 fn bad_input_exits_2_with_a_message() {
     let cases: &[(&[&str], &str)] = &[
-        (&["run", "--scenario", "lj-box", "--kernel", "fast"], "invalid value 'fast'"),
-        (&["run", "--scenario", "box", "--kernel", "naive"], "invalid value 'box'"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "-n", "0"], "must be at least 1"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--dt", "-1e-4"], "must be greater than 0"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--dt", "NaN"], "must be finite"),
-        (&["run", "--scenario", "galaxy", "--kernel", "octree", "--theta", "-0.5"], "must be 0 or greater"),
-        (&["run", "--scenario", "galaxy", "--kernel", "octree", "--theta", "nan"], "must be finite"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--density", "0"], "must be greater than 0"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--threads", "0"], "must be at least 1"),
-        (&["run", "--scenario", "galaxy", "--kernel", "cell-list"], "kernels for gravity: naive, symmetric, per-thread, octree"),
-        (&["run", "--scenario", "lj-box", "--kernel", "octree"], "kernels for lennard-jones: naive, symmetric, per-thread, cell-list"),
-        (&["run", "--scenario", "galaxy", "--kernel", "naive", "--density", "5"], "has no density parameter"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "-n", "20000", "--density", "20000"], "--allow-fewer"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--dt", "10", "--steps", "5"], "reduce --dt"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--steps", "2", "--json", "/nonexistent/r.json"], "/nonexistent/r.json"),
-        (&["run", "--scenario", "lj-box", "--kernel", "naive", "--every", "5"], "--trajectory"),
+        (
+            &["run", "--scenario", "lj-box", "--kernel", "fast"],
+            "invalid value 'fast'",
+        ),
+        (
+            &["run", "--scenario", "box", "--kernel", "naive"],
+            "invalid value 'box'",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "-n",
+                "0",
+            ],
+            "must be at least 1",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--dt",
+                "-1e-4",
+            ],
+            "must be greater than 0",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--dt",
+                "NaN",
+            ],
+            "must be finite",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "galaxy",
+                "--kernel",
+                "octree",
+                "--theta",
+                "-0.5",
+            ],
+            "must be 0 or greater",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "galaxy",
+                "--kernel",
+                "octree",
+                "--theta",
+                "nan",
+            ],
+            "must be finite",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--density",
+                "0",
+            ],
+            "must be greater than 0",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--threads",
+                "0",
+            ],
+            "must be at least 1",
+        ),
+        (
+            &["run", "--scenario", "galaxy", "--kernel", "cell-list"],
+            "kernels for gravity: naive, symmetric, per-thread, octree",
+        ),
+        (
+            &["run", "--scenario", "lj-box", "--kernel", "octree"],
+            "kernels for lennard-jones: naive, symmetric, per-thread, cell-list",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "galaxy",
+                "--kernel",
+                "naive",
+                "--density",
+                "5",
+            ],
+            "has no density parameter",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "-n",
+                "20000",
+                "--density",
+                "20000",
+            ],
+            "--allow-fewer",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--dt",
+                "10",
+                "--steps",
+                "5",
+            ],
+            "reduce --dt",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--steps",
+                "2",
+                "--json",
+                "/nonexistent/r.json",
+            ],
+            "/nonexistent/r.json",
+        ),
+        (
+            &[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--every",
+                "5",
+            ],
+            "--trajectory",
+        ),
         (&["frobnicate"], "unrecognized subcommand"),
     ];
     for (args, expected) in cases {
         let o = bin(args);
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
-        assert!(err.contains(expected), "{args:?}: expected `{expected}` in: {err}");
+        assert!(
+            err.contains(expected),
+            "{args:?}: expected `{expected}` in: {err}"
+        );
         assert!(!err.contains("panicked"), "{args:?} panicked: {err}");
     }
 }
@@ -62,21 +233,55 @@ fn bad_input_exits_2_with_a_message() {
 fn run_json_has_the_documented_fields() {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("r.json");
-    let o = bin(&["run", "--scenario", "lj-box", "--kernel", "cell-list", "-n", "400", "--steps", "30", "--json", json.to_str().unwrap()]);
+    let o = bin(&[
+        "run",
+        "--scenario",
+        "lj-box",
+        "--kernel",
+        "cell-list",
+        "-n",
+        "400",
+        "--steps",
+        "30",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     for path in [
-        "/schema", "/scenario", "/kernel", "/n", "/steps", "/threads", "/dim", "/precision", "/seed",
-        "/timing/total_s", "/timing/per_step_ns/p50", "/timing/per_step_ns/p90", "/timing/per_step_ns/p99",
-        "/timing/per_step_ns/max", "/timing/phases/force_build", "/timing/phases/force_interact",
-        "/timing/phases/integrate", "/timing/phases/boundary", "/timing/phases/output",
-        "/throughput/particle_steps_per_s", "/throughput/pair_evals_per_s", "/counters/total/pair_checks",
-        "/counters/total/cells_visited", "/energy/rel_drift",
+        "/schema",
+        "/scenario",
+        "/kernel",
+        "/n",
+        "/steps",
+        "/threads",
+        "/dim",
+        "/precision",
+        "/seed",
+        "/timing/total_s",
+        "/timing/per_step_ns/p50",
+        "/timing/per_step_ns/p90",
+        "/timing/per_step_ns/p99",
+        "/timing/per_step_ns/max",
+        "/timing/phases/force_build",
+        "/timing/phases/force_interact",
+        "/timing/phases/integrate",
+        "/timing/phases/boundary",
+        "/timing/phases/output",
+        "/throughput/particle_steps_per_s",
+        "/throughput/pair_evals_per_s",
+        "/counters/total/pair_checks",
+        "/counters/total/cells_visited",
+        "/energy/rel_drift",
     ] {
         assert!(v.pointer(path).is_some(), "missing {path}");
     }
     assert_eq!(v["schema"], "nbody-bench/run/v1");
-    assert_eq!((v["n"].as_u64(), v["steps"].as_u64(), v["dim"].as_u64()), (Some(400), Some(30), Some(2)));
+    assert_eq!(
+        (v["n"].as_u64(), v["steps"].as_u64(), v["dim"].as_u64()),
+        (Some(400), Some(30), Some(2))
+    );
     assert_eq!(v["precision"], "f32");
     assert!(v["timing"]["per_step_ns"]["p50"].as_u64().unwrap() > 0);
     assert!(v["counters"]["total"]["pair_checks"].as_u64().unwrap() > 0);
@@ -84,7 +289,17 @@ fn run_json_has_the_documented_fields() {
 
 fn dump(dir: &Path, name: &str, extra: &[&str]) -> String {
     let path = dir.join(name);
-    let mut args = vec!["run", "--scenario", "galaxy", "-n", "300", "--steps", "20", "--dump-state", path.to_str().unwrap()];
+    let mut args = vec![
+        "run",
+        "--scenario",
+        "galaxy",
+        "-n",
+        "300",
+        "--steps",
+        "20",
+        "--dump-state",
+        path.to_str().unwrap(),
+    ];
     args.extend_from_slice(extra);
     let o = bin(&args);
     assert!(o.status.success(), "{}", stderr(&o));
@@ -94,12 +309,26 @@ fn dump(dir: &Path, name: &str, extra: &[&str]) -> String {
 #[test]
 fn state_dumps_are_reproducible_and_documented() {
     let dir = tempfile::tempdir().unwrap();
-    let a = dump(dir.path(), "a.txt", &["--kernel", "naive", "--threads", "1"]);
-    let b = dump(dir.path(), "b.txt", &["--kernel", "naive", "--threads", "2"]);
-    assert_eq!(a, b, "naive computes each row the same way on any thread count");
+    let a = dump(
+        dir.path(),
+        "a.txt",
+        &["--kernel", "naive", "--threads", "1"],
+    );
+    let b = dump(
+        dir.path(),
+        "b.txt",
+        &["--kernel", "naive", "--threads", "2"],
+    );
+    assert_eq!(
+        a, b,
+        "naive computes each row the same way on any thread count"
+    );
     let lines: Vec<&str> = a.lines().collect();
     assert_eq!(lines[0], "# nbody-bench state v1");
-    assert_eq!(lines[1], "# scenario galaxy dim 3 precision f64 n 300 seed 1 steps 20 dt 0.001");
+    assert_eq!(
+        lines[1],
+        "# scenario galaxy dim 3 precision f64 n 300 seed 1 steps 20 dt 0.001"
+    );
     assert_eq!(lines[2], "# columns: id x y z vx vy vz fx fy fz");
     assert_eq!(lines.len(), 303);
     assert!(lines[3].starts_with("0 ") && lines[302].starts_with("299 "));
@@ -118,7 +347,21 @@ fn state_dumps_are_reproducible_and_documented() {
 fn trajectory_is_written_in_nbview_binary() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("t.nbv");
-    let o = bin(&["run", "--scenario", "lj-box", "--kernel", "naive", "-n", "50", "--steps", "20", "--every", "5", "--trajectory", path.to_str().unwrap()]);
+    let o = bin(&[
+        "run",
+        "--scenario",
+        "lj-box",
+        "--kernel",
+        "naive",
+        "-n",
+        "50",
+        "--steps",
+        "20",
+        "--every",
+        "5",
+        "--trajectory",
+        path.to_str().unwrap(),
+    ]);
     assert!(o.status.success(), "{}", stderr(&o));
     let t = nbody_bench::output::nbview::read_binary(std::fs::File::open(&path).unwrap()).unwrap();
     assert_eq!((t.n, t.frames.len()), (50, 5));
@@ -129,11 +372,24 @@ fn trajectory_is_written_in_nbview_binary() {
 fn validate_passes_for_every_scenario_and_dumps_forces() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("f.txt");
-    let o = bin(&["validate", "-n", "700", "--threads", "2", "--dump", path.to_str().unwrap()]);
+    let o = bin(&[
+        "validate",
+        "-n",
+        "700",
+        "--threads",
+        "2",
+        "--dump",
+        path.to_str().unwrap(),
+    ]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", stderr(&o));
     assert!(out.contains("all kernels agree"));
     let text = std::fs::read_to_string(dir.path().join("f.txt.coulomb")).unwrap();
-    assert!(text.lines().nth(2).unwrap().starts_with("# columns: id x y z fx_ref fy_ref fz_ref fx_naive"));
+    assert!(
+        text.lines()
+            .nth(2)
+            .unwrap()
+            .starts_with("# columns: id x y z fx_ref fy_ref fz_ref fx_naive")
+    );
     assert_eq!(text.lines().count(), 703);
 }

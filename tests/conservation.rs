@@ -31,19 +31,57 @@ fn energy_drift_is_bounded_for_every_scenario() {
     // (scenario, kernel, n, steps, dt, bound on |ΔE/E|). LJ energies are the shifted potential;
     // the truncated force still jumps at the cutoff, which sets the LJ bounds.
     let cases = [
-        (ScenarioKind::LjBox, KernelKind::CellList, 500, 300, None, 2e-3),
+        (
+            ScenarioKind::LjBox,
+            KernelKind::CellList,
+            500,
+            300,
+            None,
+            2e-3,
+        ),
         (ScenarioKind::LjBox, KernelKind::Naive, 500, 300, None, 2e-3),
-        (ScenarioKind::LjLiquid, KernelKind::CellList, 2000, 300, None, 1e-2),
-        (ScenarioKind::Galaxy, KernelKind::Symmetric, 1000, 300, None, 1e-4),
-        (ScenarioKind::Galaxy, KernelKind::Octree, 1000, 300, None, 1e-3),
+        (
+            ScenarioKind::LjLiquid,
+            KernelKind::CellList,
+            2000,
+            300,
+            None,
+            1e-2,
+        ),
+        (
+            ScenarioKind::Galaxy,
+            KernelKind::Symmetric,
+            1000,
+            300,
+            None,
+            1e-4,
+        ),
+        (
+            ScenarioKind::Galaxy,
+            KernelKind::Octree,
+            1000,
+            300,
+            None,
+            1e-3,
+        ),
         // At the source's dt = 1e-5 the closest opposite charges collapse within ~100 steps and
         // cross the quench radius, where the zeroed force does not conserve energy; a smaller
         // step keeps the check about the integrator.
-        (ScenarioKind::Coulomb, KernelKind::PerThread, 1000, 300, Some(1e-6), 1e-4),
+        (
+            ScenarioKind::Coulomb,
+            KernelKind::PerThread,
+            1000,
+            300,
+            Some(1e-6),
+            1e-4,
+        ),
     ];
     for (scenario, kernel, n, steps, dt, bound) in cases {
         let d = drift(scenario, kernel, n, steps, dt);
-        assert!(d.abs() < bound, "{scenario:?}/{kernel:?}: relative drift {d:e} exceeds {bound:e}");
+        assert!(
+            d.abs() < bound,
+            "{scenario:?}/{kernel:?}: relative drift {d:e} exceeds {bound:e}"
+        );
     }
 }
 
@@ -78,17 +116,24 @@ fn two_body_circular_orbit_stays_circular() {
             dt: period / steps as f64,
             info: info.clone(),
         };
-        let k = kernel.build::<f64, _, 3>(system.law, &KernelParams::default()).unwrap();
+        let k = kernel
+            .build::<f64, _, 3>(system.law, &KernelParams::default())
+            .unwrap();
         let mut sim = Simulation::new(system, k);
         let e0 = sim.probe().total();
         for _ in 0..steps {
             sim.step().unwrap();
-            let sep: f64 = (0..3).map(|d| (sim.state.pos[d][0] - sim.state.pos[d][1]).powi(2)).sum::<f64>().sqrt();
+            let sep: f64 = (0..3)
+                .map(|d| (sim.state.pos[d][0] - sim.state.pos[d][1]).powi(2))
+                .sum::<f64>()
+                .sqrt();
             assert!((sep - 2.0 * r).abs() < 1e-4, "{kernel:?}: separation {sep}");
         }
         // After one period the bodies are back where they started.
         let slot = sim.state.slots_by_id();
-        assert!((sim.state.pos[0][slot[0]] - r).abs() < 1e-4 && sim.state.pos[1][slot[0]].abs() < 1e-3);
+        assert!(
+            (sim.state.pos[0][slot[0]] - r).abs() < 1e-4 && sim.state.pos[1][slot[0]].abs() < 1e-3
+        );
         assert!(((sim.probe().total() - e0) / e0).abs() < 1e-8);
     }
 }

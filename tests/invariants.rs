@@ -7,8 +7,20 @@ use nbody_bench::state::{Field, State, zero_field};
 use nbody_bench::testing::{random_state, spaced_state};
 use proptest::prelude::*;
 
-fn forces<L: PairLaw<f64>, const D: usize>(kind: KernelKind, law: L, s: &State<f64, D>) -> Field<f64, D> {
-    let mut k = kind.build::<f64, L, D>(law, &KernelParams { theta: 0.0, leaf_size: 4 }).unwrap();
+fn forces<L: PairLaw<f64>, const D: usize>(
+    kind: KernelKind,
+    law: L,
+    s: &State<f64, D>,
+) -> Field<f64, D> {
+    let mut k = kind
+        .build::<f64, L, D>(
+            law,
+            &KernelParams {
+                theta: 0.0,
+                leaf_size: 4,
+            },
+        )
+        .unwrap();
     let mut f = zero_field(s.len());
     k.compute(s, &mut f, false);
     f
@@ -16,13 +28,27 @@ fn forces<L: PairLaw<f64>, const D: usize>(kind: KernelKind, law: L, s: &State<f
 
 /// Largest |component| of the summed force relative to the summed magnitudes.
 fn net_force_ratio<const D: usize>(f: &Field<f64, D>) -> f64 {
-    let scale: f64 = (0..f[0].len()).map(|i| (0..D).map(|d| f[d][i].abs()).sum::<f64>()).sum::<f64>().max(1e-300);
-    (0..D).map(|d| f[d].iter().sum::<f64>().abs()).fold(0.0, f64::max) / scale
+    let scale: f64 = (0..f[0].len())
+        .map(|i| (0..D).map(|d| f[d][i].abs()).sum::<f64>())
+        .sum::<f64>()
+        .max(1e-300);
+    (0..D)
+        .map(|d| f[d].iter().sum::<f64>().abs())
+        .fold(0.0, f64::max)
+        / scale
 }
 
-fn check_invariants<L: PairLaw<f64>, const D: usize>(law: L, s: State<f64, D>, shift: f64, perm_seed: u64) {
+fn check_invariants<L: PairLaw<f64>, const D: usize>(
+    law: L,
+    s: State<f64, D>,
+    shift: f64,
+    perm_seed: u64,
+) {
     let n = s.len();
-    for kind in KernelKind::ALL.into_iter().filter(|k| k.supports(law.kind())) {
+    for kind in KernelKind::ALL
+        .into_iter()
+        .filter(|k| k.supports(law.kind()))
+    {
         let f = forces(kind, law, &s);
         prop_assert_lt(net_force_ratio(&f), 1e-9, &format!("{kind:?}: net force"));
         // Translation: the same forces when every particle moves by `shift`.
@@ -42,11 +68,24 @@ fn check_invariants<L: PairLaw<f64>, const D: usize>(law: L, s: State<f64, D>, s
         shuffled.permute(&order, &mut []);
         let h = forces(kind, law, &shuffled);
         let slot = shuffled.slots_by_id();
-        let scale = f.iter().flatten().map(|v| v.abs()).fold(0.0, f64::max).max(1e-300);
+        let scale = f
+            .iter()
+            .flatten()
+            .map(|v| v.abs())
+            .fold(0.0, f64::max)
+            .max(1e-300);
         for i in 0..n {
             for d in 0..D {
-                prop_assert_lt((g[d][i] - f[d][i]).abs() / scale, 1e-6, &format!("{kind:?}: translation"));
-                prop_assert_lt((h[d][slot[i]] - f[d][i]).abs() / scale, 1e-9, &format!("{kind:?}: permutation"));
+                prop_assert_lt(
+                    (g[d][i] - f[d][i]).abs() / scale,
+                    1e-6,
+                    &format!("{kind:?}: translation"),
+                );
+                prop_assert_lt(
+                    (h[d][slot[i]] - f[d][i]).abs() / scale,
+                    1e-9,
+                    &format!("{kind:?}: permutation"),
+                );
             }
         }
     }

@@ -27,10 +27,21 @@ impl SystemJob for Compare {
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> Self::Output {
         let n = sys.state.len();
         let (reference, abs_sum) = reference_forces(&sys.law.widen(), &sys.state.convert::<f64>());
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(self.threads).build().unwrap();
-        let params = KernelParams { theta: self.theta, ..KernelParams::default() };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.threads)
+            .build()
+            .unwrap();
+        let params = KernelParams {
+            theta: self.theta,
+            ..KernelParams::default()
+        };
         let mut out = Vec::new();
-        for kind in self.kinds.iter().copied().filter(|k| k.supports(sys.law.kind())) {
+        for kind in self
+            .kinds
+            .iter()
+            .copied()
+            .filter(|k| k.supports(sys.law.kind()))
+        {
             let mut k = kind.build::<T, L, D>(sys.law, &params).unwrap();
             let mut f = zero_field::<T, D>(n);
             // Twice: the second call runs on reused buffers.
@@ -39,7 +50,10 @@ impl SystemJob for Compare {
             let mut worst = 0.0f64;
             let mut rel = Vec::new();
             for i in 0..n {
-                let err: f64 = (0..D).map(|d| (f[d][i].as_f64() - reference[d][i]).powi(2)).sum::<f64>().sqrt();
+                let err: f64 = (0..D)
+                    .map(|d| (f[d][i].as_f64() - reference[d][i]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
                 let norm: f64 = (0..D).map(|d| reference[d][i].powi(2)).sum::<f64>().sqrt();
                 if abs_sum[i] > 0.0 {
                     worst = worst.max(err / abs_sum[i]);
@@ -52,7 +66,11 @@ impl SystemJob for Compare {
             }
             rel.sort_by(f64::total_cmp);
             let median_rel = rel.get(rel.len() / 2).copied().unwrap_or(0.0);
-            out.push(Errors { kind, rounding_ratio: worst, median_rel });
+            out.push(Errors {
+                kind,
+                rounding_ratio: worst,
+                median_rel,
+            });
         }
         (T::EPSILON_F64, out)
     }
@@ -69,12 +87,21 @@ fn setup(scenario: ScenarioKind, n: usize, precision: Precision, seed: u64) -> S
 
 #[test]
 fn exact_kernels_agree_with_the_reference() {
-    let exact = vec![KernelKind::Naive, KernelKind::Symmetric, KernelKind::PerThread, KernelKind::CellList];
+    let exact = vec![
+        KernelKind::Naive,
+        KernelKind::Symmetric,
+        KernelKind::PerThread,
+        KernelKind::CellList,
+    ];
     for scenario in ScenarioKind::ALL {
         for precision in [Precision::F32, Precision::F64] {
             for n in [1, 2, 7, 100, 1500] {
                 for threads in [1, 2, 3] {
-                    let job = Compare { kinds: exact.clone(), threads, theta: 0.5 };
+                    let job = Compare {
+                        kinds: exact.clone(),
+                        threads,
+                        theta: 0.5,
+                    };
                     let (eps, errs) = setup(scenario, n, precision, 7).dispatch(job).unwrap();
                     assert!(errs.len() >= 3);
                     for e in errs {
@@ -96,9 +123,17 @@ fn octree_is_exact_at_theta_zero() {
     for scenario in [ScenarioKind::Galaxy, ScenarioKind::Coulomb] {
         for n in [1, 3, 17, 600] {
             for threads in [1, 2] {
-                let job = Compare { kinds: vec![KernelKind::Octree], threads, theta: 0.0 };
+                let job = Compare {
+                    kinds: vec![KernelKind::Octree],
+                    threads,
+                    theta: 0.0,
+                };
                 let (eps, errs) = setup(scenario, n, Precision::F64, 3).dispatch(job).unwrap();
-                assert!(errs[0].rounding_ratio <= EXACT_ULPS * eps, "{scenario:?} n={n}: {:e}", errs[0].rounding_ratio);
+                assert!(
+                    errs[0].rounding_ratio <= EXACT_ULPS * eps,
+                    "{scenario:?} n={n}: {:e}",
+                    errs[0].rounding_ratio
+                );
             }
         }
     }
@@ -110,16 +145,38 @@ fn octree_error_grows_with_theta_and_meets_the_target() {
         let errors: Vec<f64> = [0.2, 0.4, 0.6, 0.9]
             .iter()
             .map(|&theta| {
-                let job = Compare { kinds: vec![KernelKind::Octree], threads: 2, theta };
-                setup(scenario, 3000, Precision::F64, 5).dispatch(job).unwrap().1[0].median_rel
+                let job = Compare {
+                    kinds: vec![KernelKind::Octree],
+                    threads: 2,
+                    theta,
+                };
+                setup(scenario, 3000, Precision::F64, 5)
+                    .dispatch(job)
+                    .unwrap()
+                    .1[0]
+                    .median_rel
             })
             .collect();
-        assert!(errors.windows(2).all(|w| w[0] < w[1]), "{scenario:?}: {errors:?}");
+        assert!(
+            errors.windows(2).all(|w| w[0] < w[1]),
+            "{scenario:?}: {errors:?}"
+        );
         let at_half = {
-            let job = Compare { kinds: vec![KernelKind::Octree], threads: 1, theta: 0.5 };
-            setup(scenario, 3000, Precision::F64, 5).dispatch(job).unwrap().1[0].median_rel
+            let job = Compare {
+                kinds: vec![KernelKind::Octree],
+                threads: 1,
+                theta: 0.5,
+            };
+            setup(scenario, 3000, Precision::F64, 5)
+                .dispatch(job)
+                .unwrap()
+                .1[0]
+                .median_rel
         };
         let bound = nbody_bench::validate::octree_tolerance(scenario.law(), 0.5);
-        assert!(at_half <= bound, "{scenario:?}: median error {at_half:e} > {bound:e} at theta 0.5");
+        assert!(
+            at_half <= bound,
+            "{scenario:?}: median error {at_half:e} > {bound:e} at theta 0.5"
+        );
     }
 }

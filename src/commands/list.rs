@@ -5,16 +5,27 @@ pub fn list() -> anyhow::Result<i32> {
     println!("Kernels:");
     for k in KernelKind::ALL {
         let what = match k {
-            KernelKind::Naive => "every pair from both ends, n(n-1) evaluations; parallel over targets",
+            KernelKind::Naive => {
+                "every pair from both ends, n(n-1) evaluations; parallel over targets"
+            }
             KernelKind::Symmetric => "each pair once (Newton's third law), n(n-1)/2; one thread",
-            KernelKind::PerThread => "symmetric, split over threads with private force buffers + reduction",
-            KernelKind::CellList => "bins of side >= cutoff, sorted by bin; O(n); parallel over bins",
-            KernelKind::Octree => "Barnes-Hut tree (quadtree in 2-D), opening angle --theta; O(n log n)",
+            KernelKind::PerThread => {
+                "symmetric, split over threads with private force buffers + reduction"
+            }
+            KernelKind::CellList => {
+                "bins of side >= cutoff, sorted by bin; O(n); parallel over bins"
+            }
+            KernelKind::Octree => {
+                "Barnes-Hut tree (quadtree in 2-D), opening angle --theta; O(n log n)"
+            }
         };
         println!("  {:<11} {what}", k.name());
     }
     println!("\nScenarios:");
-    println!("  {:<10} {:>3} {:>9} {:>6} {:>8}  description", "name", "dim", "precision", "n", "dt");
+    println!(
+        "  {:<10} {:>3} {:>9} {:>6} {:>8}  description",
+        "name", "dim", "precision", "n", "dt"
+    );
     for s in ScenarioKind::ALL {
         let d = s.defaults();
         println!(
@@ -29,7 +40,12 @@ pub fn list() -> anyhow::Result<i32> {
     }
     println!("\nSupported combinations (law: kernels):");
     for s in ScenarioKind::ALL {
-        println!("  {:<10} ({}): {}", s.name(), s.law().name(), crate::kernels::supported_for(s.law()));
+        println!(
+            "  {:<10} ({}): {}",
+            s.name(),
+            s.law().name(),
+            crate::kernels::supported_for(s.law())
+        );
     }
     Ok(0)
 }

@@ -2,7 +2,10 @@
 
 mod list;
 mod run;
+mod sweep;
 mod validate;
+
+pub use run::fmt_ns;
 
 use crate::cli::{Cli, Command, KernelArgs, SystemArgs};
 use crate::kernels::KernelParams;
@@ -14,6 +17,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::List => list::list(),
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
+        Command::Sweep(args) => sweep::sweep(args),
     }
 }
 
@@ -30,5 +34,8 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
 }
 
 fn kernel_params(args: &KernelArgs) -> KernelParams {
-    KernelParams { theta: args.theta, leaf_size: args.leaf_size }
+    KernelParams {
+        theta: args.theta,
+        leaf_size: args.leaf_size,
+    }
 }

@@ -10,7 +10,11 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
         params: kernel_params(&args.kernel_args),
         steps: args.steps as u64,
         threads: args.kernel_args.threads,
-        trajectory: args.trajectory.map(|path| TrajectorySpec { path, format: args.format, every: args.every as u64 }),
+        trajectory: args.trajectory.map(|path| TrajectorySpec {
+            path,
+            format: args.format,
+            every: args.every as u64,
+        }),
         dump_state: args.dump_state,
     };
     if spec.threads > logical_cpus() {
@@ -40,14 +44,21 @@ fn print_summary(r: &RunOutcome) {
         r.steps,
         r.threads,
         if r.threads == 1 { "" } else { "s" },
-        if r.oversubscribed { " (oversubscribed)" } else { "" },
+        if r.oversubscribed {
+            " (oversubscribed)"
+        } else {
+            ""
+        },
         r.dim,
         r.precision,
         r.seed,
         r.simd
     );
     if r.n < r.n_requested {
-        println!("note: placed {} of the {} particles requested (--allow-fewer)", r.n, r.n_requested);
+        println!(
+            "note: placed {} of the {} particles requested (--allow-fewer)",
+            r.n, r.n_requested
+        );
     }
     let p = &t.per_step_ns;
     println!(
@@ -74,15 +85,28 @@ fn print_summary(r: &RunOutcome) {
         pct(ph.output)
     );
     let c = &r.counters;
-    print!("work per step     {:.4e} pair checks", c.pair_checks_per_step);
+    print!(
+        "work per step     {:.4e} pair checks",
+        c.pair_checks_per_step
+    );
     let steps = r.steps.max(1) as f64;
     if c.total.nodes_opened > 0 {
-        print!(", {:.4e} nodes opened, {:.4e} accepted", c.total.nodes_opened as f64 / steps, c.total.nodes_accepted as f64 / steps);
+        print!(
+            ", {:.4e} nodes opened, {:.4e} accepted",
+            c.total.nodes_opened as f64 / steps,
+            c.total.nodes_accepted as f64 / steps
+        );
     }
     if c.total.cells_visited > 0 {
-        print!(", {:.4e} cells visited", c.total.cells_visited as f64 / steps);
+        print!(
+            ", {:.4e} cells visited",
+            c.total.cells_visited as f64 / steps
+        );
     }
-    println!("; {} interacting pairs at the end", c.pairs_interacting_final);
+    println!(
+        "; {} interacting pairs at the end",
+        c.pairs_interacting_final
+    );
     println!(
         "energy            {:.6e} -> {:.6e}, relative drift {:+.3e}",
         r.energy.initial.total(),

@@ -13,14 +13,25 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
     let mut results: Vec<ScenarioCheck> = Vec::new();
     for &scenario in &scenarios {
         let mut s = setup(scenario, &args.system);
-        if args.scenario.is_none() && args.system.density.is_some() && scenario.defaults().density.is_none() {
+        if args.scenario.is_none()
+            && args.system.density.is_some()
+            && scenario.defaults().density.is_none()
+        {
             // --density applies to the scenarios that have one.
             s.density = None;
         }
-        let job = ValidateJob { params, threads: args.kernel_args.threads, want_dump: args.dump.is_some() };
+        let job = ValidateJob {
+            params,
+            threads: args.kernel_args.threads,
+            want_dump: args.dump.is_some(),
+        };
         let check = s.dispatch(job)??;
         if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
-            let path = if scenarios.len() > 1 { dump_path(path, scenario) } else { path.clone() };
+            let path = if scenarios.len() > 1 {
+                dump_path(path, scenario)
+            } else {
+                path.clone()
+            };
             crate::output::write_atomic(&path, text.as_bytes())?;
             if !args.json {
                 println!("forces written to {}", path.display());
@@ -33,7 +44,12 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
     }
     let failed: Vec<String> = results
         .iter()
-        .flat_map(|c| c.kernels.iter().filter(|k| !k.passed).map(move |k| format!("{}/{}", c.scenario, k.kernel)))
+        .flat_map(|c| {
+            c.kernels
+                .iter()
+                .filter(|k| !k.passed)
+                .map(move |k| format!("{}/{}", c.scenario, k.kernel))
+        })
         .collect();
     if args.json {
         println!("{}", serde_json::to_string_pretty(&results)?);
@@ -52,8 +68,14 @@ fn dump_path(path: &std::path::Path, scenario: ScenarioKind) -> PathBuf {
 }
 
 fn print_check(c: &ScenarioCheck) {
-    println!("{}: n = {}, {}, reference = naive in f64, theta = {}", c.scenario, c.n, c.precision, c.theta);
-    println!("  {:<11} {:>12} {:>12}  {:<6} criterion", "kernel", "max rel err", "median", "result");
+    println!(
+        "{}: n = {}, {}, reference = naive in f64, theta = {}",
+        c.scenario, c.n, c.precision, c.theta
+    );
+    println!(
+        "  {:<11} {:>12} {:>12}  {:<6} criterion",
+        "kernel", "max rel err", "median", "result"
+    );
     for k in &c.kernels {
         println!(
             "  {:<11} {:>12.3e} {:>12.3e}  {:<6} {}",

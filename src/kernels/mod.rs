@@ -27,7 +27,9 @@ use serde::Serialize;
 use thiserror::Error;
 
 /// The five kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum KernelKind {
     /// Every particle against every other (n(n−1) pair evaluations).
@@ -110,7 +112,7 @@ pub fn supported_for(law: LawKind) -> String {
 }
 
 /// Tuning parameters shared by the kernels that use them.
-#[derive(Clone, Copy, Debug, Serialize)]
+#[derive(Clone, Copy, Debug, Serialize, serde::Deserialize, PartialEq)]
 pub struct KernelParams {
     /// Barnes-Hut opening angle: a node of side `s` at distance `d` is used whole when `s/d < θ`.
     pub theta: f64,
@@ -122,7 +124,7 @@ impl Default for KernelParams {
     fn default() -> Self {
         KernelParams {
             theta: 0.5,
-            leaf_size: 16,
+            leaf_size: 8,
         }
     }
 }
@@ -158,7 +160,7 @@ pub enum KernelError {
 }
 
 /// Deterministic work done by one force computation.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]
 pub struct WorkCounters {
     /// Pair distance evaluations (candidate pairs examined).
     pub pair_checks: u64,

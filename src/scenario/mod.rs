@@ -21,7 +21,9 @@ use thiserror::Error;
 pub use placement::PlacementError;
 
 /// The scenarios a user can pick.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, clap::ValueEnum)]
+#[derive(
+    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum ScenarioKind {
     /// 2-D Lennard-Jones gas in a box with reflecting walls and downward gravity (source 000).
@@ -35,8 +37,12 @@ pub enum ScenarioKind {
 }
 
 impl ScenarioKind {
-    pub const ALL: [ScenarioKind; 4] =
-        [ScenarioKind::LjBox, ScenarioKind::LjLiquid, ScenarioKind::Coulomb, ScenarioKind::Galaxy];
+    pub const ALL: [ScenarioKind; 4] = [
+        ScenarioKind::LjBox,
+        ScenarioKind::LjLiquid,
+        ScenarioKind::Coulomb,
+        ScenarioKind::Galaxy,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
@@ -64,22 +70,46 @@ impl ScenarioKind {
 
     pub fn defaults(self) -> Defaults {
         match self {
-            ScenarioKind::LjBox => Defaults { n: 500, dt: 1e-4, precision: Precision::F32, density: Some(LJ_GAS_DENSITY) },
-            ScenarioKind::LjLiquid => {
-                Defaults { n: 10_000, dt: 1e-4, precision: Precision::F32, density: Some(LJ_LIQUID_DENSITY) }
-            }
-            ScenarioKind::Coulomb => Defaults { n: 1000, dt: 1e-5, precision: Precision::F64, density: None },
-            ScenarioKind::Galaxy => Defaults { n: 2000, dt: 1e-3, precision: Precision::F64, density: None },
+            ScenarioKind::LjBox => Defaults {
+                n: 500,
+                dt: 1e-4,
+                precision: Precision::F32,
+                density: Some(LJ_GAS_DENSITY),
+            },
+            ScenarioKind::LjLiquid => Defaults {
+                n: 10_000,
+                dt: 1e-4,
+                precision: Precision::F32,
+                density: Some(LJ_LIQUID_DENSITY),
+            },
+            ScenarioKind::Coulomb => Defaults {
+                n: 1000,
+                dt: 1e-5,
+                precision: Precision::F64,
+                density: None,
+            },
+            ScenarioKind::Galaxy => Defaults {
+                n: 2000,
+                dt: 1e-3,
+                precision: Precision::F64,
+                density: None,
+            },
         }
     }
 
     /// One line for `list`.
     pub fn summary(self) -> &'static str {
         match self {
-            ScenarioKind::LjBox => "2-D LJ gas, sigma=0.01, rc=2.5 sigma, walls, g=1, T0=1 (source 000)",
+            ScenarioKind::LjBox => {
+                "2-D LJ gas, sigma=0.01, rc=2.5 sigma, walls, g=1, T0=1 (source 000)"
+            }
             ScenarioKind::LjLiquid => "2-D LJ liquid, reduced density 0.8, walls, no field",
-            ScenarioKind::Coulomb => "3-D charges +-1 at rest in the unit cube, quench 1e-3, open (source 004)",
-            ScenarioKind::Galaxy => "3-D gravity: 6 planets around a Plummer cloud, softening 0.05, open (source 002)",
+            ScenarioKind::Coulomb => {
+                "3-D charges +-1 at rest in the unit cube, quench 1e-3, open (source 004)"
+            }
+            ScenarioKind::Galaxy => {
+                "3-D gravity: 6 planets around a Plummer cloud, softening 0.05, open (source 002)"
+            }
         }
     }
 }
@@ -109,7 +139,7 @@ pub struct Defaults {
     pub density: Option<f64>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Precision {
     F32,
@@ -154,7 +184,15 @@ pub enum SetupError {
 
 impl Setup {
     pub fn new(scenario: ScenarioKind) -> Self {
-        Setup { scenario, n: None, seed: 1, dt: None, density: None, precision: None, allow_fewer: false }
+        Setup {
+            scenario,
+            n: None,
+            seed: 1,
+            dt: None,
+            density: None,
+            precision: None,
+            allow_fewer: false,
+        }
     }
 
     pub fn n(&self) -> usize {
@@ -197,8 +235,12 @@ impl Setup {
     pub fn dispatch<J: SystemJob>(&self, job: J) -> Result<J::Output, SetupError> {
         self.validate()?;
         Ok(match (self.scenario, self.precision()) {
-            (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F32) => job.run(self.lj::<f32>()?),
-            (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F64) => job.run(self.lj::<f64>()?),
+            (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F32) => {
+                job.run(self.lj::<f32>()?)
+            }
+            (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F64) => {
+                job.run(self.lj::<f64>()?)
+            }
             (ScenarioKind::Coulomb, Precision::F32) => job.run(self.coulomb::<f32>()),
             (ScenarioKind::Coulomb, Precision::F64) => job.run(self.coulomb::<f64>()),
             (ScenarioKind::Galaxy, Precision::F32) => job.run(self.galaxy::<f32>()),
@@ -213,7 +255,9 @@ impl Setup {
         let positions = match self.scenario {
             // Random sequential placement jams near packing fraction 0.55; the liquid
             // (0.63) starts from a jittered lattice instead.
-            ScenarioKind::LjLiquid => placement::jittered_lattice(self.n(), side, LJ_SIGMA, &mut rng),
+            ScenarioKind::LjLiquid => {
+                placement::jittered_lattice(self.n(), side, LJ_SIGMA, &mut rng)
+            }
             _ => placement::spaced_uniform(self.n(), side, LJ_SIGMA, self.allow_fewer, &mut rng)?,
         };
         let n = positions.len();
@@ -225,11 +269,18 @@ impl Setup {
                 state.vel[d][i] = T::of(normal.sample(&mut rng));
             }
         }
-        let g = if self.scenario == ScenarioKind::LjBox { LJ_GRAVITY } else { 0.0 };
+        let g = if self.scenario == ScenarioKind::LjBox {
+            LJ_GRAVITY
+        } else {
+            0.0
+        };
         Ok(System {
             state,
             law: LennardJones::new(LJ_EPSILON, LJ_SIGMA, LJ_CUTOFF),
-            boundary: Boundary::Reflecting { lo: [T::zero(); 2], hi: [T::of(side); 2] },
+            boundary: Boundary::Reflecting {
+                lo: [T::zero(); 2],
+                hi: [T::of(side); 2],
+            },
             external: [T::zero(), T::of(-g)],
             dt: T::of(self.dt()),
             info: self.info(n, Some(side)),
@@ -323,7 +374,10 @@ mod tests {
     impl SystemJob for Snapshot {
         type Output = (usize, Vec<f64>, Vec<f64>);
         fn run<T: Real, L: PairLaw<T>, const D: usize>(self, s: System<T, L, D>) -> Self::Output {
-            let pos = (0..s.state.len()).flat_map(|i| s.state.position(i)).map(|x| x.as_f64()).collect();
+            let pos = (0..s.state.len())
+                .flat_map(|i| s.state.position(i))
+                .map(|x| x.as_f64())
+                .collect();
             let src = s.state.source.iter().map(|x| x.as_f64()).collect();
             (D, pos, src)
         }

@@ -1,20 +1,67 @@
-//! `octree` (being written).
-use super::{ForceKernel, ForceReport, KernelKind};
+//! `octree`: Barnes-Hut with opening angle θ (an octree in 3-D, a quadtree in 2-D), monopoles
+//! at the centre of strength, O(n log n).
+//!
+//! Each step: Morton keys over the current bounding cube, one sort, and a compressed tree in a
+//! flat arena ([`tree`]); then a grouped walk ([`walk`]): each group of up to [`GROUP_SIZE`]
+//! neighbouring particles builds one interaction list (accepted nodes as monopoles, opened
+//! leaves as particles) and each of its particles gathers from it with the shared SIMD pair
+//! loop (`rows::gather`). A node of side `s` is accepted when `s/d < θ`, with `d` the distance
+//! from its centre of strength to the nearest point of the group's bounding box, so θ = 0 gives
+//! the direct sum. Sources of each sign get their own tree (Coulomb), and every group walks all
+//! trees. Parallel over groups; the forces do not depend on the thread count.
+//!
+//! Counters: `nodes_accepted` and `nodes_opened` count, summed over groups, the nodes whose test
+//! passed and failed (a failed node is split into its children, or its particles are used
+//! directly if it is a leaf or lies inside the group); `pair_checks` counts the particle-
+//! particle and particle-node interactions evaluated, padding excluded.
+//!
+//! Memory, all reused from step to step: a sorted copy of positions and strengths, the keys
+//! (16 B per particle), the nodes (fewer than 2n, as every internal node has two children or
+//! more; ~0.43 n on a Plummer sphere at leaf size 8), a sorted force buffer, and one
+//! interaction list per thread (a few thousand entries).
+
+mod tree;
+mod walk;
+
+#[cfg(test)]
+mod tests;
+
+use super::par::chunk_len;
+use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::state::{Field, State};
-use std::marker::PhantomData;
+use std::sync::Mutex;
+use std::time::Instant;
+use tree::Tree;
+use walk::{Scratch, Totals, eval_groups, for_group_runs};
+
+/// Most particles in a target group sharing one interaction list. Larger groups walk the
+/// tree fewer times but gather from longer lists (the box is larger, so fewer nodes pass).
+/// On a Plummer sphere of 1e5 at θ = 0.5 and leaf size 8, 16 and 32 are within 2 % of each
+/// other; 8 is 15 % slower (more walks), 64 is 7 % slower (longer lists).
+pub const GROUP_SIZE: usize = 32;
 
 pub struct Octree<L, T, const D: usize> {
     law: L,
-    _t: PhantomData<T>,
+    tree: Tree<T, D>,
+    /// Forces in sorted (tree) order, scattered back to the caller's order after the walk.
+    sorted_forces: [Vec<T>; D],
+    /// One interaction list per rayon thread, picked by thread index (never contended).
+    lists: Vec<Mutex<Scratch<T, D>>>,
+    /// Pair checks of the previous step: the estimate that decides whether to fork.
+    last_pairs: Option<u64>,
 }
 
 impl<L, T: Real, const D: usize> Octree<L, T, D> {
-    pub fn new(law: L, _theta: f64, _leaf_size: usize) -> Self {
+    /// `theta ≥ 0` and `1 ≤ leaf_size` are validated by the caller (`KernelParams::validate`).
+    pub fn new(law: L, theta: f64, leaf_size: usize) -> Self {
         Octree {
             law,
-            _t: PhantomData,
+            tree: Tree::new(theta, leaf_size, GROUP_SIZE),
+            sorted_forces: std::array::from_fn(|_| Vec::new()),
+            lists: Vec::new(),
+            last_pairs: None,
         }
     }
 }
@@ -23,13 +70,95 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
     fn kind(&self) -> KernelKind {
         KernelKind::Octree
     }
+
     fn compute(
         &mut self,
-        _state: &State<T, D>,
-        _forces: &mut Field<T, D>,
-        _probe: bool,
+        state: &State<T, D>,
+        forces: &mut Field<T, D>,
+        probe: bool,
     ) -> ForceReport {
-        let _ = &self.law;
-        ForceReport::default()
+        let n = state.len();
+        for f in forces.iter() {
+            assert_eq!(f.len(), n, "force field length must equal n");
+        }
+        if n == 0 {
+            return ForceReport {
+                energy: probe.then_some(0.0),
+                ..Default::default()
+            };
+        }
+        let started = Instant::now();
+        self.tree.build(state);
+        let build_s = started.elapsed().as_secs_f64();
+
+        for f in &mut self.sorted_forces {
+            f.resize(n, T::zero());
+        }
+        let threads = rayon::current_num_threads().max(1);
+        if self.lists.len() < threads {
+            self.lists
+                .resize_with(threads, || Mutex::new(Scratch::new()));
+        }
+        let (law, tree, lists) = (&self.law, &self.tree, &self.lists);
+        let mut out = self.sorted_forces.each_mut().map(|f| f.as_mut_slice());
+        // A poisoned lock only means another thread panicked mid-walk; the list is rebuilt
+        // from scratch by every group, so its contents are never relied upon.
+        let list = |slot: usize| {
+            lists[slot % lists.len()]
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+        };
+        let estimate = self.last_pairs.unwrap_or((n as u64) * (n as u64 - 1));
+        let totals = if probe {
+            eval_groups::<T, L, D, true>(law, tree, &tree.groups, 0, &mut out, &mut list(0))
+        } else if worth_parallel(estimate) {
+            for_group_runs(
+                &tree.groups,
+                out,
+                0,
+                chunk_len(n),
+                &|groups, offset, mut part| {
+                    let mut list = list(rayon::current_thread_index().unwrap_or(0));
+                    eval_groups::<T, L, D, false>(law, tree, groups, offset, &mut part, &mut list)
+                },
+            )
+        } else {
+            eval_groups::<T, L, D, false>(law, tree, &tree.groups, 0, &mut out, &mut list(0))
+        };
+        self.last_pairs = Some(totals.work.pair_checks);
+
+        // Back to the caller's order.
+        for d in 0..D {
+            let (dst, src) = (&mut forces[d], &self.sorted_forces[d]);
+            for (&i, &f) in self.tree.order.iter().zip(src.iter()) {
+                dst[i as usize] = f;
+            }
+        }
+        report(totals, build_s, probe)
+    }
+
+    /// Tree order: Morton order within each sign class (pure Morton order for gravity), which
+    /// makes the next builds' gathers sequential.
+    fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
+        self.tree.sort(state);
+        Some(self.tree.sorted_order())
+    }
+}
+
+fn report(totals: Totals, build_s: f64, probe: bool) -> ForceReport {
+    let Totals {
+        work,
+        energy,
+        interacting,
+    } = totals;
+    ForceReport {
+        // Every pair of particles is seen from both ends; a particle-node interaction stands
+        // for pairs seen from both ends in the same approximation.
+        energy: probe.then_some(0.5 * energy),
+        build_s,
+        work: WorkCounters {
+            pairs_interacting: if probe { interacting / 2 } else { 0 },
+            ..work
+        },
     }
 }

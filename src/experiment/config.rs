@@ -1,0 +1,371 @@
+//! Sweep configurations: TOML files, typed, unknown keys rejected, validated before anything
+//! runs. Every error names the file, the key and what is allowed.
+
+use crate::kernels::KernelKind;
+use crate::scenario::{Precision, ScenarioKind};
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// What a sweep varies and how its results are read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Study {
+    /// Fixed n, varying threads: speedup and efficiency (threads must include 1).
+    Strong,
+    /// Work per thread held constant: n (or simulated time) grows with the threads.
+    Weak,
+    /// Kernels over n on one thread: cost growth and crossovers.
+    Complexity,
+    /// Every combination of the lists, no particular reading.
+    Cartesian,
+}
+
+/// How a weak-scaling sweep grows the problem with the thread count p.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WeakRule {
+    /// From the kernel's cost model: n·p for O(n) kernels, n·√p for O(n²) ones, and
+    /// n log n = p · n₀ log n₀ for the octree.
+    CostModel,
+    /// n = n₀ · p whatever the kernel.
+    Linear,
+    /// n = n₀ · √p whatever the kernel.
+    Sqrt,
+    /// n fixed, steps × p: the simulated time grows instead (source 002's second study).
+    Time,
+}
+
+/// The particle counts: an explicit list or a geometric range.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Counts {
+    List(Vec<usize>),
+    Range(CountRange),
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CountRange {
+    pub from: usize,
+    pub to: usize,
+    /// Ratio between consecutive counts (> 1).
+    pub factor: f64,
+}
+
+impl Counts {
+    /// The counts in increasing order of appearance.
+    pub fn values(&self) -> Vec<usize> {
+        match self {
+            Counts::List(v) => v.clone(),
+            Counts::Range(r) => {
+                let mut out = Vec::new();
+                let mut x = r.from as f64;
+                while x.round() as usize <= r.to && out.len() < 10_000 {
+                    let n = x.round() as usize;
+                    if out.last() != Some(&n) {
+                        out.push(n);
+                    }
+                    x *= r.factor;
+                }
+                out
+            }
+        }
+    }
+}
+
+/// How each case is measured (SPEC §3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Measure {
+    /// Seconds of untimed stepping before the samples (caches, branch predictors, tree sizes).
+    pub warmup_s: f64,
+    /// Samples per case (summed over rounds).
+    pub samples: usize,
+    /// A sample lasts at least this long: its step count is chosen to reach it.
+    pub min_sample_s: f64,
+    /// Cases are measured in this many interleaved rounds, each taking an equal share of the
+    /// samples, so that slow machine drift spreads over all cases instead of biasing some.
+    pub rounds: usize,
+    /// Whole-sweep time budget in seconds (0 = none); cases that would start after it are
+    /// left for `--resume`.
+    pub budget_s: f64,
+    /// Largest |relative energy drift| over a case's measured steps before it is flagged.
+    pub max_energy_drift: f64,
+    /// Also measure the force error against an f64 direct sum on this many sampled particles
+    /// (0 = off).
+    pub force_error_sample: usize,
+}
+
+impl Default for Measure {
+    fn default() -> Self {
+        Measure {
+            warmup_s: 0.05,
+            samples: 10,
+            min_sample_s: 0.01,
+            rounds: 2,
+            budget_s: 0.0,
+            max_energy_drift: 0.05,
+            force_error_sample: 0,
+        }
+    }
+}
+
+/// Weak-scaling settings.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Weak {
+    pub rule: WeakRule,
+    /// n at one thread (the n list is not used by weak studies).
+    pub base_n: usize,
+}
+
+/// A sweep, as written in a TOML file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SweepConfig {
+    /// Names the results directory: `<out>/<name>/results.json`.
+    pub name: String,
+    pub study: Study,
+    pub scenarios: Vec<ScenarioKind>,
+    pub kernels: Vec<KernelKind>,
+    /// Particle counts (not used by weak studies, which use `weak.base_n`).
+    #[serde(default)]
+    pub n: Option<Counts>,
+    /// Thread counts.
+    #[serde(default = "one_thread")]
+    pub threads: Vec<usize>,
+    #[serde(default = "one_seed")]
+    pub seeds: Vec<u64>,
+    /// Barnes-Hut opening angles (octree cases only).
+    #[serde(default = "default_theta")]
+    pub theta: Vec<f64>,
+    #[serde(default)]
+    pub precision: Option<Precision>,
+    /// Output directory [default: results].
+    #[serde(default = "default_out")]
+    pub out: PathBuf,
+    #[serde(default)]
+    pub measure: Measure,
+    #[serde(default)]
+    pub weak: Option<Weak>,
+}
+
+fn one_thread() -> Vec<usize> {
+    vec![1]
+}
+fn one_seed() -> Vec<u64> {
+    vec![1]
+}
+fn default_theta() -> Vec<f64> {
+    vec![0.5]
+}
+fn default_out() -> PathBuf {
+    PathBuf::from("results")
+}
+
+#[derive(Debug, Error)]
+pub enum ConfigError {
+    #[error("cannot read config {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("config {path}: {message}")]
+    Parse { path: PathBuf, message: String },
+    #[error("config {path}: `{key}` {problem}")]
+    Invalid {
+        path: PathBuf,
+        key: String,
+        problem: String,
+    },
+}
+
+impl SweepConfig {
+    /// Reads, parses and validates a config file.
+    pub fn load(path: &Path) -> Result<(SweepConfig, String), ConfigError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+            path: path.into(),
+            source,
+        })?;
+        let config = Self::parse(&text, path)?;
+        Ok((config, text))
+    }
+
+    /// Parses and validates config text; `path` is only used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<SweepConfig, ConfigError> {
+        let config: SweepConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
+            path: path.into(),
+            message: e.message().to_string() + &location(text, e.span()),
+        })?;
+        config.validate(path)?;
+        Ok(config)
+    }
+
+    fn validate(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = |key: &str, problem: String| ConfigError::Invalid {
+            path: path.into(),
+            key: key.into(),
+            problem,
+        };
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+        {
+            return Err(bad(
+                "name",
+                "must be a non-empty name of letters, digits, '-', '_' or '.'".into(),
+            ));
+        }
+        if self.scenarios.is_empty() {
+            return Err(bad(
+                "scenarios",
+                "is empty; list at least one of lj-box, lj-liquid, coulomb, galaxy".into(),
+            ));
+        }
+        if self.kernels.is_empty() {
+            return Err(bad(
+                "kernels",
+                "is empty; list at least one of naive, symmetric, per-thread, cell-list, octree"
+                    .into(),
+            ));
+        }
+        for &s in &self.scenarios {
+            if !self.kernels.iter().any(|k| k.supports(s.law())) {
+                return Err(bad(
+                    "kernels",
+                    format!(
+                        "has no kernel for scenario `{}`; kernels for {}: {}",
+                        s.name(),
+                        s.law().name(),
+                        crate::kernels::supported_for(s.law())
+                    ),
+                ));
+            }
+        }
+        for &k in &self.kernels {
+            if !self.scenarios.iter().any(|s| k.supports(s.law())) {
+                return Err(bad(
+                    "kernels",
+                    format!("`{}` applies to none of the listed scenarios", k.name()),
+                ));
+            }
+        }
+        if self.threads.is_empty() || self.threads.contains(&0) {
+            return Err(bad(
+                "threads",
+                "must be a non-empty list of thread counts >= 1".into(),
+            ));
+        }
+        if self.seeds.is_empty() {
+            return Err(bad("seeds", "must list at least one seed".into()));
+        }
+        if self.theta.is_empty() || self.theta.iter().any(|t| !(t.is_finite() && *t >= 0.0)) {
+            return Err(bad(
+                "theta",
+                "must be a non-empty list of finite values >= 0".into(),
+            ));
+        }
+        match (&self.study, &self.weak) {
+            (Study::Weak, None) => {
+                return Err(bad(
+                    "weak",
+                    "is required for study = \"weak\": set weak.rule and weak.base_n".into(),
+                ));
+            }
+            (Study::Weak, Some(w)) if w.base_n == 0 => {
+                return Err(bad("weak.base_n", "must be at least 1".into()));
+            }
+            (Study::Weak, Some(_)) => {}
+            (_, Some(_)) => return Err(bad("weak", "only applies to study = \"weak\"".into())),
+            (_, None) => match &self.n {
+                None => {
+                    return Err(bad(
+                        "n",
+                        "is required: a list such as [1000, 2000] or { from, to, factor }".into(),
+                    ));
+                }
+                Some(Counts::List(v)) if v.is_empty() => {
+                    return Err(bad("n", "is empty; list at least one count".into()));
+                }
+                Some(Counts::List(v)) if v.contains(&0) => {
+                    return Err(bad("n", "must not contain 0".into()));
+                }
+                Some(Counts::Range(r))
+                    if r.from == 0
+                        || r.to < r.from
+                        || !(r.factor > 1.0 && r.factor.is_finite()) =>
+                {
+                    return Err(bad(
+                        "n",
+                        "range needs 1 <= from <= to and factor > 1".into(),
+                    ));
+                }
+                Some(_) => {}
+            },
+        }
+        if self.study == Study::Strong && !self.threads.contains(&1) {
+            return Err(bad(
+                "threads",
+                "must include 1 for a strong-scaling study (speedups are relative to it)".into(),
+            ));
+        }
+        let m = &self.measure;
+        if m.samples == 0 || m.rounds == 0 || m.rounds > m.samples {
+            return Err(bad(
+                "measure",
+                "needs samples >= 1 and 1 <= rounds <= samples".into(),
+            ));
+        }
+        for (key, v) in [
+            ("measure.warmup_s", m.warmup_s),
+            ("measure.min_sample_s", m.min_sample_s),
+            ("measure.budget_s", m.budget_s),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(bad(key, format!("must be a finite number >= 0 (got {v})")));
+            }
+        }
+        if !(m.max_energy_drift.is_finite() && m.max_energy_drift > 0.0) {
+            return Err(bad(
+                "measure.max_energy_drift",
+                "must be a finite number > 0".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// " at line L, column C" for a parse error span.
+fn location(text: &str, span: Option<std::ops::Range<usize>>) -> String {
+    let Some(span) = span else {
+        return String::new();
+    };
+    let before = &text[..span.start.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
+    format!(" (line {line}, column {col})")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn geometric_range_expands() {
+        let r = Counts::Range(CountRange {
+            from: 1000,
+            to: 100_000,
+            factor: 10.0,
+        });
+        assert_eq!(r.values(), vec![1000, 10_000, 100_000]);
+        let r = Counts::Range(CountRange {
+            from: 100,
+            to: 400,
+            factor: 2.0,
+        });
+        assert_eq!(r.values(), vec![100, 200, 400]);
+    }
+}

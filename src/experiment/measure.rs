@@ -1,0 +1,229 @@
+//! Measuring one case for one round: warm-up, adaptive steps per sample, timed samples,
+//! phase timers, work counters and physics sanity.
+
+use super::plan::Case;
+use crate::engine::{PhaseTimes, Simulation};
+use crate::kernels::{KernelParams, WorkCounters};
+use crate::physics::PairLaw;
+use crate::real::Real;
+use crate::run::RunError;
+use crate::scenario::{System, SystemJob};
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
+
+/// A monotonic time source; the runner and its tests are written against this trait so that
+/// tests can script the durations.
+pub trait Clock: Sync {
+    /// Time since an arbitrary fixed origin.
+    fn now(&self) -> Duration;
+}
+
+/// The real monotonic clock.
+pub struct WallClock(Instant);
+
+impl WallClock {
+    pub fn new() -> Self {
+        WallClock(Instant::now())
+    }
+}
+
+impl Default for WallClock {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Clock for WallClock {
+    fn now(&self) -> Duration {
+        self.0.elapsed()
+    }
+}
+
+/// A scripted clock for tests: every reading advances time by `tick`.
+pub struct MockClock {
+    ns: AtomicU64,
+    tick_ns: u64,
+}
+
+impl MockClock {
+    pub fn new(tick: Duration) -> Self {
+        MockClock {
+            ns: AtomicU64::new(0),
+            tick_ns: tick.as_nanos() as u64,
+        }
+    }
+}
+
+impl Clock for MockClock {
+    fn now(&self) -> Duration {
+        Duration::from_nanos(self.ns.fetch_add(self.tick_ns, Ordering::Relaxed) + self.tick_ns)
+    }
+}
+
+/// How one round of a case is measured.
+#[derive(Clone, Debug)]
+pub struct RoundSpec {
+    pub samples: usize,
+    pub warmup_s: f64,
+    pub min_sample_s: f64,
+    /// Steps per sample to use (a later round reuses the first round's choice); `None` to
+    /// choose from the warm-up.
+    pub steps_per_sample: Option<u64>,
+    pub force_error_sample: usize,
+}
+
+/// What one round measured. Times are per step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RoundOutcome {
+    pub steps_per_sample: u64,
+    /// Mean step time of each sample, seconds.
+    pub samples_s: Vec<f64>,
+    /// Every timed step, nanoseconds.
+    #[serde(skip)]
+    pub step_ns: Vec<u64>,
+    pub steps: u64,
+    pub warmup_steps: u64,
+    /// Seconds per step in each phase (means over the timed steps).
+    pub phases: PhaseTimes,
+    /// Work over the timed steps.
+    pub work: WorkCounters,
+    /// Interacting pairs in the final configuration.
+    pub pairs_interacting: u64,
+    /// Relative energy drift from the start of the warm-up to the end of the samples.
+    pub energy_drift: f64,
+    /// Median and max relative force error against an f64 direct sum, when asked.
+    pub force_error: Option<[f64; 2]>,
+    /// Particles actually simulated (fewer than asked only with `allow_fewer`).
+    pub n: usize,
+    /// Cost of one clock reading relative to the median step (the timing overhead).
+    pub clock_overhead: f64,
+}
+
+/// Measures a round of `case` on the system it is given.
+pub struct MeasureJob<'a, C: Clock> {
+    pub case: &'a Case,
+    pub spec: &'a RoundSpec,
+    pub clock: &'a C,
+}
+
+impl<C: Clock> SystemJob for MeasureJob<'_, C> {
+    type Output = Result<RoundOutcome, RunError>;
+
+    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+        let params = KernelParams {
+            theta: self.case.theta.unwrap_or(KernelParams::default().theta),
+            ..KernelParams::default()
+        };
+        let law = system.law;
+        let kernel = self.case.kernel.build::<T, L, D>(law, &params)?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(self.case.threads)
+            .build()
+            .map_err(|source| RunError::Pool {
+                threads: self.case.threads,
+                source,
+            })?;
+        pool.install(|| measure(self.spec, self.clock, &law, Simulation::new(system, kernel)))
+    }
+}
+
+fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
+    spec: &RoundSpec,
+    clock: &C,
+    law: &L,
+    mut sim: Simulation<T, D>,
+) -> Result<RoundOutcome, RunError> {
+    let n = sim.state.len();
+    let e0 = sim.probe().total();
+    // Warm-up: untimed for the results, but its step times choose the sample length.
+    let warm_start = clock.now();
+    let mut warm = Vec::new();
+    loop {
+        let t = clock.now();
+        sim.step()?;
+        warm.push((clock.now() - t).as_secs_f64());
+        if (clock.now() - warm_start).as_secs_f64() >= spec.warmup_s || warm.len() >= 1_000_000 {
+            break;
+        }
+    }
+    let typical = crate::stats::median(&warm).unwrap_or(0.0).max(1e-9);
+    let k = spec
+        .steps_per_sample
+        .unwrap_or_else(|| ((spec.min_sample_s / typical).ceil() as u64).clamp(1, 1_000_000));
+    let (phases0, work0, steps0) = (sim.phases, sim.work, sim.step);
+    let mut samples = Vec::with_capacity(spec.samples);
+    let mut step_ns = Vec::with_capacity(spec.samples * k as usize);
+    for _ in 0..spec.samples {
+        let mut sum = 0u64;
+        for _ in 0..k {
+            let t = clock.now();
+            sim.step()?;
+            let dt = (clock.now() - t).as_nanos() as u64;
+            step_ns.push(dt);
+            sum += dt;
+        }
+        samples.push(sum as f64 * 1e-9 / k as f64);
+    }
+    let steps = sim.step - steps0;
+    let e1 = sim.probe().total();
+    if !e1.is_finite() {
+        return Err(RunError::EnergyBlowUp {
+            step: sim.step,
+            energy: e1,
+        });
+    }
+    let per = |a: f64, b: f64| (a - b) / steps.max(1) as f64;
+    let phases = PhaseTimes {
+        force_build: per(sim.phases.force_build, phases0.force_build),
+        force_interact: per(sim.phases.force_interact, phases0.force_interact),
+        integrate: per(sim.phases.integrate, phases0.integrate),
+        boundary: per(sim.phases.boundary, phases0.boundary),
+        output: 0.0,
+    };
+    let mut work = sim.work;
+    work.pair_checks -= work0.pair_checks;
+    work.cells_visited -= work0.cells_visited;
+    work.nodes_opened -= work0.nodes_opened;
+    work.nodes_accepted -= work0.nodes_accepted;
+    let force_error = (spec.force_error_sample > 0).then(|| {
+        let (median, max) = crate::validate::sampled_force_error(
+            law,
+            &sim.state,
+            &sim.forces,
+            spec.force_error_sample,
+            0x5eed,
+        );
+        [median, max]
+    });
+    let clock_cost = clock_cost(clock);
+    let median_step = crate::stats::median(&samples).unwrap_or(0.0);
+    Ok(RoundOutcome {
+        steps_per_sample: k,
+        samples_s: samples,
+        step_ns,
+        steps,
+        warmup_steps: warm.len() as u64,
+        phases,
+        work,
+        pairs_interacting: sim.probe_work().pairs_interacting,
+        energy_drift: (e1 - e0) / e0.abs(),
+        force_error,
+        n,
+        clock_overhead: if median_step > 0.0 {
+            2.0 * clock_cost / median_step
+        } else {
+            0.0
+        },
+    })
+}
+
+/// Seconds per clock reading (two readings bracket each timed step).
+fn clock_cost<C: Clock>(clock: &C) -> f64 {
+    let reps = 1000;
+    let t0 = clock.now();
+    for _ in 0..reps {
+        std::hint::black_box(clock.now());
+    }
+    (clock.now() - t0).as_secs_f64() / (reps + 1) as f64
+}

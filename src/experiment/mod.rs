@@ -1,0 +1,8 @@
+//! The experiment runner: sweep configs → planned cases → measured rounds → results file.
+
+pub mod config;
+pub mod measure;
+pub mod plan;
+pub mod progress;
+pub mod results;
+pub mod runner;

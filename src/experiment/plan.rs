@@ -1,0 +1,171 @@
+//! Expands a sweep config into the list of cases to measure.
+
+use super::config::{Study, SweepConfig, WeakRule};
+use crate::kernels::KernelKind;
+use crate::scenario::{Precision, ScenarioKind};
+use serde::{Deserialize, Serialize};
+
+/// One measured configuration (SPEC §3): everything that changes the work or the machine use.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Case {
+    pub scenario: ScenarioKind,
+    pub kernel: KernelKind,
+    pub n: usize,
+    pub threads: usize,
+    /// MPI ranks (1 without MPI).
+    pub ranks: usize,
+    /// Opening angle, for the octree only.
+    pub theta: Option<f64>,
+    pub seed: u64,
+    pub precision: Option<Precision>,
+    /// Simulated-time factor of a weak-by-time study (the run stands for this many times the
+    /// steps of the one-thread case); 1 otherwise.
+    pub time_factor: u64,
+}
+
+impl Case {
+    /// A stable identifier, used to match cases across runs (resume, gate).
+    pub fn key(&self) -> String {
+        let mut k = format!(
+            "{}/{}/n={}/p={}/r={}/seed={}",
+            self.scenario.name(),
+            self.kernel.name(),
+            self.n,
+            self.threads,
+            self.ranks,
+            self.seed
+        );
+        if let Some(t) = self.theta {
+            k.push_str(&format!("/theta={t}"));
+        }
+        if let Some(p) = self.precision {
+            k.push_str(&format!("/{}", p.name()));
+        }
+        if self.time_factor != 1 {
+            k.push_str(&format!("/time-x{}", self.time_factor));
+        }
+        k
+    }
+}
+
+/// The cases of a config, in a fixed order: scenario, kernel, n, threads, seed, θ.
+pub fn cases(config: &SweepConfig) -> Vec<Case> {
+    let mut out = Vec::new();
+    for &scenario in &config.scenarios {
+        for &kernel in config.kernels.iter().filter(|k| k.supports(scenario.law())) {
+            let thetas: Vec<Option<f64>> = if kernel == KernelKind::Octree {
+                config.theta.iter().map(|&t| Some(t)).collect()
+            } else {
+                vec![None]
+            };
+            for &threads in &config.threads {
+                let sizes: Vec<(usize, u64)> = match (&config.study, &config.weak) {
+                    (Study::Weak, Some(w)) => vec![weak_size(kernel, w.rule, w.base_n, threads)],
+                    _ => config
+                        .n
+                        .as_ref()
+                        .map(|n| n.values())
+                        .unwrap_or_default()
+                        .into_iter()
+                        .map(|n| (n, 1))
+                        .collect(),
+                };
+                for (n, time_factor) in sizes {
+                    for &seed in &config.seeds {
+                        for &theta in &thetas {
+                            out.push(Case {
+                                scenario,
+                                kernel,
+                                n,
+                                threads,
+                                ranks: 1,
+                                theta,
+                                seed,
+                                precision: config.precision,
+                                time_factor,
+                            });
+                        }
+                    }
+                }
+            }
+        }
+    }
+    out.sort_by_key(|c| (c.scenario as u8, c.kernel as u8, c.n, c.threads, c.seed));
+    out
+}
+
+/// n (and simulated-time factor) at `p` threads so that the work per thread stays that of
+/// `base_n` on one thread.
+pub fn weak_size(kernel: KernelKind, rule: WeakRule, base_n: usize, p: usize) -> (usize, u64) {
+    let pf = p as f64;
+    let b = base_n as f64;
+    let n = match rule {
+        WeakRule::Time => return (base_n, p as u64),
+        WeakRule::Linear => b * pf,
+        WeakRule::Sqrt => b * pf.sqrt(),
+        WeakRule::CostModel => match kernel {
+            KernelKind::CellList => b * pf,
+            KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => b * pf.sqrt(),
+            KernelKind::Octree => solve_n_log_n(pf * b * b.max(2.0).ln()),
+        },
+    };
+    (n.round().max(1.0) as usize, 1)
+}
+
+/// n with n·ln n = w (Newton's method; w ≥ 2 ln 2).
+fn solve_n_log_n(w: f64) -> f64 {
+    let mut n = (w / w.max(2.0).ln()).max(2.0);
+    for _ in 0..50 {
+        let f = n * n.ln() - w;
+        n -= f / (n.ln() + 1.0);
+        n = n.max(2.0);
+    }
+    n
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn weak_sizes_follow_the_cost_model() {
+        assert_eq!(
+            weak_size(KernelKind::CellList, WeakRule::CostModel, 1000, 4),
+            (4000, 1)
+        );
+        assert_eq!(
+            weak_size(KernelKind::Naive, WeakRule::CostModel, 1000, 4),
+            (2000, 1)
+        );
+        assert_eq!(
+            weak_size(KernelKind::Naive, WeakRule::Time, 1000, 4),
+            (1000, 4)
+        );
+        let (n, _) = weak_size(KernelKind::Octree, WeakRule::CostModel, 10_000, 2);
+        let w = |n: f64| n * n.ln();
+        assert!((w(n as f64) / w(10_000.0) - 2.0).abs() < 1e-3, "{n}");
+        assert!(n > 18_000 && n < 20_000);
+    }
+
+    #[test]
+    fn case_keys_are_distinct() {
+        let text = r#"
+            name = "t"
+            study = "cartesian"
+            scenarios = ["galaxy", "lj-box"]
+            kernels = ["naive", "octree", "cell-list"]
+            n = [100, 200]
+            threads = [1, 2]
+            theta = [0.3, 0.6]
+        "#;
+        let c = SweepConfig::parse(text, std::path::Path::new("t.toml")).unwrap();
+        let cases = cases(&c);
+        // galaxy: naive 2n×2p + octree 2n×2p×2θ; lj-box: naive + cell-list 2n×2p each.
+        assert_eq!(cases.len(), 4 + 8 + 4 + 4);
+        let mut keys: Vec<String> = cases.iter().map(Case::key).collect();
+        keys.sort();
+        keys.dedup();
+        assert_eq!(keys.len(), cases.len());
+        assert!(keys.contains(&"galaxy/octree/n=100/p=2/r=1/seed=1/theta=0.3".to_string()));
+    }
+}

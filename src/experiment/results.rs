@@ -1,0 +1,368 @@
+//! The results file of a sweep: schema, metadata, calibration, and every case with its raw
+//! samples and summaries. Written atomically after every measured round.
+
+use super::config::SweepConfig;
+use super::measure::RoundOutcome;
+use super::plan::Case;
+use crate::calibrate::Calibration;
+use crate::engine::PhaseTimes;
+use crate::kernels::WorkCounters;
+use crate::stats::{StepPercentiles, bootstrap_median_ci, mad, median};
+use hdrhistogram::Histogram;
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+pub const RESULTS_SCHEMA: &str = "nbody-bench/results/v1";
+
+/// Bootstrap resamples for the median's confidence interval.
+const BOOTSTRAP_RESAMPLES: usize = 2000;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct ResultsFile {
+    pub schema: String,
+    pub metadata: Metadata,
+    /// The config as parsed, and verbatim as written.
+    pub config: SweepConfig,
+    pub config_text: String,
+    pub calibration: Calibrations,
+    pub cases: Vec<CaseRecord>,
+}
+
+#[derive(Clone, Debug, Default, Serialize, Deserialize)]
+pub struct Calibrations {
+    pub start: Option<Calibration>,
+    pub end: Option<Calibration>,
+}
+
+/// Where and how the results were produced (SPEC §3).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Metadata {
+    pub tool_version: String,
+    pub git_commit: String,
+    pub git_dirty: bool,
+    pub rustc_version: String,
+    /// Instruction set the pair loops ran with, and the target features compiled in.
+    pub simd: String,
+    pub target_features: Vec<String>,
+    pub cargo_features: Vec<String>,
+    pub profile: String,
+    pub host: String,
+    pub os: String,
+    /// UTC, ISO 8601, when the sweep started (the first run, not a resume).
+    pub started: String,
+}
+
+/// One case: what it is, every raw value, and summaries recomputed from them.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct CaseRecord {
+    pub key: String,
+    pub case: Case,
+    /// Particles simulated.
+    pub n: usize,
+    /// Threads × ranks exceed the machine's logical CPUs.
+    pub oversubscribed: bool,
+    /// Rounds measured so far; the case is complete at `rounds_planned`.
+    pub rounds_done: usize,
+    pub rounds_planned: usize,
+    pub steps_per_sample: u64,
+    /// Each round as measured (samples in seconds per step, phases, counters, sanity).
+    pub rounds: Vec<RoundOutcome>,
+    /// Step-time histogram (HDR, ns): (value, count) of every recorded bucket.
+    pub step_histogram: Vec<[u64; 2]>,
+    pub summary: Option<Summary>,
+}
+
+/// Statistics over all rounds of a case.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Median over samples of the time per step, seconds, with a bootstrap 95% CI.
+    pub median_s: f64,
+    pub ci95_s: [f64; 2],
+    pub mad_s: f64,
+    pub min_s: f64,
+    pub mean_s: f64,
+    pub samples: usize,
+    /// Per-step percentiles from the histogram, nanoseconds.
+    pub step_ns: StepPercentiles,
+    pub ns_per_particle_step: f64,
+    pub particle_steps_per_s: f64,
+    pub pair_evals_per_s: f64,
+    /// Seconds per step in each phase, averaged over rounds.
+    pub phases: PhaseTimes,
+    /// Work per step.
+    pub pair_checks_per_step: f64,
+    pub cells_visited_per_step: f64,
+    pub nodes_opened_per_step: f64,
+    pub nodes_accepted_per_step: f64,
+    pub pairs_interacting: u64,
+    /// Largest |energy drift| of any round, and whether it exceeded the config's limit.
+    pub max_energy_drift: f64,
+    pub sanity_ok: bool,
+    pub force_error: Option<[f64; 2]>,
+    /// Largest timing overhead (clock readings) relative to the median step.
+    pub clock_overhead: f64,
+}
+
+#[derive(Debug, Error)]
+pub enum ResultsError {
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "{path} is not a valid results file ({detail}); it may be truncated or from another tool"
+    )]
+    Corrupt { path: PathBuf, detail: String },
+    #[error("{path} has schema `{found}`, this version reads `{RESULTS_SCHEMA}`")]
+    Schema { path: PathBuf, found: String },
+    #[error(transparent)]
+    Write(#[from] crate::output::WriteError),
+}
+
+impl ResultsFile {
+    pub fn load(path: &Path) -> Result<ResultsFile, ResultsError> {
+        let text = std::fs::read_to_string(path).map_err(|source| ResultsError::Read {
+            path: path.into(),
+            source,
+        })?;
+        let value: serde_json::Value =
+            serde_json::from_str(&text).map_err(|e| ResultsError::Corrupt {
+                path: path.into(),
+                detail: e.to_string(),
+            })?;
+        let schema = value
+            .get("schema")
+            .and_then(|s| s.as_str())
+            .unwrap_or("(none)");
+        if schema != RESULTS_SCHEMA {
+            return Err(ResultsError::Schema {
+                path: path.into(),
+                found: schema.to_string(),
+            });
+        }
+        serde_json::from_value(value).map_err(|e| ResultsError::Corrupt {
+            path: path.into(),
+            detail: e.to_string(),
+        })
+    }
+
+    /// Writes the whole file atomically (temporary file + rename).
+    pub fn save(&self, path: &Path) -> Result<(), ResultsError> {
+        let text = serde_json::to_string_pretty(self).expect("results serialize");
+        crate::output::write_atomic(path, text.as_bytes())?;
+        Ok(())
+    }
+
+    pub fn record_mut(&mut self, key: &str) -> Option<&mut CaseRecord> {
+        self.cases.iter_mut().find(|c| c.key == key)
+    }
+}
+
+impl CaseRecord {
+    pub fn new(case: Case, rounds_planned: usize, logical_cpus: usize) -> Self {
+        CaseRecord {
+            key: case.key(),
+            n: case.n,
+            oversubscribed: case.threads * case.ranks > logical_cpus,
+            case,
+            rounds_done: 0,
+            rounds_planned,
+            steps_per_sample: 0,
+            rounds: Vec::new(),
+            step_histogram: Vec::new(),
+            summary: None,
+        }
+    }
+
+    pub fn is_complete(&self) -> bool {
+        self.rounds_done >= self.rounds_planned
+    }
+
+    /// Adds a measured round and recomputes the summary from all raw values.
+    pub fn add_round(&mut self, round: RoundOutcome, max_drift: f64) {
+        let mut hist = self.histogram();
+        for &ns in &round.step_ns {
+            // Values beyond the histogram's range (an hour) are clamped, not dropped.
+            hist.saturating_record(ns.max(1));
+        }
+        self.step_histogram = hist
+            .iter_recorded()
+            .map(|v| [v.value_iterated_to(), v.count_at_value()])
+            .collect();
+        self.n = round.n;
+        self.steps_per_sample = round.steps_per_sample;
+        self.rounds.push(round);
+        self.rounds_done += 1;
+        self.summary = Some(self.summarize(&hist, max_drift));
+    }
+
+    fn histogram(&self) -> Histogram<u64> {
+        let mut h = Histogram::<u64>::new_with_bounds(1, 3_600_000_000_000, 3)
+            .expect("valid histogram bounds");
+        for &[value, count] in &self.step_histogram {
+            h.saturating_record_n(value, count);
+        }
+        h
+    }
+
+    fn summarize(&self, hist: &Histogram<u64>, max_drift: f64) -> Summary {
+        let samples: Vec<f64> = self
+            .rounds
+            .iter()
+            .flat_map(|r| r.samples_s.iter().copied())
+            .collect();
+        let med = median(&samples).unwrap_or(0.0);
+        let rounds = self.rounds.len().max(1) as f64;
+        let steps: u64 = self.rounds.iter().map(|r| r.steps).sum();
+        let mean_of =
+            |f: &dyn Fn(&RoundOutcome) -> f64| self.rounds.iter().map(f).sum::<f64>() / rounds;
+        let per_step = |f: &dyn Fn(&WorkCounters) -> u64| {
+            self.rounds.iter().map(|r| f(&r.work) as f64).sum::<f64>() / steps.max(1) as f64
+        };
+        let pair_checks = per_step(&|w| w.pair_checks);
+        let drift = self
+            .rounds
+            .iter()
+            .map(|r| r.energy_drift.abs())
+            .fold(0.0, f64::max);
+        let n = self.n as f64;
+        Summary {
+            median_s: med,
+            ci95_s: bootstrap_median_ci(&samples, BOOTSTRAP_RESAMPLES, 0x5eed)
+                .unwrap_or([med, med]),
+            mad_s: mad(&samples).unwrap_or(0.0),
+            min_s: samples.iter().copied().fold(f64::INFINITY, f64::min),
+            mean_s: samples.iter().sum::<f64>() / samples.len().max(1) as f64,
+            samples: samples.len(),
+            step_ns: StepPercentiles {
+                min: hist.min(),
+                p50: hist.value_at_quantile(0.5),
+                p90: hist.value_at_quantile(0.9),
+                p99: hist.value_at_quantile(0.99),
+                max: hist.max(),
+                mean: hist.mean(),
+            },
+            ns_per_particle_step: med * 1e9 / n,
+            particle_steps_per_s: if med > 0.0 { n / med } else { 0.0 },
+            pair_evals_per_s: if med > 0.0 { pair_checks / med } else { 0.0 },
+            phases: PhaseTimes {
+                force_build: mean_of(&|r| r.phases.force_build),
+                force_interact: mean_of(&|r| r.phases.force_interact),
+                integrate: mean_of(&|r| r.phases.integrate),
+                boundary: mean_of(&|r| r.phases.boundary),
+                output: 0.0,
+            },
+            pair_checks_per_step: pair_checks,
+            cells_visited_per_step: per_step(&|w| w.cells_visited),
+            nodes_opened_per_step: per_step(&|w| w.nodes_opened),
+            nodes_accepted_per_step: per_step(&|w| w.nodes_accepted),
+            pairs_interacting: self.rounds.last().map(|r| r.pairs_interacting).unwrap_or(0),
+            max_energy_drift: drift,
+            sanity_ok: drift <= max_drift,
+            force_error: self.rounds.iter().filter_map(|r| r.force_error).next_back(),
+            clock_overhead: self
+                .rounds
+                .iter()
+                .map(|r| r.clock_overhead)
+                .fold(0.0, f64::max),
+        }
+    }
+}
+
+impl Metadata {
+    /// Describes this build and machine now.
+    pub fn collect() -> Metadata {
+        let (git_commit, git_dirty) = git_state();
+        Metadata {
+            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+            git_commit,
+            git_dirty,
+            rustc_version: option_env!("NBODY_BENCH_RUSTC")
+                .unwrap_or("unknown")
+                .to_string(),
+            simd: crate::simd::level().name().to_string(),
+            target_features: compiled_features(),
+            cargo_features: Vec::new(),
+            profile: if cfg!(debug_assertions) {
+                "debug"
+            } else {
+                "release"
+            }
+            .to_string(),
+            host: std::fs::read_to_string("/etc/hostname")
+                .map(|h| h.trim().to_string())
+                .unwrap_or_else(|_| "unknown".into()),
+            os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
+            started: utc_now(),
+        }
+    }
+}
+
+/// The commit of the working directory's repository and whether tracked files differ from it.
+pub fn git_state() -> (String, bool) {
+    let run = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+            .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+    };
+    match run(&["rev-parse", "HEAD"]) {
+        Some(commit) => {
+            let dirty = run(&["status", "--porcelain", "--untracked-files=no"])
+                .is_some_and(|s| !s.is_empty());
+            (commit, dirty)
+        }
+        None => ("unknown".to_string(), false),
+    }
+}
+
+fn compiled_features() -> Vec<String> {
+    let mut f = Vec::new();
+    macro_rules! feature {
+        ($($name:literal),*) => {$( if cfg!(target_feature = $name) { f.push($name.to_string()); } )*};
+    }
+    feature!("sse2", "sse4.2", "avx", "avx2", "fma", "avx512f");
+    f.push(format!("runtime-dispatch:{}", crate::simd::level().name()));
+    f
+}
+
+/// The current UTC time as `YYYY-MM-DDTHH:MM:SSZ`.
+pub fn utc_now() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map(|d| d.as_secs())
+        .unwrap_or(0);
+    let (days, rem) = (secs / 86_400, secs % 86_400);
+    // Civil date from days since 1970-01-01 (Howard Hinnant's algorithm).
+    let z = days as i64 + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + (month <= 2) as i64;
+    format!(
+        "{year:04}-{month:02}-{day:02}T{:02}:{:02}:{:02}Z",
+        rem / 3600,
+        rem % 3600 / 60,
+        rem % 60
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn utc_format() {
+        let s = utc_now();
+        assert_eq!(s.len(), 20);
+        assert!(s.starts_with("20") && s.ends_with('Z'));
+    }
+}

@@ -1,0 +1,287 @@
+//! Runs a sweep: plans the cases, measures them in interleaved rounds, saves the results
+//! file after every round of every case, and resumes an interrupted sweep.
+
+use super::config::SweepConfig;
+use super::measure::{Clock, MeasureJob, RoundSpec};
+use super::plan::{Case, cases};
+use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
+use crate::scenario::Setup;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// How a sweep starts.
+#[derive(Clone, Debug, Default)]
+pub struct SweepOptions {
+    /// Continue an existing results file instead of refusing to touch it.
+    pub resume: bool,
+    /// Resume even if the config or the commit differ from the file's.
+    pub force: bool,
+    /// Start over: an existing results file is kept under a `.bak` name.
+    pub fresh: bool,
+    /// Output directory instead of the config's `out`.
+    pub out: Option<PathBuf>,
+    /// Calibrate the machine at the start and end (tests turn it off).
+    pub calibrate: bool,
+    /// Stop after this many measured rounds, as if interrupted (tests).
+    pub stop_after: Option<usize>,
+}
+
+/// Follows a sweep's progress (terminal bar, log lines, or nothing).
+pub trait Observer {
+    fn start(&mut self, _total_rounds: usize, _done_rounds: usize) {}
+    fn round_done(&mut self, _record: &CaseRecord, _round: usize) {}
+    fn message(&mut self, _text: &str) {}
+    fn finish(&mut self) {}
+}
+
+/// Observes nothing.
+pub struct Silent;
+impl Observer for Silent {}
+
+#[derive(Debug, Error)]
+pub enum SweepError {
+    #[error(
+        "{0} already exists; pass --resume to continue that sweep, or --fresh to start over \
+         (the existing file is kept as a .bak copy)"
+    )]
+    Exists(PathBuf),
+    #[error(
+        "{path} was produced by a different {what} ({detail}); refusing to mix results — \
+         pass --force to resume anyway or --fresh to start over"
+    )]
+    Mismatch {
+        path: PathBuf,
+        what: &'static str,
+        detail: String,
+    },
+    #[error(transparent)]
+    Results(#[from] ResultsError),
+    #[error("case {key}")]
+    Case {
+        key: String,
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    #[error("cannot create {path}: {source}")]
+    Dir {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// What a sweep did.
+#[derive(Debug)]
+pub struct SweepReport {
+    pub path: PathBuf,
+    pub rounds_measured: usize,
+    pub cases: usize,
+    /// Cases not complete (budget reached or stopped).
+    pub incomplete: usize,
+}
+
+/// The results path of a config: `<out>/<name>/results.json`.
+pub fn results_path(config: &SweepConfig, out: Option<&Path>) -> PathBuf {
+    out.unwrap_or(&config.out)
+        .join(&config.name)
+        .join("results.json")
+}
+
+pub fn run_sweep<C: Clock>(
+    config: &SweepConfig,
+    config_text: &str,
+    options: &SweepOptions,
+    clock: &C,
+    observer: &mut dyn Observer,
+) -> Result<SweepReport, SweepError> {
+    let path = results_path(config, options.out.as_deref());
+    let mut results = open(config, config_text, options, &path)?;
+    let logical = crate::run::logical_cpus();
+    let rounds = config.measure.rounds;
+    for case in cases(config) {
+        if results.record_mut(&case.key()).is_none() {
+            results.cases.push(CaseRecord::new(case, rounds, logical));
+        }
+    }
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
+            path: dir.into(),
+            source,
+        })?;
+    }
+    let oversubscribed: Vec<&str> = results
+        .cases
+        .iter()
+        .filter(|c| c.oversubscribed)
+        .map(|c| c.key.as_str())
+        .collect();
+    if !oversubscribed.is_empty() {
+        observer.message(&format!(
+            "warning: {} case(s) use more threads than the {logical} logical CPUs; they are marked oversubscribed",
+            oversubscribed.len()
+        ));
+    }
+    let thread_counts: Vec<usize> = {
+        let mut t: Vec<usize> = results.cases.iter().map(|c| c.case.threads).collect();
+        t.sort_unstable();
+        t.dedup();
+        t
+    };
+    if options.calibrate && results.calibration.start.is_none() {
+        observer.message("calibrating the machine...");
+        let cal = crate::calibrate::calibrate(&thread_counts);
+        observer.message(&cal.summary());
+        results.calibration.start = Some(cal);
+    }
+    results.save(&path)?;
+
+    let total: usize = results.cases.len() * rounds;
+    let done: usize = results
+        .cases
+        .iter()
+        .map(|c| c.rounds_done.min(rounds))
+        .sum();
+    observer.start(total, done);
+    let started = clock.now();
+    let mut measured = 0;
+    let mut stopped = false;
+    'rounds: for round in 0..rounds {
+        // Alternate the direction of each round so no case always runs first or last.
+        let mut order: Vec<usize> = (0..results.cases.len()).collect();
+        if round % 2 == 1 {
+            order.reverse();
+        }
+        for i in order {
+            if results.cases[i].rounds_done > round {
+                continue;
+            }
+            let budget = config.measure.budget_s;
+            if budget > 0.0 && (clock.now() - started).as_secs_f64() >= budget {
+                observer.message(
+                    "time budget reached; run again with --resume to measure the remaining cases",
+                );
+                stopped = true;
+                break 'rounds;
+            }
+            if options.stop_after.is_some_and(|k| measured >= k) {
+                stopped = true;
+                break 'rounds;
+            }
+            let record = &results.cases[i];
+            let spec = RoundSpec {
+                samples: samples_in_round(config.measure.samples, rounds, round),
+                warmup_s: config.measure.warmup_s,
+                min_sample_s: config.measure.min_sample_s,
+                steps_per_sample: (record.rounds_done > 0).then_some(record.steps_per_sample),
+                force_error_sample: config.measure.force_error_sample,
+            };
+            let outcome =
+                measure_case(&record.case, &spec, clock).map_err(|source| SweepError::Case {
+                    key: record.key.clone(),
+                    source,
+                })?;
+            let record = &mut results.cases[i];
+            record.add_round(outcome, config.measure.max_energy_drift);
+            results.save(&path)?;
+            measured += 1;
+            observer.round_done(&results.cases[i], round);
+        }
+    }
+    if options.calibrate && !stopped {
+        let cal = crate::calibrate::calibrate(&thread_counts);
+        results.calibration.end = Some(cal);
+        results.save(&path)?;
+    }
+    observer.finish();
+    Ok(SweepReport {
+        path,
+        rounds_measured: measured,
+        cases: results.cases.len(),
+        incomplete: results.cases.iter().filter(|c| !c.is_complete()).count(),
+    })
+}
+
+/// The share of `samples` taken in `round`: equal parts, the remainder in the first rounds.
+fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
+    samples / rounds + usize::from(round < samples % rounds)
+}
+
+fn measure_case<C: Clock>(
+    case: &Case,
+    spec: &RoundSpec,
+    clock: &C,
+) -> Result<super::measure::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
+    let mut setup = Setup::new(case.scenario);
+    setup.n = Some(case.n);
+    setup.seed = case.seed;
+    setup.precision = case.precision;
+    Ok(setup.dispatch(MeasureJob { case, spec, clock })??)
+}
+
+/// Opens the results file for this sweep: a new one, or an existing one to resume.
+fn open(
+    config: &SweepConfig,
+    config_text: &str,
+    options: &SweepOptions,
+    path: &Path,
+) -> Result<ResultsFile, SweepError> {
+    let fresh = || ResultsFile {
+        schema: RESULTS_SCHEMA.to_string(),
+        metadata: Metadata::collect(),
+        config: config.clone(),
+        config_text: config_text.to_string(),
+        calibration: Default::default(),
+        cases: Vec::new(),
+    };
+    if !path.exists() {
+        return Ok(fresh());
+    }
+    if options.fresh {
+        let backup = path.with_extension(format!(
+            "json.{}.bak",
+            super::results::utc_now().replace(':', "")
+        ));
+        std::fs::rename(path, &backup).map_err(|source| SweepError::Dir {
+            path: backup.clone(),
+            source,
+        })?;
+        return Ok(fresh());
+    }
+    if !options.resume {
+        return Err(SweepError::Exists(path.into()));
+    }
+    let existing = ResultsFile::load(path)?;
+    if !options.force {
+        if existing.config != *config {
+            return Err(SweepError::Mismatch {
+                path: path.into(),
+                what: "config",
+                detail: "the config in the file differs from the one given".into(),
+            });
+        }
+        let (commit, _) = super::results::git_state();
+        if existing.metadata.git_commit != commit {
+            return Err(SweepError::Mismatch {
+                path: path.into(),
+                what: "commit",
+                detail: format!("file: {}, now: {commit}", existing.metadata.git_commit),
+            });
+        }
+    }
+    Ok(existing)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_are_shared_between_rounds() {
+        assert_eq!(
+            (0..3)
+                .map(|r| samples_in_round(10, 3, r))
+                .collect::<Vec<_>>(),
+            vec![4, 3, 3]
+        );
+        assert_eq!((0..2).map(|r| samples_in_round(4, 2, r)).sum::<usize>(), 4);
+    }
+}

@@ -1,0 +1,336 @@
+//! The grouped tree walk (Barnes' vectorized method): each target group builds one interaction
+//! list from the root, and every particle of the group then gathers from that list.
+//!
+//! The list is a small SoA array of sources: the group's own particles first, then, in walk
+//! order, the centres and total strengths of accepted nodes (a monopole acts exactly like one
+//! particle there) and the particles of opened leaves. One `rows::gather` per target over this list does
+//! both the particle-node and particle-particle work in full SIMD blocks. On the timed path the
+//! list is padded to a multiple of `LANES` with zero-strength sources outside the bounding cube,
+//! and the target's own slot is swapped for such a source while it gathers, so the self-pair is
+//! excluded without a scalar tail. (A zero-strength source exerts no force: the law is linear in
+//! the source strength, which the monopole approximation already relies on.) The probe path
+//! instead splits the run around the target, so the interaction counts see only real sources.
+
+use super::tree::{Group, Tree};
+use crate::kernels::WorkCounters;
+use crate::kernels::rows::{LANES, Sources, Target, gather};
+use crate::physics::PairLaw;
+use crate::real::Real;
+use crate::simd;
+
+/// Per-walk scratch: the interaction list of the current group (SoA, `len` entries in use;
+/// the arrays only grow, so that entries can be written before deciding whether to keep
+/// them) and the walk's stack of nodes to open.
+pub(super) struct Scratch<T, const D: usize> {
+    pos: [Vec<T>; D],
+    src: Vec<T>,
+    len: usize,
+    stack: Vec<u32>,
+}
+
+impl<T: Real, const D: usize> Scratch<T, D> {
+    pub fn new() -> Self {
+        Scratch {
+            pos: std::array::from_fn(|_| Vec::new()),
+            src: Vec::new(),
+            len: 0,
+            stack: Vec::new(),
+        }
+    }
+
+    /// Makes room for `extra` more entries.
+    #[inline(always)]
+    fn reserve(&mut self, extra: usize) {
+        let need = self.len + extra;
+        if self.src.len() < need {
+            // Grow geometrically: after the first steps this never happens again.
+            let cap = need.max(2 * self.src.len()).max(256);
+            for p in &mut self.pos {
+                p.resize(cap, T::zero());
+            }
+            self.src.resize(cap, T::zero());
+        }
+    }
+
+    /// Writes a source at the end of the list and keeps it if `keep` (branch-free).
+    #[inline(always)]
+    fn push_if(&mut self, x: [T; D], s: T, keep: bool) {
+        let k = self.len;
+        for d in 0..D {
+            self.pos[d][k] = x[d];
+        }
+        self.src[k] = s;
+        self.len += keep as usize;
+    }
+
+    /// Appends sorted particles `lo..hi` of the tree.
+    #[inline(always)]
+    fn push_range(&mut self, tree: &Tree<T, D>, lo: usize, hi: usize) {
+        self.reserve(hi - lo);
+        let k = self.len;
+        for d in 0..D {
+            self.pos[d][k..k + hi - lo].copy_from_slice(&tree.pos[d][lo..hi]);
+        }
+        self.src[k..k + hi - lo].copy_from_slice(&tree.src[lo..hi]);
+        self.len += hi - lo;
+    }
+
+    /// Entries `lo..hi`.
+    #[inline(always)]
+    fn sources(&self, lo: usize, hi: usize) -> Sources<'_, T, D> {
+        Sources::range(&self.pos, &self.src, lo, hi)
+    }
+
+    /// Swaps slot `k` with `(x, s)`, returning what was there.
+    #[inline(always)]
+    fn swap(&mut self, k: usize, x: [T; D], s: T) -> ([T; D], T) {
+        let old = (std::array::from_fn(|d| self.pos[d][k]), self.src[k]);
+        for d in 0..D {
+            self.pos[d][k] = x[d];
+        }
+        self.src[k] = s;
+        old
+    }
+}
+
+/// What a run of groups adds to the step's totals.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Totals {
+    pub work: WorkCounters,
+    /// Σ over targets of their energy with their sources (each pair counted from both ends).
+    pub energy: f64,
+    pub interacting: u64,
+}
+
+impl Totals {
+    pub fn add(&mut self, o: &Totals) {
+        self.work.add(&o.work);
+        self.energy += o.energy;
+        self.interacting += o.interacting;
+    }
+}
+
+/// The group being listed: its particle range and bounding box.
+struct GroupBox<T, const D: usize> {
+    start: u32,
+    end: u32,
+    lo: [T; D],
+    hi: [T; D],
+}
+
+/// Tests the nodes `family` against the group: accepted ones go to the list as monopoles,
+/// the others onto the stack to be opened. Branch-free: every node is written to both and
+/// only one of the two lengths advances, so the unpredictable accept/open outcome costs no
+/// mispredicted branches.
+#[inline(always)]
+fn test_family<T: Real, const D: usize>(
+    tree: &Tree<T, D>,
+    family: std::ops::Range<usize>,
+    g: &GroupBox<T, D>,
+    list: &mut Scratch<T, D>,
+    work: &mut WorkCounters,
+) {
+    let count = family.len();
+    list.reserve(count);
+    let (base, sp) = (list.len, list.stack.len());
+    list.stack.resize(sp + count, 0);
+    // Local slices and counters, so that the loop keeps them in registers.
+    let pos = list.pos.each_mut().map(|p| &mut p[base..base + count]);
+    let src = &mut list.src[base..base + count];
+    let stack = &mut list.stack[sp..sp + count];
+    let (mut accepted, mut opened) = (0, 0);
+    for (c, node) in tree.nodes[family.clone()].iter().enumerate() {
+        // Squared distance from the centre of strength to the nearest point of the box.
+        let mut d2 = T::zero();
+        for d in 0..D {
+            let x = node.com[d];
+            let e = max(max(g.lo[d] - x, x - g.hi[d]), T::zero());
+            d2 += e * e;
+        }
+        // A node holding some of the group's own particles is never accepted (it would count
+        // them, and the self-pairs, twice); the criterion alone ensures it for θ < 1/√D only.
+        let own = (node.start < g.end) & (node.end > g.start);
+        let accept = (d2 > node.crit2) & !own;
+        for d in 0..D {
+            pos[d][accepted] = node.com[d];
+        }
+        src[accepted] = node.strength;
+        stack[opened] = (family.start + c) as u32;
+        accepted += accept as usize;
+        opened += !accept as usize;
+    }
+    list.len = base + accepted;
+    list.stack.truncate(sp + opened);
+    work.nodes_accepted += accepted as u64;
+    work.nodes_opened += opened as u64;
+}
+
+/// The larger of two values as a plain compare-and-select (a NaN gives `b`): `Float::max`
+/// adds NaN fix-ups that double the cost of the node test.
+#[inline(always)]
+fn max<T: Real>(a: T, b: T) -> T {
+    if a > b { a } else { b }
+}
+
+/// Builds the interaction list of a group: its own particles first (at slots 0..m, so target
+/// k sits at slot k), then what a walk of every tree from its root accepts or opens.
+fn interaction_list<T: Real, const D: usize>(
+    tree: &Tree<T, D>,
+    g: &GroupBox<T, D>,
+    list: &mut Scratch<T, D>,
+    work: &mut WorkCounters,
+) {
+    list.len = 0;
+    list.stack.clear();
+    list.push_range(tree, g.start as usize, g.end as usize);
+    for &root in &tree.roots {
+        test_family(tree, root as usize..root as usize + 1, g, list, work);
+    }
+    // Every node is pushed at most once and the tree is finite, so this ends whatever the
+    // values (NaN distances open nodes down to the leaves).
+    while let Some(i) = list.stack.pop() {
+        let node = &tree.nodes[i as usize];
+        if node.start >= g.start && node.end <= g.end {
+            // Inside the group: its particles are already listed.
+            continue;
+        }
+        if node.children == 0 {
+            // An opened leaf contributes its particles directly.
+            list.push_range(tree, node.start as usize, node.end as usize);
+        } else {
+            let first = node.first as usize;
+            test_family(tree, first..first + node.children as usize, g, list, work);
+        }
+    }
+}
+
+/// Computes the forces on the particles of `groups` (contiguous in sorted order) into `out`,
+/// whose first element is sorted slot `offset`.
+///
+/// The walk runs at the baseline instruction set; only each group's target loop goes through
+/// `simd::dispatch`. With the walk inlined into the same function as the pair loop, LLVM
+/// scalarized the loop's lane accumulators (1.5× slower pair loop), so they are kept apart.
+pub(super) fn eval_groups<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+    law: &L,
+    tree: &Tree<T, D>,
+    groups: &[Group],
+    offset: usize,
+    out: &mut [&mut [T]; D],
+    list: &mut Scratch<T, D>,
+) -> Totals {
+    let mut totals = Totals::default();
+    for g in groups {
+        let (start, end) = (g.start as usize, g.end as usize);
+        // The group's bounding box (tighter than its cells).
+        let mut lo = [T::infinity(); D];
+        let mut hi = [T::neg_infinity(); D];
+        for d in 0..D {
+            for &x in &tree.pos[d][start..end] {
+                lo[d] = lo[d].min(x);
+                hi[d] = hi[d].max(x);
+            }
+        }
+        let group = GroupBox {
+            start: g.start,
+            end: g.end,
+            lo,
+            hi,
+        };
+        interaction_list(tree, &group, list, &mut totals.work);
+        let real = list.len;
+        totals.work.pair_checks += ((end - start) * (real - 1)) as u64;
+        if !PROBE {
+            let padded = real.next_multiple_of(LANES);
+            list.reserve(padded - real);
+            while list.len < padded {
+                list.push_if(tree.dummy, T::zero(), true);
+            }
+        }
+        let out = out.each_mut().map(|o| &mut o[start - offset..end - offset]);
+        let (energy, interacting) = simd::dispatch(
+            #[inline(always)]
+            || group_forces::<T, L, D, PROBE>(law, tree, start, real, list, out),
+        );
+        totals.energy += energy;
+        totals.interacting += interacting;
+    }
+    totals
+}
+
+/// Forces on the group's particles (sorted slots `start..start + out.len()`, list slots
+/// `0..out.len()`) from the first `real` entries of its list; returns the energy and the
+/// interacting count when probing.
+#[inline(always)]
+fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+    law: &L,
+    tree: &Tree<T, D>,
+    start: usize,
+    real: usize,
+    list: &mut Scratch<T, D>,
+    out: [&mut [T]; D],
+) -> (f64, u64) {
+    let (mut energy, mut interacting) = (0.0, 0);
+    for k in 0..out[0].len() {
+        let i = start + k;
+        let t = Target {
+            x: std::array::from_fn(|d| tree.pos[d][i]),
+            s: tree.src[i],
+        };
+        let sum = if PROBE {
+            // Split the run around the target: only real sources are counted.
+            let mut sum = gather::<T, L, D, true>(law, &t, &list.sources(0, k));
+            sum.add(&gather::<T, L, D, true>(
+                law,
+                &t,
+                &list.sources(k + 1, real),
+            ));
+            sum
+        } else {
+            // Full blocks only: the target's own slot holds a zero-strength source meanwhile.
+            let own = list.swap(k, tree.dummy, T::zero());
+            let sum = gather::<T, L, D, false>(law, &t, &list.sources(0, list.len));
+            list.swap(k, own.0, own.1);
+            sum
+        };
+        for d in 0..D {
+            out[d][k] = sum.force[d];
+        }
+        if PROBE {
+            energy += sum.energy.as_f64();
+            interacting += sum.interacting;
+        }
+    }
+    (energy, interacting)
+}
+
+/// Calls `f(groups, offset, out)` on consecutive runs of groups with the matching disjoint
+/// parts of the sorted-order force arrays, in parallel on the current rayon pool, splitting
+/// at group boundaries down to about `min_len` particles. Returns the summed totals.
+pub(super) fn for_group_runs<T: Send, const D: usize, F>(
+    groups: &[Group],
+    out: [&mut [T]; D],
+    offset: usize,
+    min_len: usize,
+    f: &F,
+) -> Totals
+where
+    F: Fn(&[Group], usize, [&mut [T]; D]) -> Totals + Sync,
+{
+    if groups.len() <= 1 || out[0].len() <= min_len.max(1) {
+        return f(groups, offset, out);
+    }
+    let mid = groups.len() / 2;
+    let split = groups[mid].start as usize - offset;
+    let mut halves = out.map(|p| {
+        let (a, b) = p.split_at_mut(split);
+        (Some(a), Some(b))
+    });
+    let lo: [&mut [T]; D] = std::array::from_fn(|d| halves[d].0.take().expect("split once"));
+    let hi: [&mut [T]; D] = std::array::from_fn(|d| halves[d].1.take().expect("split once"));
+    let (mut a, b) = rayon::join(
+        || for_group_runs(&groups[..mid], lo, offset, min_len, f),
+        || for_group_runs(&groups[mid..], hi, offset + split, min_len, f),
+    );
+    a.add(&b);
+    a
+}
