@@ -19,7 +19,12 @@ pub enum BoundaryError {
         "step {step}: particle {id} is still outside the box after one reflection \
          (coordinate {dim} = {value}); the time step is too large for these velocities — reduce --dt"
     )]
-    MultipleReflection { step: u64, id: u32, dim: usize, value: f64 },
+    MultipleReflection {
+        step: u64,
+        id: u32,
+        dim: usize,
+        value: f64,
+    },
     #[error(
         "step {step}: particle {id} has a non-finite position; the simulation blew up — \
          reduce --dt or check the initial state"
@@ -29,7 +34,11 @@ pub enum BoundaryError {
 
 impl<T: Real, const D: usize> Boundary<T, D> {
     /// Applies the boundary after a drift and returns the particles' bounding box.
-    pub fn apply(&self, state: &mut State<T, D>, step: u64) -> Result<([T; D], [T; D]), BoundaryError> {
+    pub fn apply(
+        &self,
+        state: &mut State<T, D>,
+        step: u64,
+    ) -> Result<([T; D], [T; D]), BoundaryError> {
         match *self {
             Boundary::Reflecting { lo, hi } => {
                 for d in 0..D {
@@ -55,7 +64,9 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                 let (lo, hi) = state.bounding_box();
                 for d in 0..D {
                     // min/max skip NaN, so test finiteness separately: x·0 is NaN for NaN and ±∞.
-                    let poison = state.pos[d].iter().fold(T::zero(), |acc, &x| acc + x * T::zero());
+                    let poison = state.pos[d]
+                        .iter()
+                        .fold(T::zero(), |acc, &x| acc + x * T::zero());
                     if !(lo[d].is_finite() && hi[d].is_finite() && poison.is_finite()) {
                         return Err(first_offender(state, step, d, |x| !x.is_finite()));
                     }
@@ -73,12 +84,23 @@ fn first_offender<T: Real, const D: usize>(
     d: usize,
     is_bad: impl Fn(T) -> bool,
 ) -> BoundaryError {
-    let i = state.pos[d].iter().position(|&x| is_bad(x) || !x.is_finite()).unwrap_or(0);
+    let i = state.pos[d]
+        .iter()
+        .position(|&x| is_bad(x) || !x.is_finite())
+        .unwrap_or(0);
     let x = state.pos[d][i];
     if x.is_finite() {
-        BoundaryError::MultipleReflection { step, id: state.id[i], dim: d, value: x.as_f64() }
+        BoundaryError::MultipleReflection {
+            step,
+            id: state.id[i],
+            dim: d,
+            value: x.as_f64(),
+        }
     } else {
-        BoundaryError::NonFinite { step, id: state.id[i] }
+        BoundaryError::NonFinite {
+            step,
+            id: state.id[i],
+        }
     }
 }
 
@@ -87,7 +109,10 @@ mod tests {
     use super::*;
 
     fn box2() -> Boundary<f64, 2> {
-        Boundary::Reflecting { lo: [0.0, 0.0], hi: [1.0, 2.0] }
+        Boundary::Reflecting {
+            lo: [0.0, 0.0],
+            hi: [1.0, 2.0],
+        }
     }
 
     #[test]
@@ -110,7 +135,15 @@ mod tests {
         s.pos = [vec![0.5, 2.5], vec![0.5, 0.5]];
         s.id = vec![10, 11];
         let err = box2().apply(&mut s, 42).unwrap_err();
-        assert_eq!(err, BoundaryError::MultipleReflection { step: 42, id: 11, dim: 0, value: -0.5 });
+        assert_eq!(
+            err,
+            BoundaryError::MultipleReflection {
+                step: 42,
+                id: 11,
+                dim: 0,
+                value: -0.5
+            }
+        );
         assert!(err.to_string().contains("step 42") && err.to_string().contains("--dt"));
     }
 
@@ -122,8 +155,14 @@ mod tests {
         assert_eq!(err, BoundaryError::NonFinite { step: 3, id: 1 });
         let mut s = State::<f32, 2>::new(1);
         s.pos[0][0] = f32::INFINITY;
-        let b = Boundary::<f32, 2>::Reflecting { lo: [0.0; 2], hi: [1.0; 2] };
-        assert_eq!(b.apply(&mut s, 5).unwrap_err(), BoundaryError::NonFinite { step: 5, id: 0 });
+        let b = Boundary::<f32, 2>::Reflecting {
+            lo: [0.0; 2],
+            hi: [1.0; 2],
+        };
+        assert_eq!(
+            b.apply(&mut s, 5).unwrap_err(),
+            BoundaryError::NonFinite { step: 5, id: 0 }
+        );
     }
 
     #[test]

@@ -5,7 +5,12 @@ use crate::real::Real;
 use crate::state::{Field, State};
 
 /// Half kick: `v += (F/m + external)·dt/2`.
-pub fn kick<T: Real, const D: usize>(state: &mut State<T, D>, forces: &Field<T, D>, external: [T; D], half_dt: T) {
+pub fn kick<T: Real, const D: usize>(
+    state: &mut State<T, D>,
+    forces: &Field<T, D>,
+    external: [T; D],
+    half_dt: T,
+) {
     for d in 0..D {
         let (g, f) = (external[d], &forces[d]);
         for ((v, &f), &m) in state.vel[d].iter_mut().zip(f).zip(&state.mass) {

@@ -10,7 +10,18 @@ use std::ops::{AddAssign, MulAssign, SubAssign};
 
 /// A floating-point type the engine can run in: `f32` or `f64`.
 pub trait Real:
-    Float + AddAssign + SubAssign + MulAssign + Sum + Debug + Display + std::fmt::LowerExp + Default + Send + Sync + 'static
+    Float
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + Sum
+    + Debug
+    + Display
+    + std::fmt::LowerExp
+    + Default
+    + Send
+    + Sync
+    + 'static
 {
     /// The name used in results and on the command line.
     const NAME: &'static str;

@@ -7,7 +7,7 @@ use crate::output::nbview::{self, NbviewFormat};
 use crate::output::{AtomicFile, WriteError, dump};
 use crate::physics::PairLaw;
 use crate::real::Real;
-use crate::scenario::{SystemInfo, SystemJob, System};
+use crate::scenario::{System, SystemInfo, SystemJob};
 use crate::simd;
 use crate::stats::StepPercentiles;
 use serde::Serialize;
@@ -45,7 +45,10 @@ pub enum RunError {
     #[error(transparent)]
     Write(#[from] WriteError),
     #[error("cannot start a pool of {threads} threads: {source}")]
-    Pool { threads: usize, source: rayon::ThreadPoolBuildError },
+    Pool {
+        threads: usize,
+        source: rayon::ThreadPoolBuildError,
+    },
     #[error(
         "energy is not finite after step {step} (E = {energy}); the simulation blew up — reduce --dt"
     )]
@@ -142,7 +145,10 @@ impl SystemJob for RunJob<'_> {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(spec.threads)
             .build()
-            .map_err(|source| RunError::Pool { threads: spec.threads, source })?;
+            .map_err(|source| RunError::Pool {
+                threads: spec.threads,
+                source,
+            })?;
         let info = system.info.clone();
         let law = system.law.kind().name();
         pool.install(|| measure(spec, &info, law, Simulation::new(system, kernel)))
@@ -168,7 +174,10 @@ fn measure<T: Real, const D: usize>(
         let t = Instant::now();
         sim.step()?;
         step_ns.push(t.elapsed().as_nanos() as u64);
-        if let Some(tr) = trajectory.as_mut().filter(|tr| sim.step.is_multiple_of(tr.every)) {
+        if let Some(tr) = trajectory
+            .as_mut()
+            .filter(|tr| sim.step.is_multiple_of(tr.every))
+        {
             let t = Instant::now();
             tr.frame(&sim)?;
             sim.phases.output += t.elapsed().as_secs_f64();
@@ -177,7 +186,10 @@ fn measure<T: Real, const D: usize>(
     let total_s = start.elapsed().as_secs_f64();
     let e1 = sim.probe();
     if !e1.total().is_finite() {
-        return Err(RunError::EnergyBlowUp { step: sim.step, energy: e1.total() });
+        return Err(RunError::EnergyBlowUp {
+            step: sim.step,
+            energy: e1.total(),
+        });
     }
     if let Some(tr) = trajectory {
         tr.file.commit()?;
@@ -191,7 +203,10 @@ fn measure<T: Real, const D: usize>(
             sim.step,
             info.dt
         );
-        crate::output::write_atomic(path, dump::state_dump(&header, &sim.state, &sim.forces).as_bytes())?;
+        crate::output::write_atomic(
+            path,
+            dump::state_dump(&header, &sim.state, &sim.forces).as_bytes(),
+        )?;
     }
     let step_sum_s = step_ns.iter().sum::<u64>() as f64 * 1e-9;
     let per_step_ns = StepPercentiles::of(&step_ns).unwrap_or_default();
@@ -222,8 +237,16 @@ fn measure<T: Real, const D: usize>(
             ns_per_particle_step: per_step_ns.p50 as f64 / n as f64,
         },
         throughput: Throughput {
-            particle_steps_per_s: if step_sum_s > 0.0 { n as f64 * steps / step_sum_s } else { 0.0 },
-            pair_evals_per_s: if step_sum_s > 0.0 { sim.work.pair_checks as f64 / step_sum_s } else { 0.0 },
+            particle_steps_per_s: if step_sum_s > 0.0 {
+                n as f64 * steps / step_sum_s
+            } else {
+                0.0
+            },
+            pair_evals_per_s: if step_sum_s > 0.0 {
+                sim.work.pair_checks as f64 / step_sum_s
+            } else {
+                0.0
+            },
         },
         counters: Counters {
             total: sim.work,
@@ -236,13 +259,18 @@ fn measure<T: Real, const D: usize>(
             rel_drift: (e1.total() - e0.total()) / e0.total().abs(),
             lj_potential: "shifted",
         },
-        momentum: MomentumCheck { initial: p0, last: sim.state.momentum().to_vec() },
+        momentum: MomentumCheck {
+            initial: p0,
+            last: sim.state.momentum().to_vec(),
+        },
     })
 }
 
 /// Logical CPUs available to this process.
 pub fn logical_cpus() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
 }
 
 /// An NBView trajectory being written.
@@ -267,8 +295,14 @@ impl Trajectory {
             .fold(0.0, f64::max);
         let scale = box_side.unwrap_or(extent);
         let n = sim.state.len();
-        nbview::write_header(file.writer(), spec.format, n as u32, scale as f32).map_err(|e| file.error(e))?;
-        let mut t = Trajectory { file, format: spec.format, every: spec.every.max(1), frame: vec![[0.0; 2]; n] };
+        nbview::write_header(file.writer(), spec.format, n as u32, scale as f32)
+            .map_err(|e| file.error(e))?;
+        let mut t = Trajectory {
+            file,
+            format: spec.format,
+            every: spec.every.max(1),
+            frame: vec![[0.0; 2]; n],
+        };
         t.frame(sim)?;
         Ok(t)
     }
@@ -276,7 +310,10 @@ impl Trajectory {
     fn frame<T: Real, const D: usize>(&mut self, sim: &Simulation<T, D>) -> Result<(), WriteError> {
         let s = &sim.state;
         for (slot, &id) in s.id.iter().enumerate() {
-            self.frame[id as usize] = [s.pos[0][slot].as_f64() as f32, s.pos[1.min(D - 1)][slot].as_f64() as f32];
+            self.frame[id as usize] = [
+                s.pos[0][slot].as_f64() as f32,
+                s.pos[1.min(D - 1)][slot].as_f64() as f32,
+            ];
         }
         let out = self.file.writer();
         nbview::write_frame(out, self.format, &self.frame).map_err(|e| self.file.error(e))

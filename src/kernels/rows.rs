@@ -70,7 +70,10 @@ pub struct Exclude {
 }
 
 impl Exclude {
-    pub const NONE: Exclude = Exclude { below: 0, index: usize::MAX };
+    pub const NONE: Exclude = Exclude {
+        below: 0,
+        index: usize::MAX,
+    };
 
     /// Skip only source `index` (the target's own slot).
     pub fn index(index: usize) -> Self {
@@ -79,7 +82,10 @@ impl Exclude {
 
     /// Skip the sources before `below`.
     pub fn below(below: usize) -> Self {
-        Exclude { below, index: usize::MAX }
+        Exclude {
+            below,
+            index: usize::MAX,
+        }
     }
 
     #[inline(always)]
@@ -320,7 +326,13 @@ pub fn gather_excluding<T: Real, L: PairLaw<T>, const D: usize, const PROBE: boo
     let s = &src.s[..n];
     let mut acc = Accumulator::<T, D>::new();
     let full = n - n % LANES;
-    for_blocks!(exclude, full, |base, MASK| gather_block::<T, L, D, PROBE, MASK>(
+    for_blocks!(exclude, full, |base, MASK| gather_block::<
+        T,
+        L,
+        D,
+        PROBE,
+        MASK,
+    >(
         law, t, &pos, s, base, &exclude, &mut acc
     ));
     for j in (full..n).filter(|&j| exclude.keeps(j)) {
@@ -353,7 +365,13 @@ pub fn scatter<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     let mut fsrc = fsrc.map(|f| &mut f[..n]);
     let mut acc = Accumulator::<T, D>::new();
     let full = n - n % LANES;
-    for_blocks!(exclude, full, |base, MASK| scatter_block::<T, L, D, PROBE, MASK>(
+    for_blocks!(exclude, full, |base, MASK| scatter_block::<
+        T,
+        L,
+        D,
+        PROBE,
+        MASK,
+    >(
         law, t, &pos, s, base, &exclude, &mut acc, &mut fsrc
     ));
     for j in (full..n).filter(|&j| exclude.keeps(j)) {
@@ -405,9 +423,17 @@ mod tests {
             (0..n).map(|j| (j as f64).sin()).collect(),
         ];
         let s = vec![1.0; n];
-        let t = Target { x: [0.5, 0.0], s: 1.0 };
+        let t = Target {
+            x: [0.5, 0.0],
+            s: 1.0,
+        };
         let src = Sources::range(&pos, &s, 0, n);
-        for ex in [Exclude::index(3), Exclude::index(n - 1), Exclude::below(7), Exclude::below(LANES + 2)] {
+        for ex in [
+            Exclude::index(3),
+            Exclude::index(n - 1),
+            Exclude::below(7),
+            Exclude::below(LANES + 2),
+        ] {
             let got = gather_excluding::<f64, _, 2, true>(&law, &t, &src, ex);
             let mut want = [0.0; 2];
             let mut kept = 0;
@@ -417,7 +443,10 @@ mod tests {
                 want[1] += f[1];
                 kept += 1;
             }
-            assert!((got.force[0] - want[0]).abs() < 1e-12 && (got.force[1] - want[1]).abs() < 1e-12, "{ex:?}");
+            assert!(
+                (got.force[0] - want[0]).abs() < 1e-12 && (got.force[1] - want[1]).abs() < 1e-12,
+                "{ex:?}"
+            );
             assert_eq!(got.interacting, kept);
         }
     }

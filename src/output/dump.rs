@@ -23,15 +23,28 @@ const AXES: [&str; 3] = ["x", "y", "z"];
 
 /// Column names `prefix` + axis (+ suffix) for D components.
 fn columns(prefix: &str, suffix: &str, d: usize) -> String {
-    AXES[..d].iter().map(|a| format!(" {prefix}{a}{suffix}")).collect()
+    AXES[..d]
+        .iter()
+        .map(|a| format!(" {prefix}{a}{suffix}"))
+        .collect()
 }
 
 /// The state dump text. `header` is the run description placed on the second line.
-pub fn state_dump<T: Real, const D: usize>(header: &str, state: &State<T, D>, forces: &Field<T, D>) -> String {
+pub fn state_dump<T: Real, const D: usize>(
+    header: &str,
+    state: &State<T, D>,
+    forces: &Field<T, D>,
+) -> String {
     let mut out = String::with_capacity(state.len() * 16 * (3 * D + 1));
     out.push_str("# nbody-bench state v1\n");
     let _ = writeln!(out, "# {header}");
-    let _ = writeln!(out, "# columns: id{}{}{}", columns("", "", D), columns("v", "", D), columns("f", "", D));
+    let _ = writeln!(
+        out,
+        "# columns: id{}{}{}",
+        columns("", "", D),
+        columns("v", "", D),
+        columns("f", "", D)
+    );
     for (id, slot) in state.slots_by_id().into_iter().enumerate() {
         let _ = write!(out, "{id}");
         for field in [&state.pos, &state.vel, forces] {
@@ -55,7 +68,12 @@ pub fn force_dump<T: Real, const D: usize>(
     let mut out = String::new();
     out.push_str("# nbody-bench forces v1\n");
     let _ = writeln!(out, "# {header}");
-    let _ = write!(out, "# columns: id{}{}", columns("", "", D), columns("f", "_ref", D));
+    let _ = write!(
+        out,
+        "# columns: id{}{}",
+        columns("", "", D),
+        columns("f", "_ref", D)
+    );
     for (name, _) in kernels {
         out.push_str(&columns("f", &format!("_{name}"), D));
     }

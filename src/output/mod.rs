@@ -27,14 +27,23 @@ pub struct AtomicFile {
 
 impl AtomicFile {
     pub fn create(path: &Path) -> Result<Self, WriteError> {
-        let err = |source| WriteError { path: path.to_path_buf(), source };
-        let name = path.file_name().ok_or_else(|| err(io::Error::other("not a file name")))?;
+        let err = |source| WriteError {
+            path: path.to_path_buf(),
+            source,
+        };
+        let name = path
+            .file_name()
+            .ok_or_else(|| err(io::Error::other("not a file name")))?;
         let mut tmp_name = std::ffi::OsString::from(".");
         tmp_name.push(name);
         tmp_name.push(format!(".{}.tmp", std::process::id()));
         let tmp = path.with_file_name(tmp_name);
         let file = File::create(&tmp).map_err(err)?;
-        Ok(AtomicFile { path: path.to_path_buf(), tmp, out: Some(BufWriter::new(file)) })
+        Ok(AtomicFile {
+            path: path.to_path_buf(),
+            tmp,
+            out: Some(BufWriter::new(file)),
+        })
     }
 
     pub fn writer(&mut self) -> &mut BufWriter<File> {
@@ -47,7 +56,10 @@ impl AtomicFile {
 
     /// Flushes, syncs and renames the file into place.
     pub fn commit(mut self) -> Result<(), WriteError> {
-        let err = |source| WriteError { path: self.path.clone(), source };
+        let err = |source| WriteError {
+            path: self.path.clone(),
+            source,
+        };
         let out = self.out.take().expect("writer present until commit");
         let file = out.into_inner().map_err(|e| err(e.into_error()))?;
         file.sync_all().map_err(err)?;
@@ -56,7 +68,10 @@ impl AtomicFile {
 
     /// Maps an I/O error from writing to this file into a [`WriteError`] naming it.
     pub fn error(&self, source: io::Error) -> WriteError {
-        WriteError { path: self.path.clone(), source }
+        WriteError {
+            path: self.path.clone(),
+            source,
+        }
     }
 }
 
@@ -71,7 +86,10 @@ impl Drop for AtomicFile {
 /// Writes `contents` to `path` atomically.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), WriteError> {
     let mut f = AtomicFile::create(path)?;
-    f.writer().write_all(contents).map_err(|e| WriteError { path: path.to_path_buf(), source: e })?;
+    f.writer().write_all(contents).map_err(|e| WriteError {
+        path: path.to_path_buf(),
+        source: e,
+    })?;
     f.commit()
 }
 

@@ -23,7 +23,12 @@ pub const TEXT_TAG: &[u8; 8] = b"NBView00";
 pub const BINARY_TAG: &[u8; 8] = b"NBView01";
 
 /// Writes the tag and header.
-pub fn write_header(out: &mut impl Write, format: NbviewFormat, n: u32, scale: f32) -> io::Result<()> {
+pub fn write_header(
+    out: &mut impl Write,
+    format: NbviewFormat,
+    n: u32,
+    scale: f32,
+) -> io::Result<()> {
     match format {
         NbviewFormat::NbviewBin => {
             out.write_all(BINARY_TAG)?;
@@ -78,12 +83,18 @@ pub fn read_binary(mut input: impl Read) -> io::Result<Trajectory> {
     input.read_to_end(&mut rest)?;
     let frame_bytes = n as usize * 8;
     if frame_bytes == 0 || rest.len() % frame_bytes != 0 {
-        return Err(bad("truncated NBView01 file: data is not a whole number of frames"));
+        return Err(bad(
+            "truncated NBView01 file: data is not a whole number of frames",
+        ));
     }
     let f = |b: &[u8]| f32::from_be_bytes(b.try_into().expect("4 bytes"));
     let frames = rest
         .chunks_exact(frame_bytes)
-        .map(|fr| fr.chunks_exact(8).map(|p| [f(&p[..4]), f(&p[4..])]).collect())
+        .map(|fr| {
+            fr.chunks_exact(8)
+                .map(|p| [f(&p[..4]), f(&p[4..])])
+                .collect()
+        })
         .collect();
     Ok(Trajectory { n, scale, frames })
 }
@@ -96,15 +107,20 @@ mod tests {
     fn binary_layout_is_as_documented() {
         let mut buf = Vec::new();
         write_header(&mut buf, NbviewFormat::NbviewBin, 2, 1.0).unwrap();
-        write_frame(&mut buf, NbviewFormat::NbviewBin, &[[0.5, -2.0], [1.0, 0.25]]).unwrap();
+        write_frame(
+            &mut buf,
+            NbviewFormat::NbviewBin,
+            &[[0.5, -2.0], [1.0, 0.25]],
+        )
+        .unwrap();
         let expected: Vec<u8> = [
             b"NBView01\n".to_vec(),
-            vec![0, 0, 0, 2],          // n = 2, big-endian
-            vec![0x3f, 0x80, 0, 0],    // 1.0f32
-            vec![0x3f, 0, 0, 0],       // 0.5
-            vec![0xc0, 0, 0, 0],       // -2.0
-            vec![0x3f, 0x80, 0, 0],    // 1.0
-            vec![0x3e, 0x80, 0, 0],    // 0.25
+            vec![0, 0, 0, 2],       // n = 2, big-endian
+            vec![0x3f, 0x80, 0, 0], // 1.0f32
+            vec![0x3f, 0, 0, 0],    // 0.5
+            vec![0xc0, 0, 0, 0],    // -2.0
+            vec![0x3f, 0x80, 0, 0], // 1.0
+            vec![0x3e, 0x80, 0, 0], // 0.25
         ]
         .concat();
         assert_eq!(buf, expected);
@@ -112,14 +128,24 @@ mod tests {
 
     #[test]
     fn binary_round_trips() {
-        let frames = vec![vec![[0.1, 0.2], [0.3, 0.4], [0.5, 0.6]], vec![[1.1, 1.2], [1.3, 1.4], [1.5, 1.6]]];
+        let frames = vec![
+            vec![[0.1, 0.2], [0.3, 0.4], [0.5, 0.6]],
+            vec![[1.1, 1.2], [1.3, 1.4], [1.5, 1.6]],
+        ];
         let mut buf = Vec::new();
         write_header(&mut buf, NbviewFormat::NbviewBin, 3, 2.5).unwrap();
         for f in &frames {
             write_frame(&mut buf, NbviewFormat::NbviewBin, f).unwrap();
         }
         let t = read_binary(&buf[..]).unwrap();
-        assert_eq!(t, Trajectory { n: 3, scale: 2.5, frames });
+        assert_eq!(
+            t,
+            Trajectory {
+                n: 3,
+                scale: 2.5,
+                frames
+            }
+        );
         // A truncated file is refused, not half-read.
         assert!(read_binary(&buf[..buf.len() - 3]).is_err());
         assert!(read_binary(&b"NBView00\n"[..]).is_err());

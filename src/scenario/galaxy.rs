@@ -43,7 +43,11 @@ pub fn galaxy<T: Real>(n: usize, seed: u64) -> State<T, 3> {
         vel.push([-v * phi.sin(), v * phi.cos(), 0.0]);
         mass.push(PLANET_MASS);
     }
-    let m_light = if cloud > 0 { CLOUD_MASS / cloud as f64 } else { 0.0 };
+    let m_light = if cloud > 0 {
+        CLOUD_MASS / cloud as f64
+    } else {
+        0.0
+    };
     for _ in 0..cloud {
         let (x, v) = plummer_body(&mut rng);
         pos.push(x);

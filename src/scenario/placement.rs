@@ -69,7 +69,12 @@ pub fn spaced_uniform(
         break;
     }
     if pts.len() < n && !allow_fewer {
-        return Err(PlacementError { placed: pts.len(), requested: n, min_dist, side });
+        return Err(PlacementError {
+            placed: pts.len(),
+            requested: n,
+            min_dist,
+            side,
+        });
     }
     Ok(pts)
 }
@@ -142,6 +147,9 @@ mod tests {
         let p = jittered_lattice(n, side, 0.01, &mut rng);
         assert_eq!(p.len(), n);
         assert!(min_distance(&p) > 0.0099, "{}", min_distance(&p));
-        assert!(p.iter().all(|q| q.iter().all(|&x| (0.0..side).contains(&x))));
+        assert!(
+            p.iter()
+                .all(|q| q.iter().all(|&x| (0.0..side).contains(&x)))
+        );
     }
 }
