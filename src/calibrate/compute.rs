@@ -216,4 +216,3 @@ pub(super) fn measure_ceiling(
     }
     out
 }
-

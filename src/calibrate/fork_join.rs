@@ -15,7 +15,12 @@ pub(super) const FORK_JOIN_TIMEOUT: Duration = Duration::from_millis(2);
 /// pool thread take part: without it an empty region is usually run entirely by the calling
 /// thread before any worker wakes up, which measures nothing a real region pays. Returns
 /// whether every leaf saw all the others.
-pub(super) fn region(leaves: usize, total: usize, arrived: &AtomicUsize, deadline: Instant) -> bool {
+pub(super) fn region(
+    leaves: usize,
+    total: usize,
+    arrived: &AtomicUsize,
+    deadline: Instant,
+) -> bool {
     if leaves <= 1 {
         arrived.fetch_add(1, Ordering::AcqRel);
         while arrived.load(Ordering::Acquire) < total {
@@ -92,4 +97,3 @@ pub(super) fn measure_fork_join(p: usize, budget_s: f64, warnings: &mut Vec<Stri
     // `repeat` runs at least 5 times each, so there are medians.
     (median(&cold).unwrap_or(0.0), median(&hot).unwrap_or(0.0))
 }
-

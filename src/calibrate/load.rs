@@ -75,4 +75,3 @@ pub(super) fn parse_own_ticks(text: &str) -> Option<u64> {
     let stime: u64 = fields.get(12)?.parse().ok()?;
     Some(utime + stime)
 }
-

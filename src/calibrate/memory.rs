@@ -52,4 +52,3 @@ pub(super) fn measure_bandwidth(bytes: usize, budget_s: f64, warnings: &mut Vec<
     .into_iter()
     .fold(0.0, f64::max)
 }
-

@@ -194,7 +194,6 @@ fn cpu_model() -> String {
         .unwrap_or_else(|| "unknown".to_string())
 }
 
-
 mod compute;
 mod fork_join;
 mod load;
@@ -246,7 +245,6 @@ fn size_iters(target_s: f64, mut run: impl FnMut(u64) -> f64) -> u64 {
         iters *= 4;
     }
 }
-
 
 #[cfg(test)]
 mod tests {

@@ -1,0 +1,265 @@
+//! The particles of one step counting-sorted by bin and laid out as *strips*.
+//!
+//! The stencil of a bin is 3 × 3 bins in 2-D. In plain row-major order those are three runs,
+//! one per row; a strip instead interleaves three neighbouring rows column by column: strip `y`
+//! holds, for each column `x` in turn, the particles of bins `(x, y−1)`, `(x, y)` and `(x, y+1)`.
+//! The whole stencil of bin `(x, y)` is then the single contiguous run of columns `x−1 ..= x+1`
+//! of strip `y`, so each target needs one call of the SIMD pair loop (in 3-D, one per plane
+//! `z−1 ..= z+1`). Each particle is stored in the 3 strips it belongs to, once per step; the
+//! force loop then only reads.
+//!
+//! After each strip come `pad` sentinel particles far outside the box. A run may be lengthened
+//! to a whole number of SIMD blocks: what it gains are columns `x+2…` of its strip (at least one
+//! bin width, so at least the cutoff, away along axis 0) or sentinels, which contribute zero.
+
+use super::grid::{Grid, bounding_box, sentinel};
+use crate::kernels::rows::LANES;
+use crate::real::Real;
+use crate::state::State;
+
+/// Sentinels after each strip: enough to round any run up to a multiple of `LANES`.
+const PAD: usize = LANES - 1;
+
+/// Largest particle count whose strip slots (3 per particle, padding) and bins (≤ 4 per
+/// particle) fit in `u32`.
+pub const MAX_PARTICLES: usize = 1 << 29;
+
+pub struct Strips<T, const D: usize> {
+    pub grid: Grid<D>,
+    /// Sentinel slots after each strip (0 when runs must not be lengthened).
+    pub pad: usize,
+    /// Strip positions and source strengths, `LANES` spare slots at the end.
+    pub pos: [Vec<T>; D],
+    pub src: Vec<T>,
+    /// First strip slot of each column, indexed like the bins: entry `(x, y, z)` starts
+    /// column `x` of strip `(y, z)`; the phantom column ends the strip.
+    pub column: Vec<u32>,
+    /// Per particle in state order: its slot in its own strip.
+    pub own: Vec<u32>,
+    /// Per particle in state order: its rank among the particles of its bin.
+    pub rank: Vec<u32>,
+    /// First sorted slot of each bin (phantom bins included): the counting sort.
+    start: Vec<u32>,
+    /// Per particle in state order: its bin, and its bin coordinate along axis 1.
+    bin: Vec<u32>,
+    row_y: Vec<u32>,
+    /// A position at least `rc` from every particle (for the padding), if representable.
+    far: Option<[T; D]>,
+}
+
+impl<T: Real, const D: usize> Strips<T, D> {
+    pub fn new() -> Self {
+        Strips {
+            grid: Grid::new([0.0; D], [0.0; D], 1.0, 0),
+            pad: 0,
+            pos: std::array::from_fn(|_| Vec::new()),
+            src: Vec::new(),
+            column: Vec::new(),
+            own: Vec::new(),
+            rank: Vec::new(),
+            start: Vec::new(),
+            bin: Vec::new(),
+            row_y: Vec::new(),
+            far: None,
+        }
+    }
+
+    /// Bins the particles of `state` (the counting sort). Buffers only grow, so a run of steps
+    /// of equal size allocates nothing after the first. Inline so that it is compiled inside
+    /// `simd::dispatch` with the wide instruction set, like `fill`.
+    #[inline(always)]
+    pub fn sort(&mut self, state: &State<T, D>, rc: f64) {
+        let n = state.len();
+        assert!(
+            n <= MAX_PARTICLES,
+            "the cell list handles at most {MAX_PARTICLES} particles (got {n})"
+        );
+        let (lo, hi) = bounding_box(state);
+        self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), rc, n);
+        self.far = sentinel(lo, hi, rc);
+        self.count(state);
+    }
+
+    /// Fills the strips with the particles sorted by `sort`.
+    #[inline(always)]
+    pub fn fill(&mut self, state: &State<T, D>) {
+        // Padding costs `PAD` slots per strip; when strips are nearly empty (a line-like
+        // configuration) that would dwarf the particles, so runs are left as they are.
+        let n = state.len();
+        self.pad = if self.far.is_some() && (self.grid.rows + 1) * PAD <= n + 1024 {
+            PAD
+        } else {
+            0
+        };
+        self.columns();
+        self.place(state);
+        if let Some(far) = self.far.filter(|_| self.pad > 0) {
+            self.fill_padding(far);
+        }
+    }
+
+    /// Expected candidate pairs of a step: each particle sees 3^D bins of mean occupancy.
+    pub fn expected_candidates(&self) -> u64 {
+        let n = self.bin.len() as f64;
+        let bins: usize = self.grid.dims.iter().product();
+        (n * (n * 3f64.powi(D as i32) / bins as f64).min(n)) as u64
+    }
+
+    /// Bin of every particle (a vectorizable pass), its rank inside the bin while counting
+    /// (a histogram), then the first sorted slot of each bin.
+    #[inline(always)]
+    fn count(&mut self, state: &State<T, D>) {
+        let (g, n) = (&self.grid, state.len());
+        self.bin.resize(n, 0);
+        self.row_y.resize(n, 0);
+        self.rank.resize(n, 0);
+        self.start.clear();
+        self.start.resize(g.bins(), 0);
+        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
+        let (bin, row_y) = (&mut self.bin[..n], &mut self.row_y[..n]);
+        for i in 0..n {
+            let c = g.cell(position(&pos, i));
+            bin[i] = g.bin(&c) as u32;
+            row_y[i] = c.get(1).copied().unwrap_or(0) as u32;
+        }
+        for (&b, rank) in bin.iter().zip(self.rank.iter_mut()) {
+            let count = &mut self.start[b as usize];
+            *rank = *count;
+            *count += 1;
+        }
+        let mut next = 0u32;
+        for s in self.start.iter_mut() {
+            let count = *s;
+            *s = next;
+            next += count;
+        }
+    }
+
+    /// First strip slot of every column: the strip's base plus, for each of its rows, the
+    /// row's particles before that column.
+    #[inline(always)]
+    fn columns(&mut self) {
+        let g = &self.grid;
+        let (row_len, ny) = (g.row_len, g.extent(1));
+        self.column.resize(g.bins(), 0);
+        let start = &self.start;
+        let mut base = 0u32;
+        for (s, column) in self.column.chunks_exact_mut(row_len).enumerate() {
+            let y = s % ny;
+            let rows = (s - y + y.saturating_sub(1))..=(s - y + (y + 1).min(ny - 1));
+            column.fill(base);
+            for r in rows {
+                let row = &start[r * row_len..(r + 1) * row_len];
+                for (c, &st) in column.iter_mut().zip(row) {
+                    *c += st - row[0];
+                }
+            }
+            base = column[row_len - 1] + self.pad as u32;
+        }
+        let len = base as usize + LANES;
+        for d in 0..D {
+            self.pos[d].resize(len, T::zero());
+        }
+        self.src.resize(len, T::zero());
+    }
+
+    /// Copies every particle into the strips of its own row and of the rows above and below.
+    /// Inside a column the particles are ordered by row, then by rank.
+    #[inline(always)]
+    fn place(&mut self, state: &State<T, D>) {
+        let n = state.len();
+        let g = &self.grid;
+        let (row_len, ny) = (g.row_len, g.extent(1));
+        self.own.resize(n, 0);
+        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
+        let (start, column) = (&self.start, &self.column);
+        // Slices, not `Vec`s: stores through a `Vec` make LLVM reload its header.
+        let mut out_pos: [&mut [T]; D] = self.pos.each_mut().map(|v| v.as_mut_slice());
+        let out_src = self.src.as_mut_slice();
+        let (bin, rank, row_y, own) = (
+            &self.bin[..n],
+            &self.rank[..n],
+            &self.row_y[..n],
+            &mut self.own[..n],
+        );
+        for i in 0..n {
+            let x = position(&pos, i);
+            let s = state.source[i];
+            let y = row_y[i] as usize;
+            let (b, k) = (bin[i] as usize, rank[i]);
+            // Particles of the rows below in the same column of the same strip.
+            let below1 = if y >= 1 { count(start, b - row_len) } else { 0 };
+            let below2 = if y >= 2 {
+                count(start, b - 2 * row_len)
+            } else {
+                0
+            };
+            let slot = column[b] + below1 + k;
+            own[i] = slot;
+            put(&mut out_pos, out_src, slot, &x, s);
+            if y + 1 < ny {
+                // The lowest row of strip y + 1.
+                put(&mut out_pos, out_src, column[b + row_len] + k, &x, s);
+            }
+            if y >= 1 {
+                // The highest row of strip y − 1.
+                let slot = column[b - row_len] + below1 + below2 + k;
+                put(&mut out_pos, out_src, slot, &x, s);
+            }
+        }
+    }
+
+    /// Writes sentinels after every strip.
+    fn fill_padding(&mut self, far: [T; D]) {
+        let row_len = self.grid.row_len;
+        for s in 0..self.grid.rows {
+            let end = self.column[s * row_len + row_len - 1] as usize;
+            for d in 0..D {
+                self.pos[d][end..end + self.pad].fill(far[d]);
+            }
+            self.src[end..end + self.pad].fill(T::zero());
+        }
+    }
+
+    /// The particles in bin order, as `order[new_slot] = old_slot` (valid after `sort`).
+    pub fn order(&self) -> Vec<u32> {
+        let mut order = vec![0u32; self.bin.len()];
+        for (i, (&b, &k)) in self.bin.iter().zip(&self.rank).enumerate() {
+            order[(self.start[b as usize] + k) as usize] = i as u32;
+        }
+        order
+    }
+}
+
+/// Particles in bin `b`.
+#[inline(always)]
+fn count(start: &[u32], b: usize) -> u32 {
+    start[b + 1] - start[b]
+}
+
+/// Stores a particle in strip slot `slot`.
+#[inline(always)]
+fn put<T: Real, const D: usize>(
+    pos: &mut [&mut [T]; D],
+    src: &mut [T],
+    slot: u32,
+    x: &[T; D],
+    s: T,
+) {
+    let slot = slot as usize;
+    for d in 0..D {
+        pos[d][slot] = x[d];
+    }
+    src[slot] = s;
+}
+
+/// Position of particle `i` (a loop rather than `State::position`'s `array::from_fn`, whose
+/// closure may stay out of line and so miss the caller's instruction set).
+#[inline(always)]
+pub fn position<T: Real, const D: usize>(pos: &[&[T]; D], i: usize) -> [T; D] {
+    let mut x = [T::zero(); D];
+    for d in 0..D {
+        x[d] = pos[d][i];
+    }
+    x
+}
