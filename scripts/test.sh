@@ -13,5 +13,4 @@ rustup component add rustfmt clippy >/dev/null 2>&1 || true
 cargo fmt --all -- --check
 cargo clippy --all-targets --release -- -D warnings
 cargo test --release
-cargo build --release
-./target/release/nbody-bench validate --threads 2
+cargo run --release --quiet -- validate --threads 2
