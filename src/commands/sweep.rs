@@ -26,6 +26,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     )?;
     let results = ResultsFile::load(&report.path)?;
     print_table(&results);
+    print_speedups(&results);
     println!(
         "\n{} cases, {} rounds measured in this run; results in {}",
         report.cases,
@@ -70,5 +71,59 @@ fn print_table(results: &ResultsFile) {
                 ""
             }
         );
+    }
+}
+
+/// Speedup of every multi-thread case over its one-thread twin, raw and relative to the
+/// calibrated hardware ceiling (the throughput ratio of an embarrassingly parallel loop).
+fn print_speedups(results: &ResultsFile) {
+    let ceiling = |p: usize| {
+        results
+            .calibration
+            .start
+            .as_ref()
+            .and_then(|c| c.ceiling(p))
+    };
+    let mut lines = Vec::new();
+    for c in results.cases.iter().filter(|c| c.case.threads > 1) {
+        let mut one = c.case.clone();
+        one.threads = 1;
+        let base = results
+            .cases
+            .iter()
+            .find(|o| o.case == one)
+            .and_then(|o| o.summary.as_ref());
+        let (Some(base), Some(s)) = (base, c.summary.as_ref()) else {
+            continue;
+        };
+        if s.median_s <= 0.0 {
+            continue;
+        }
+        let speedup = base.median_s / s.median_s;
+        let relative = match ceiling(c.case.threads) {
+            Some(h) if h > 0.0 => format!("{:>6.2}  (ceiling {h:.2}x)", speedup / h),
+            _ => "     -".to_string(),
+        };
+        lines.push(format!(
+            "{:<52} {:>7.2}x {:>6.2} {}{}",
+            c.key,
+            speedup,
+            speedup / c.case.threads as f64,
+            relative,
+            if c.oversubscribed {
+                "  oversubscribed: not a parallel measurement"
+            } else {
+                ""
+            }
+        ));
+    }
+    if !lines.is_empty() {
+        println!(
+            "\n{:<52} {:>8} {:>6} {:>6}",
+            "speedup over the same case on 1 thread", "raw", "eff.", "/ceiling"
+        );
+        for l in lines {
+            println!("{l}");
+        }
     }
 }
