@@ -142,6 +142,18 @@ fn bad_input_exits_2_with_a_message() {
             "must be at least 1",
         ),
         (
+            &[
+                "run",
+                "--scenario",
+                "galaxy",
+                "--kernel",
+                "naive",
+                "-n",
+                "1000000000",
+            ],
+            "more than this tool handles",
+        ),
+        (
             &["run", "--scenario", "galaxy", "--kernel", "cell-list"],
             "kernels for gravity: naive, symmetric, per-thread, octree",
         ),

@@ -114,6 +114,10 @@ impl ScenarioKind {
     }
 }
 
+/// Largest particle count: particle indices are stored as `u32` in ids and in the cell list,
+/// and 2^29 particles already need tens of GB.
+pub const MAX_PARTICLES: usize = 1 << 29;
+
 /// Lennard-Jones parameters shared by the LJ scenarios (source 000's units).
 pub const LJ_EPSILON: f64 = 1.0;
 pub const LJ_SIGMA: f64 = 0.01;
@@ -172,6 +176,8 @@ pub struct Setup {
 pub enum SetupError {
     #[error("n must be at least 1 (got 0)")]
     ZeroParticles,
+    #[error("n = {0} is more than this tool handles (at most {MAX_PARTICLES} particles)")]
+    TooManyParticles(usize),
     #[error("--dt must be a positive finite number (got {0})")]
     BadDt(f64),
     #[error("--density must be a positive finite number (got {0})")]
@@ -215,6 +221,9 @@ impl Setup {
     pub fn validate(&self) -> Result<(), SetupError> {
         if self.n() == 0 {
             return Err(SetupError::ZeroParticles);
+        }
+        if self.n() > MAX_PARTICLES {
+            return Err(SetupError::TooManyParticles(self.n()));
         }
         let dt = self.dt();
         if !(dt.is_finite() && dt > 0.0) {
