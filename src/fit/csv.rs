@@ -1,0 +1,289 @@
+//! Tables of measurements from other codes: comma-separated, a header naming the columns,
+//! one row per sample, several rows per x. Header names are matched case-insensitively with
+//! surrounding spaces (and double quotes) ignored; blank lines and lines starting with `#` are
+//! skipped. Every error names the line (1-based) it is about.
+
+use super::{Samples, WeakSamples};
+use thiserror::Error;
+
+#[derive(Clone, Debug, PartialEq, Error)]
+#[non_exhaustive]
+pub enum CsvError {
+    #[error("the table is empty; expected a header line `{expected}` followed by data rows")]
+    Empty { expected: String },
+    #[error(
+        "line {line}: missing header: the first line must name the columns (`{expected}`), not hold numbers"
+    )]
+    MissingHeader { line: usize, expected: String },
+    #[error("line {line}: unknown column(s) {names}; expected `{expected}`")]
+    UnknownColumns {
+        line: usize,
+        names: String,
+        expected: String,
+    },
+    #[error("line {line}: missing column `{name}`; expected `{expected}`")]
+    MissingColumn {
+        line: usize,
+        name: &'static str,
+        expected: String,
+    },
+    #[error("line {line}: column `{name}` appears twice")]
+    DuplicateColumn { line: usize, name: String },
+    #[error("line {line}: {got} fields, but the header has {expected}")]
+    WrongFieldCount {
+        line: usize,
+        got: usize,
+        expected: usize,
+    },
+    #[error("line {line}: `{value}` in column `{column}` is not a finite number")]
+    NotANumber {
+        line: usize,
+        column: &'static str,
+        value: String,
+    },
+    #[error("line {line}: {column} = {value}, but {requirement}")]
+    OutOfRange {
+        line: usize,
+        column: &'static str,
+        value: f64,
+        requirement: &'static str,
+    },
+    #[error(
+        "line {line}: p = {p} has n = {n}, but line {first_line} gave it n = {first_n}; each p needs one problem size"
+    )]
+    InconsistentN {
+        line: usize,
+        p: f64,
+        n: f64,
+        first_line: usize,
+        first_n: f64,
+    },
+    #[error("no data rows after the header on line {header_line}")]
+    NoRows { header_line: usize },
+}
+
+/// A column the parser knows: its name and the values it accepts.
+#[derive(Clone, Copy, Debug)]
+struct Column {
+    name: &'static str,
+    accepts: fn(f64) -> bool,
+    requirement: &'static str,
+}
+
+const P: Column = Column {
+    name: "p",
+    accepts: |v| v >= 1.0,
+    requirement: "worker counts must be >= 1",
+};
+const N: Column = Column {
+    name: "n",
+    accepts: |v| v > 0.0,
+    requirement: "problem sizes must be > 0",
+};
+const TIME: Column = Column {
+    name: "time",
+    accepts: |v| v > 0.0,
+    requirement: "times must be seconds > 0",
+};
+
+/// Parsed rows: for each row its line number and one value per requested column, in the order
+/// the columns were requested (absent optional columns are `None`).
+struct Table {
+    rows: Vec<(usize, Vec<Option<f64>>)>,
+}
+
+fn parse_table(text: &str, required: &[Column], optional: &[Column]) -> Result<Table, CsvError> {
+    let expected = required
+        .iter()
+        .chain(optional)
+        .map(|c| c.name)
+        .collect::<Vec<_>>()
+        .join(",");
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l.trim()))
+        .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
+    let Some((header_line, header)) = lines.next() else {
+        return Err(CsvError::Empty { expected });
+    };
+    let names: Vec<String> = fields(header).map(|f| f.to_ascii_lowercase()).collect();
+    if names.iter().all(|f| f.parse::<f64>().is_ok()) {
+        return Err(CsvError::MissingHeader {
+            line: header_line,
+            expected,
+        });
+    }
+    let known: Vec<&Column> = required.iter().chain(optional).collect();
+    let unknown: Vec<String> = names
+        .iter()
+        .filter(|n| !known.iter().any(|c| c.name == n.as_str()))
+        .map(|n| {
+            if n.is_empty() {
+                "(an empty name)".to_string()
+            } else {
+                format!("`{n}`")
+            }
+        })
+        .collect();
+    if !unknown.is_empty() {
+        return Err(CsvError::UnknownColumns {
+            line: header_line,
+            names: unknown.join(", "),
+            expected,
+        });
+    }
+    for (i, n) in names.iter().enumerate() {
+        if names[..i].contains(n) {
+            return Err(CsvError::DuplicateColumn {
+                line: header_line,
+                name: n.clone(),
+            });
+        }
+    }
+    if let Some(missing) = required.iter().find(|c| !names.iter().any(|n| n == c.name)) {
+        return Err(CsvError::MissingColumn {
+            line: header_line,
+            name: missing.name,
+            expected,
+        });
+    }
+    let position: Vec<Option<usize>> = known
+        .iter()
+        .map(|c| names.iter().position(|n| n == c.name))
+        .collect();
+    let mut rows = Vec::new();
+    for (line, text) in lines {
+        let raw: Vec<&str> = fields(text).collect();
+        if raw.len() != names.len() {
+            return Err(CsvError::WrongFieldCount {
+                line,
+                got: raw.len(),
+                expected: names.len(),
+            });
+        }
+        let mut values = Vec::with_capacity(known.len());
+        for (column, pos) in known.iter().zip(&position) {
+            let Some(pos) = *pos else {
+                values.push(None);
+                continue;
+            };
+            let v = raw[pos]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| CsvError::NotANumber {
+                    line,
+                    column: column.name,
+                    value: raw[pos].to_string(),
+                })?;
+            if !(column.accepts)(v) {
+                return Err(CsvError::OutOfRange {
+                    line,
+                    column: column.name,
+                    value: v,
+                    requirement: column.requirement,
+                });
+            }
+            values.push(Some(v));
+        }
+        rows.push((line, values));
+    }
+    if rows.is_empty() {
+        return Err(CsvError::NoRows { header_line });
+    }
+    Ok(Table { rows })
+}
+
+/// The fields of a line, trimmed and without surrounding double quotes.
+fn fields(line: &str) -> impl Iterator<Item = &str> {
+    line.split(',').map(|f| {
+        let f = f.trim();
+        f.strip_prefix('"')
+            .and_then(|g| g.strip_suffix('"'))
+            .unwrap_or(f)
+            .trim()
+    })
+}
+
+/// Groups `(x, time)` rows by x, in order of first appearance.
+fn group(rows: impl Iterator<Item = (f64, f64)>) -> Vec<Samples> {
+    let mut out: Vec<Samples> = Vec::new();
+    for (x, t) in rows {
+        match out.iter_mut().find(|s| s.x == x) {
+            Some(s) => s.values.push(t),
+            None => out.push(Samples::new(x, vec![t])),
+        }
+    }
+    out
+}
+
+/// A `p,time` table (strong scaling) as samples at x = p.
+pub fn parse_threads(text: &str) -> Result<Vec<Samples>, CsvError> {
+    let table = parse_table(text, &[P, TIME], &[])?;
+    Ok(group(
+        table
+            .rows
+            .iter()
+            .map(|(_, v)| (v[0].unwrap(), v[1].unwrap())),
+    ))
+}
+
+/// An `n,time` table (complexity in n) as samples at x = n.
+pub fn parse_sizes(text: &str) -> Result<Vec<Samples>, CsvError> {
+    let table = parse_table(text, &[N, TIME], &[])?;
+    Ok(group(
+        table
+            .rows
+            .iter()
+            .map(|(_, v)| (v[0].unwrap(), v[1].unwrap())),
+    ))
+}
+
+/// A weak-scaling table: `p,time`, or `p,n,time` when the problem sizes are known.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WeakTable {
+    Times(Vec<Samples>),
+    WithN(Vec<WeakSamples>),
+}
+
+pub fn parse_weak(text: &str) -> Result<WeakTable, CsvError> {
+    let table = parse_table(text, &[P, TIME], &[N])?;
+    let has_n = table.rows[0].1[2].is_some();
+    let pairs = table
+        .rows
+        .iter()
+        .map(|(_, v)| (v[0].unwrap(), v[1].unwrap()));
+    if !has_n {
+        return Ok(WeakTable::Times(group(pairs)));
+    }
+    let mut out: Vec<(usize, WeakSamples)> = Vec::new();
+    for (line, v) in &table.rows {
+        let (p, time, n) = (v[0].unwrap(), v[1].unwrap(), v[2].unwrap());
+        match out.iter_mut().find(|(_, s)| s.p == p) {
+            Some((first_line, s)) if s.n != n => {
+                return Err(CsvError::InconsistentN {
+                    line: *line,
+                    p,
+                    n,
+                    first_line: *first_line,
+                    first_n: s.n,
+                });
+            }
+            Some((_, s)) => s.values.push(time),
+            None => out.push((
+                *line,
+                WeakSamples {
+                    p,
+                    n,
+                    values: vec![time],
+                },
+            )),
+        }
+    }
+    Ok(WeakTable::WithN(out.into_iter().map(|(_, s)| s).collect()))
+}
+
+#[cfg(test)]
+#[path = "csv_tests.rs"]
+mod tests;

@@ -1,0 +1,342 @@
+//! Complexity in n: the free power law `T = c·n^k` (log-log least squares on the medians) and
+//! the complexity class chosen among n, n log n, n^1.5, n², n² log n and n³ by leave-one-out
+//! cross-validation on SMAPE, as Extra-P selects its hypotheses.
+
+use super::bootstrap::{bootstrap, estimate};
+use super::linear::{self, Basis, Goodness};
+use super::{CiMethod, Data, Estimate, FitError, Input, RESAMPLES, Samples, XRule, prepare};
+use serde::{Serialize, Serializer};
+
+const MODEL: &str = "power law";
+
+/// A candidate growth class `g(n)`; models are `c·g(n)` or `a + c·g(n)`. Logarithms are base 2
+/// (any base is absorbed by `c`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ComplexityClass {
+    N,
+    NLogN,
+    NSqrtN,
+    N2,
+    N2LogN,
+    N3,
+}
+
+impl ComplexityClass {
+    pub const ALL: [ComplexityClass; 6] = [
+        ComplexityClass::N,
+        ComplexityClass::NLogN,
+        ComplexityClass::NSqrtN,
+        ComplexityClass::N2,
+        ComplexityClass::N2LogN,
+        ComplexityClass::N3,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ComplexityClass::N => "n",
+            ComplexityClass::NLogN => "n log n",
+            ComplexityClass::NSqrtN => "n^1.5",
+            ComplexityClass::N2 => "n^2",
+            ComplexityClass::N2LogN => "n^2 log n",
+            ComplexityClass::N3 => "n^3",
+        }
+    }
+
+    /// The growth function, `g(n)`.
+    pub fn g(self, n: f64) -> f64 {
+        match self {
+            ComplexityClass::N => n,
+            ComplexityClass::NLogN => n * n.log2(),
+            ComplexityClass::NSqrtN => n * n.sqrt(),
+            ComplexityClass::N2 => n * n,
+            ComplexityClass::N2LogN => n * n * n.log2(),
+            ComplexityClass::N3 => n * n * n,
+        }
+    }
+}
+
+impl Serialize for ComplexityClass {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// One hypothesis of the class selection, fitted to all the medians.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ClassCandidate {
+    pub class: ComplexityClass,
+    /// `a + c·g(n)` when true, `c·g(n)` otherwise.
+    pub with_constant: bool,
+    /// `a`, seconds (0 without a constant).
+    pub constant: f64,
+    /// `c`, seconds per unit of `g(n)`.
+    pub coefficient: f64,
+    /// Leave-one-out SMAPE in percent; `None` when there are too few points (a constant term
+    /// needs 3) or a fold is singular.
+    pub loo_smape_percent: Option<f64>,
+    /// Only hypotheses with `c > 0` and `a >= 0` (a time that grows and is never negative)
+    /// can be selected.
+    pub admissible: bool,
+}
+
+/// The selected hypothesis with bootstrap intervals on its parameters.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SelectedClass {
+    pub class: ComplexityClass,
+    pub with_constant: bool,
+    pub constant: Estimate,
+    pub coefficient: Estimate,
+    pub loo_smape_percent: f64,
+    /// In-sample fit of the selected model to the medians (r² on relative residuals).
+    pub goodness: Goodness,
+    /// Fraction of bootstrap replicates whose own selection picked the same class (with or
+    /// without a constant): how firmly the data decide.
+    pub support: f64,
+}
+
+/// The fits of time against problem size.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PowerFit {
+    /// x = n, the median time and sample count at each n.
+    pub inputs: Vec<Input>,
+    /// `k` of the free power law `T = c·n^k`, with its bootstrap interval.
+    pub exponent: Estimate,
+    /// `c` of the free power law, seconds.
+    pub coefficient: Estimate,
+    /// Fit of the free power law in log-log space.
+    pub power_law_goodness: Goodness,
+    /// The selected complexity class (also in `selected`).
+    pub class: ComplexityClass,
+    pub selected: SelectedClass,
+    /// Every hypothesis with its leave-one-out SMAPE.
+    pub candidates: Vec<ClassCandidate>,
+    pub ci_method: CiMethod,
+    pub resamples: usize,
+    pub notes: Vec<String>,
+}
+
+impl PowerFit {
+    /// Time predicted at `n` by the selected class model (the one to extrapolate with).
+    pub fn predict(&self, n: f64) -> f64 {
+        self.selected.constant.estimate + self.selected.coefficient.estimate * self.class.g(n)
+    }
+
+    /// Time predicted at `n` by the free power law `c·n^k`.
+    pub fn predict_power_law(&self, n: f64) -> f64 {
+        self.coefficient.estimate * n.powf(self.exponent.estimate)
+    }
+}
+
+/// Fits `T = c·n^k` and selects a complexity class. Needs 3 distinct n > 0 (leave-one-out with
+/// a constant term needs 3 points).
+pub fn fit_power(samples: &[Samples], seed: u64) -> Result<PowerFit, FitError> {
+    let data = prepare(MODEL, samples, XRule::Positive, 3)?;
+    let (ln_c, k) = free_law(&data.xs, &data.medians).ok_or(FitError::Degenerate {
+        model: MODEL,
+        why: "log-log least squares is singular",
+    })?;
+    let hypotheses = candidates(&data.xs, &data.medians);
+    let best = select(&hypotheses).ok_or(FitError::Degenerate {
+        model: MODEL,
+        why: "no complexity class fits with a positive coefficient",
+    })?;
+    let chosen = hypotheses[best].clone();
+    let fitted: Vec<f64> = data.xs.iter().map(|n| ln_c.exp() * n.powf(k)).collect();
+
+    struct Replicate {
+        ln_c: f64,
+        k: f64,
+        constant: f64,
+        coefficient: f64,
+        class: ComplexityClass,
+    }
+    let reps = bootstrap(MODEL, &data, &fitted, 2, seed, |medians| {
+        let (ln_c, k) = free_law(&data.xs, medians)?;
+        let beta = linear::fit_relative(
+            &basis(chosen.class, chosen.with_constant),
+            &data.xs,
+            medians,
+        )?;
+        let (constant, coefficient) = split(&beta, chosen.with_constant);
+        let all = candidates(&data.xs, medians);
+        let class = all[select(&all)?].class;
+        Some(Replicate {
+            ln_c,
+            k,
+            constant,
+            coefficient,
+            class,
+        })
+    })?;
+    let n_reps = reps.fits.len() as f64;
+    let support = reps.fits.iter().filter(|r| r.class == chosen.class).count() as f64 / n_reps;
+    let exponent = estimate(k, reps.fits.iter().map(|r| r.k));
+    let selected_pred: Vec<f64> = data
+        .xs
+        .iter()
+        .map(|&n| chosen.constant + chosen.coefficient * chosen.class.g(n))
+        .collect();
+    let selected = SelectedClass {
+        class: chosen.class,
+        with_constant: chosen.with_constant,
+        constant: estimate(chosen.constant, reps.fits.iter().map(|r| r.constant)),
+        coefficient: estimate(chosen.coefficient, reps.fits.iter().map(|r| r.coefficient)),
+        loo_smape_percent: chosen
+            .loo_smape_percent
+            .expect("selected candidates have one"),
+        goodness: Goodness::of(
+            &data.medians,
+            &selected_pred,
+            &linear::relative_weights(&data.medians),
+        ),
+        support,
+    };
+    let notes = notes(&exponent, &selected);
+    Ok(PowerFit {
+        inputs: data.inputs(),
+        exponent,
+        coefficient: estimate(ln_c.exp(), reps.fits.iter().map(|r| r.ln_c.exp())),
+        power_law_goodness: log_log_goodness(&data, ln_c, k),
+        class: chosen.class,
+        selected,
+        candidates: hypotheses,
+        ci_method: reps.method,
+        resamples: RESAMPLES,
+        notes,
+    })
+}
+
+/// The n in `[lo, hi]` where the fitted curves ([`PowerFit::predict`]) of two kernels cross,
+/// the first crossing when there are several; `None` when they do not cross in the range (or
+/// the range is not `0 < lo < hi`).
+pub fn crossover(a: &PowerFit, b: &PowerFit, lo: f64, hi: f64) -> Option<f64> {
+    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
+        return None;
+    }
+    let diff = |ln_n: f64| a.predict(ln_n.exp()) - b.predict(ln_n.exp());
+    let (ln_lo, ln_hi) = (lo.ln(), hi.ln());
+    const STEPS: usize = 512;
+    let mut left = ln_lo;
+    let mut d_left = diff(left);
+    for i in 1..=STEPS {
+        if d_left == 0.0 {
+            return Some(left.exp());
+        }
+        let right = ln_lo + (ln_hi - ln_lo) * i as f64 / STEPS as f64;
+        let d_right = diff(right);
+        if d_left.signum() != d_right.signum() {
+            // Bisection in log n down to f64 resolution.
+            let (mut l, mut r) = (left, right);
+            for _ in 0..100 {
+                let mid = 0.5 * (l + r);
+                if diff(mid).signum() == d_left.signum() {
+                    l = mid;
+                } else {
+                    r = mid;
+                }
+            }
+            return Some((0.5 * (l + r)).exp());
+        }
+        (left, d_left) = (right, d_right);
+    }
+    (d_left == 0.0).then(|| left.exp())
+}
+
+/// `(ln c, k)` of the least-squares line through `(ln n, ln T)`.
+fn free_law(ns: &[f64], times: &[f64]) -> Option<(f64, f64)> {
+    let ln_n: Vec<f64> = ns.iter().map(|n| n.ln()).collect();
+    let ln_t: Vec<f64> = times.iter().map(|t| t.ln()).collect();
+    let beta = linear::fit(&[&|_| 1.0, &|x| x], &ln_n, &ln_t, &vec![1.0; ns.len()])?;
+    Some((beta[0], beta[1]))
+}
+
+fn log_log_goodness(data: &Data, ln_c: f64, k: f64) -> Goodness {
+    let ln_t: Vec<f64> = data.medians.iter().map(|t| t.ln()).collect();
+    let pred_ln: Vec<f64> = data.xs.iter().map(|n| ln_c + k * n.ln()).collect();
+    let predicted: Vec<f64> = pred_ln.iter().map(|l| l.exp()).collect();
+    Goodness {
+        r2: linear::r2(&ln_t, &pred_ln, &vec![1.0; ln_t.len()]),
+        smape_percent: linear::smape(&data.medians, &predicted),
+    }
+}
+
+fn basis(class: ComplexityClass, with_constant: bool) -> Vec<Basis<'static>> {
+    let g: Basis<'static> = match class {
+        ComplexityClass::N => &|n| ComplexityClass::N.g(n),
+        ComplexityClass::NLogN => &|n| ComplexityClass::NLogN.g(n),
+        ComplexityClass::NSqrtN => &|n| ComplexityClass::NSqrtN.g(n),
+        ComplexityClass::N2 => &|n| ComplexityClass::N2.g(n),
+        ComplexityClass::N2LogN => &|n| ComplexityClass::N2LogN.g(n),
+        ComplexityClass::N3 => &|n| ComplexityClass::N3.g(n),
+    };
+    if with_constant {
+        vec![&|_| 1.0, g]
+    } else {
+        vec![g]
+    }
+}
+
+/// `(constant, coefficient)` from a fitted basis vector.
+fn split(beta: &[f64], with_constant: bool) -> (f64, f64) {
+    if with_constant {
+        (beta[0], beta[1])
+    } else {
+        (0.0, beta[0])
+    }
+}
+
+fn candidates(ns: &[f64], times: &[f64]) -> Vec<ClassCandidate> {
+    let mut out = Vec::with_capacity(2 * ComplexityClass::ALL.len());
+    for class in ComplexityClass::ALL {
+        for with_constant in [false, true] {
+            let basis = basis(class, with_constant);
+            let Some(beta) = linear::fit_relative(&basis, ns, times) else {
+                continue;
+            };
+            let (constant, coefficient) = split(&beta, with_constant);
+            out.push(ClassCandidate {
+                class,
+                with_constant,
+                constant,
+                coefficient,
+                loo_smape_percent: linear::loo_smape(&basis, ns, times),
+                admissible: coefficient > 0.0 && constant >= 0.0,
+            });
+        }
+    }
+    out
+}
+
+/// Index of the admissible candidate with the lowest leave-one-out SMAPE; on a tie the
+/// simpler one (listed first) wins.
+fn select(candidates: &[ClassCandidate]) -> Option<usize> {
+    let mut best: Option<(usize, f64)> = None;
+    for (i, c) in candidates.iter().enumerate() {
+        if let (true, Some(s)) = (c.admissible, c.loo_smape_percent)
+            && best.is_none_or(|(_, b)| s < b)
+        {
+            best = Some((i, s));
+        }
+    }
+    best.map(|(i, _)| i)
+}
+
+fn notes(exponent: &Estimate, selected: &SelectedClass) -> Vec<String> {
+    let mut notes = Vec::new();
+    if selected.support < 0.7 {
+        notes.push(format!(
+            "only {:.0}% of bootstrap replicates select {}: the class is not firmly determined by \
+             these points; widen the range of n or take more samples",
+            100.0 * selected.support,
+            selected.class.name()
+        ));
+    }
+    if exponent.ci95[1] - exponent.ci95[0] > 0.5 {
+        notes.push("the exponent's interval is wider than 0.5: too few or too noisy points".into());
+    }
+    notes
+}
+
+#[cfg(test)]
+#[path = "power_tests.rs"]
+mod tests;

@@ -1,0 +1,172 @@
+//! The serial fraction measured the way source 002 does: time the phases of a one-worker run
+//! that stay serial, divide by the total, and compare with the serial fraction fitted to the
+//! speedups. The fitted one is usually larger: the gap is the cost of running in parallel
+//! (synchronisation, communication, memory contention) that a one-worker run does not have and
+//! so cannot time.
+
+use super::{Estimate, FitError};
+use serde::Serialize;
+
+/// `f_timed = Σ serial / (Σ serial + Σ parallelisable)` of a one-worker run.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct TimedSerialFraction {
+    pub serial_s: f64,
+    pub parallel_s: f64,
+    pub total_s: f64,
+    pub fraction: f64,
+}
+
+/// The timed and the fitted serial fraction side by side.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SerialFractionComparison {
+    pub timed: f64,
+    pub fitted: Estimate,
+    /// `fitted − timed`, a fraction of the one-worker time.
+    pub gap: f64,
+    /// Whether the timed fraction lies inside the fitted one's 95% interval.
+    pub agree: bool,
+    /// A sentence for a report saying what the difference means.
+    pub explanation: String,
+}
+
+/// The serial fraction of a one-worker run from its phase times (seconds): the phases that
+/// stay serial and those that parallelise. When only the total was measured besides the serial
+/// phases, pass `total − Σ serial` as the one parallel phase.
+pub fn timed_serial_fraction(
+    serial_s: &[f64],
+    parallel_s: &[f64],
+) -> Result<TimedSerialFraction, FitError> {
+    let bad = |what: String| Err(FitError::BadPhases { what });
+    for (kind, phases) in [("serial", serial_s), ("parallel", parallel_s)] {
+        if let Some(t) = phases.iter().find(|t| !(t.is_finite() && **t >= 0.0)) {
+            return bad(format!(
+                "{kind} phase time {t} must be a finite number of seconds >= 0"
+            ));
+        }
+    }
+    let serial: f64 = serial_s.iter().sum();
+    let parallel: f64 = parallel_s.iter().sum();
+    let total = serial + parallel;
+    if total <= 0.0 {
+        return bad("the phases add up to 0 s; pass the measured phase times".into());
+    }
+    Ok(TimedSerialFraction {
+        serial_s: serial,
+        parallel_s: parallel,
+        total_s: total,
+        fraction: serial / total,
+    })
+}
+
+/// Compares the timed serial fraction with the one fitted to the speedups.
+pub fn compare_serial_fractions(
+    timed: &TimedSerialFraction,
+    fitted: &Estimate,
+) -> SerialFractionComparison {
+    let t = timed.fraction;
+    let gap = fitted.estimate - t;
+    let agree = fitted.contains(t);
+    let fitted_text = format!(
+        "{} [{}, {}]",
+        percent(fitted.estimate),
+        percent(fitted.ci95[0]),
+        percent(fitted.ci95[1])
+    );
+    let explanation = if agree {
+        format!(
+            "The fitted serial fraction {fitted_text} agrees with the {} of the one-worker time \
+             spent in serial phases: the serial code accounts for the loss of speedup.",
+            percent(t)
+        )
+    } else if gap > 0.0 {
+        format!(
+            "The fitted serial fraction {fitted_text} exceeds the {} of the one-worker time spent \
+             in serial phases; the difference, {} of the one-worker time, is overhead that phase \
+             timing of a one-worker run does not see: synchronisation, communication and memory \
+             contention that appear only with several workers.",
+            percent(t),
+            percent(gap)
+        )
+    } else {
+        format!(
+            "The fitted serial fraction {fitted_text} is below the {} of the one-worker time spent \
+             in serial phases: the parallel runs gained more than the serial phases cost, e.g. \
+             from more cache in total, or serial phases overlap with parallel work.",
+            percent(t)
+        )
+    };
+    SerialFractionComparison {
+        timed: t,
+        fitted: *fitted,
+        gap,
+        agree,
+        explanation,
+    }
+}
+
+/// A fraction as a percentage with two significant digits ("0.0034%", "5.2%", "12%").
+fn percent(fraction: f64) -> String {
+    let v = 100.0 * fraction;
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}%");
+    }
+    let decimals = (1 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.decimals$}%")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn source_002_table_gives_0_0034_percent() {
+        let serial = [0.0133631, 0.00107666, 0.00932205];
+        let total = 690.016;
+        let parallel = [total - serial.iter().sum::<f64>()];
+        let f = timed_serial_fraction(&serial, &parallel).unwrap();
+        assert!((f.total_s - total).abs() < 1e-9);
+        assert_eq!(percent(f.fraction), "0.0034%");
+    }
+
+    #[test]
+    fn comparison_explains_the_gap() {
+        let timed = timed_serial_fraction(&[0.5], &[9.5]).unwrap();
+        assert_eq!(timed.fraction, 0.05);
+        let larger = Estimate {
+            estimate: 0.12,
+            ci95: [0.1, 0.14],
+        };
+        let c = compare_serial_fractions(&timed, &larger);
+        assert!(!c.agree && (c.gap - 0.07).abs() < 1e-12);
+        assert!(
+            c.explanation.contains("7.0% of the one-worker time"),
+            "{}",
+            c.explanation
+        );
+        assert!(c.explanation.contains("synchronisation"));
+        let same = Estimate {
+            estimate: 0.051,
+            ci95: [0.04, 0.06],
+        };
+        assert!(compare_serial_fractions(&timed, &same).agree);
+        let smaller = Estimate {
+            estimate: 0.01,
+            ci95: [0.0, 0.02],
+        };
+        assert!(
+            compare_serial_fractions(&timed, &smaller)
+                .explanation
+                .contains("below")
+        );
+    }
+
+    #[test]
+    fn bad_phases_are_refused() {
+        assert!(timed_serial_fraction(&[-1.0], &[2.0]).is_err());
+        assert!(timed_serial_fraction(&[f64::NAN], &[2.0]).is_err());
+        assert!(timed_serial_fraction(&[0.0], &[0.0]).is_err());
+        assert_eq!(timed_serial_fraction(&[], &[2.0]).unwrap().fraction, 0.0);
+        assert_eq!(percent(0.12), "12%");
+        assert_eq!(percent(0.052), "5.2%");
+    }
+}
