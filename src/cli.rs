@@ -33,6 +33,8 @@ pub enum Command {
     /// Measure every case of a TOML config (n, threads, kernels, scenarios) with statistics and
     /// machine calibration; writes <out>/<name>/results.json after every case.
     Sweep(SweepArgs),
+    /// Fit a scaling model (amdahl, gustafson, power) to a CSV of measurements from any code.
+    Fit(FitArgs),
 }
 
 /// Options that define the simulated system.
@@ -182,4 +184,60 @@ pub struct SweepArgs {
     /// Skip the machine calibration at the start and end (faster; speedups then have no ceiling).
     #[arg(long)]
     pub no_calibration: bool,
+}
+
+/// A scaling model the `fit` command fits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum FitModel {
+    /// Strong scaling, CSV `p,time`: speedup, efficiency, Amdahl's serial fraction, Karp-Flatt.
+    Amdahl,
+    /// Weak scaling, CSV `p,time` or `p,n,time`: efficiency and Gustafson's serial fraction.
+    Gustafson,
+    /// Complexity in n, CSV `n,time`: T = c*n^k and the complexity class.
+    Power,
+}
+
+/// The cost g(n) of a whole problem of size n, for weak scaling with an n column.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum CostModel {
+    #[value(name = "n")]
+    N,
+    #[value(name = "n-log-n")]
+    NLogN,
+    #[value(name = "n1.5")]
+    NSqrtN,
+    #[value(name = "n2")]
+    N2,
+    #[value(name = "n2-log-n")]
+    N2LogN,
+    #[value(name = "n3")]
+    N3,
+}
+
+#[derive(Debug, Args)]
+#[command(
+    after_help = "CSV: a header naming the columns (any order, case-insensitive), one row per \
+    measured sample, several rows per p or n; times in seconds.\n\nExamples:\n  \
+    nbody-bench fit --model amdahl --csv strong.csv\n  \
+    nbody-bench fit --model power --csv sizes.csv --json fit.json"
+)]
+pub struct FitArgs {
+    /// The model to fit.
+    #[arg(long, value_enum)]
+    pub model: FitModel,
+    /// The measurements: `p,time` (amdahl), `p,time` or `p,n,time` (gustafson), `n,time` (power).
+    #[arg(long, value_name = "FILE")]
+    pub csv: PathBuf,
+    /// Also write the fit as JSON (schema nbody-bench/fit/v1): every parameter as
+    /// {"estimate", "ci95": [lo, hi]}.
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Seed of the bootstrap that gives the confidence intervals (fixed by default, so the
+    /// output is reproducible).
+    #[arg(long, default_value_t = crate::fit::DEFAULT_SEED)]
+    pub seed: u64,
+    /// gustafson with an n column: the cost g(n) of the whole problem; times are normalised to
+    /// the one-worker run's work per worker g(n)/p [default: n].
+    #[arg(long, value_enum)]
+    pub cost: Option<CostModel>,
 }

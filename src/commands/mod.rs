@@ -1,5 +1,7 @@
 //! The subcommands. Each returns the process exit code or an error (reported with exit code 2).
 
+mod fit;
+mod fit_tables;
 mod list;
 mod run;
 mod sweep;
@@ -18,6 +20,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
         Command::Sweep(args) => sweep::sweep(args),
+        Command::Fit(args) => fit::fit(args),
     }
 }
 

@@ -29,6 +29,17 @@ pub enum Trend {
     Undetermined,
 }
 
+impl Trend {
+    pub fn name(self) -> &'static str {
+        match self {
+            Trend::Flat => "flat",
+            Trend::Rising => "rising",
+            Trend::Falling => "falling",
+            Trend::Undetermined => "undetermined",
+        }
+    }
+}
+
 /// How e(p) changes with p: the least-squares slope of e against log2 p (the change per
 /// doubling of p, since studies usually double p) with its bootstrap interval, and the verdict.
 #[derive(Clone, Debug, PartialEq, Serialize)]
