@@ -38,6 +38,11 @@ impl AlphaBetaFit {
         let band = percentile_ci(self.replicates.iter().map(|[a, b]| a + b * bytes));
         (point, band.unwrap_or([point, point]))
     }
+
+    /// `[α, β]` of every bootstrap replicate, for custom bands.
+    pub fn replicates(&self) -> &[[f64; 2]] {
+        &self.replicates
+    }
 }
 
 fn one(_: f64) -> f64 {
@@ -77,9 +82,6 @@ pub fn fit_alpha_beta(samples: &[Samples], seed: u64) -> Result<AlphaBetaFit, Fi
              to resolve the bandwidth; measure larger messages"
                 .into(),
         );
-    }
-    if reps.method == CiMethod::ResampleResiduals {
-        notes.push(format!("95% intervals from {}", reps.method.describe()));
     }
     Ok(AlphaBetaFit {
         inputs: data.inputs(),

@@ -72,6 +72,11 @@ impl StrongFit {
         self.curve(|[_, f]| 1.0 / (f + (1.0 - f) / p))
     }
 
+    /// `[T1, f]` (f clamped) of every bootstrap replicate, for custom bands.
+    pub fn replicates(&self) -> &[[f64; 2]] {
+        &self.replicates
+    }
+
     fn curve(&self, at: impl Fn([f64; 2]) -> f64) -> (f64, [f64; 2]) {
         let point = at([self.t1.estimate, self.serial_fraction.estimate]);
         let band = percentile_ci(self.replicates.iter().map(|&r| at(r)));
@@ -212,7 +217,7 @@ pub fn fit_strong(
             ),
         }),
     };
-    let notes = notes(ps, ceiling, &unclamped, clamped, &overhead, reps.method);
+    let notes = notes(ps, ceiling, &unclamped, clamped, &overhead);
     Ok(StrongFit {
         inputs: data.inputs(),
         points,
@@ -246,7 +251,6 @@ fn notes(
     f: &Estimate,
     clamped: bool,
     overhead: &OverheadSelection,
-    method: CiMethod,
 ) -> Vec<String> {
     let mut notes = Vec::new();
     if clamped {
@@ -291,9 +295,6 @@ fn notes(
             "hardware ceilings at unmeasured p = {} are ignored",
             unused.join(", ")
         ));
-    }
-    if method == CiMethod::ResampleResiduals {
-        notes.push(format!("95% intervals from {}", method.describe()));
     }
     notes
 }

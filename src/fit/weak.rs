@@ -78,6 +78,11 @@ impl WeakFit {
         let band = percentile_ci(self.replicates.iter().map(|&a| at(a)));
         (point, band.unwrap_or([point, point]))
     }
+
+    /// α (clamped) of every bootstrap replicate, for custom bands.
+    pub fn replicates(&self) -> &[f64] {
+        &self.replicates
+    }
 }
 
 /// Weak scaling from times at x = p (each at the scaled problem size). Needs p = 1 and one
@@ -138,9 +143,6 @@ pub fn fit_weak(samples: &[Samples], seed: u64) -> Result<WeakFit, FitError> {
             "the fitted serial fraction is {:.4} [{:.4}, {:.4}]; it is reported clamped to [0, 1]",
             unclamped.estimate, unclamped.ci95[0], unclamped.ci95[1]
         ));
-    }
-    if reps.method == CiMethod::ResampleResiduals {
-        notes.push(format!("95% intervals from {}", reps.method.describe()));
     }
     Ok(WeakFit {
         inputs: data.inputs(),
