@@ -159,7 +159,7 @@ fn bad_tables_exit_2_with_the_line_number() {
     let dir = tempfile::tempdir().unwrap();
     let cases: &[(&str, &str, &str)] = &[
         ("amdahl", "1,2.0\n2,1.1\n", "line 1: missing header"),
-        ("amdahl", "", "empty"),
+        ("amdahl", "", "line 1: the table ends with no header"),
         (
             "amdahl",
             "p,time\n1,2.0\n2,slow\n",

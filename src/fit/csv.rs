@@ -9,8 +9,10 @@ use thiserror::Error;
 #[derive(Clone, Debug, PartialEq, Error)]
 #[non_exhaustive]
 pub enum CsvError {
-    #[error("the table is empty; expected a header line `{expected}` followed by data rows")]
-    Empty { expected: String },
+    #[error(
+        "line {line}: the table ends with no header (it is empty); expected a header line `{expected}` followed by data rows"
+    )]
+    Empty { line: usize, expected: String },
     #[error(
         "line {line}: missing header: the first line must name the columns (`{expected}`), not hold numbers"
     )]
@@ -99,13 +101,18 @@ fn parse_table(text: &str, required: &[Column], optional: &[Column]) -> Result<T
         .map(|c| c.name)
         .collect::<Vec<_>>()
         .join(",");
+    // A byte-order mark, as spreadsheet exports write, is not part of the first column's name.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut lines = text
         .lines()
         .enumerate()
         .map(|(i, l)| (i + 1, l.trim()))
         .filter(|(_, l)| !l.is_empty() && !l.starts_with('#'));
     let Some((header_line, header)) = lines.next() else {
-        return Err(CsvError::Empty { expected });
+        return Err(CsvError::Empty {
+            line: text.lines().count() + 1,
+            expected,
+        });
     };
     let names: Vec<String> = fields(header).map(|f| f.to_ascii_lowercase()).collect();
     if names.iter().all(|f| f.parse::<f64>().is_ok()) {

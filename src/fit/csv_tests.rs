@@ -12,6 +12,8 @@ fn threads_table_groups_samples_by_p() {
             Samples::new(4.0, vec![0.7]),
         ]
     );
+    let with_bom = parse_threads("\u{feff}p,time\n1,2.0\n").unwrap();
+    assert_eq!(with_bom, vec![Samples::new(1.0, vec![2.0])]);
     let reordered = parse_threads("time,p\n2.0,1\n1.0,2\n").unwrap();
     assert_eq!(reordered[1], Samples::new(2.0, vec![1.0]));
 }
@@ -38,8 +40,8 @@ fn sizes_and_weak_tables() {
 #[test]
 fn errors_name_the_line() {
     let cases: &[(&str, &str)] = &[
-        ("", "empty"),
-        ("\n# only a comment\n", "empty"),
+        ("", "line 1: the table ends with no header (it is empty)"),
+        ("\n# only a comment\n", "line 3: the table ends"),
         ("1,2.0\n2,1.0\n", "line 1: missing header"),
         ("p,time\n", "no data rows after the header on line 1"),
         (

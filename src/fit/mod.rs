@@ -38,7 +38,8 @@ pub use timed::{
     SerialFractionComparison, TimedSerialFraction, compare_serial_fractions, timed_serial_fraction,
 };
 pub use weak::{
-    ScaledSpeedupPoint, WeakFit, WeakSamples, WorkPerWorker, fit_weak, fit_weak_with_n,
+    EfficiencyPoint, ScaledSpeedupPoint, WeakFit, WeakSamples, WorkPerWorker, fit_weak,
+    fit_weak_with_n,
 };
 
 use serde::Serialize;
