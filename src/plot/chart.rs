@@ -11,7 +11,7 @@ use super::layout::{self, Frame};
 use super::legend::{Entry, Swatch};
 use super::palette::{self, REFERENCE};
 use super::shapes::{DrawResult, rgb};
-use super::spec::{Chart, Scale, SeriesStyle};
+use super::spec::{Chart, Point, Scale, SeriesStyle};
 use super::text::{self, TICK_SIZE};
 
 pub const BAND_ALPHA: f64 = 0.18;
@@ -63,11 +63,8 @@ pub fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) ->
 /// Every x value the chart shows, for fitting the axis; with labelled points, one more value
 /// 12% of the span beyond the largest so that the last label fits right of its marker.
 fn x_values(chart: &Chart) -> Vec<f64> {
-    let points = chart
-        .series
-        .iter()
-        .flat_map(|s| s.points.iter().map(|p| p.x));
-    let bands = chart.bands.iter().flat_map(|b| b.x.iter().copied());
+    let points = shown_points(chart).map(|p| p.x);
+    let bands = band_triples(chart).map(|(x, _, _)| x);
     let regions = chart.regions.iter().flat_map(|r| [r.x_from, r.x_to]);
     let mut values: Vec<f64> = points
         .chain(bands)
@@ -99,15 +96,29 @@ fn x_values(chart: &Chart) -> Vec<f64> {
 /// Every y value the chart shows: points with their error bars, bands and reference lines.
 fn y_values(chart: &Chart) -> Vec<f64> {
     let mut values = Vec::new();
-    for p in chart.series.iter().flat_map(|s| &s.points) {
+    for p in shown_points(chart) {
         values.push(p.y);
         values.extend(p.y_err.map(|(lo, hi)| [lo, hi]).into_iter().flatten());
     }
-    for b in &chart.bands {
-        values.extend(b.lo.iter().chain(&b.hi));
-    }
+    values.extend(band_triples(chart).flat_map(|(_, lo, hi)| [lo, hi]));
     values.extend(chart.hlines.iter().map(|h| h.y));
     values
+}
+
+/// Points that can be drawn: both coordinates finite. Only these shape the axes.
+fn shown_points(chart: &Chart) -> impl Iterator<Item = &Point> {
+    let finite = |p: &&Point| p.x.is_finite() && p.y.is_finite();
+    chart.series.iter().flat_map(|s| &s.points).filter(finite)
+}
+
+/// Band entries `(x, lo, hi)` with all three finite.
+fn band_triples(chart: &Chart) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
+    let triples = chart
+        .bands
+        .iter()
+        .flat_map(|b| b.x.iter().zip(&b.lo).zip(&b.hi));
+    let triples = triples.map(|((&x, &lo), &hi)| (x, lo, hi));
+    triples.filter(|(x, lo, hi)| x.is_finite() && lo.is_finite() && hi.is_finite())
 }
 
 pub fn series_color(index: usize, color: Option<usize>) -> RGBColor {

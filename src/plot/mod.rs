@@ -111,7 +111,10 @@ mod disabled_tests {
         assert!(matches!(err, PlotError::Disabled));
         assert!(err.to_string().contains("`plot` feature"));
         let bars = figures::phase_breakdown(&[], "");
-        assert!(matches!(render_stacked(&bars, dir.path(), "bars"), Err(PlotError::Disabled)));
+        assert!(matches!(
+            render_stacked(&bars, dir.path(), "bars"),
+            Err(PlotError::Disabled)
+        ));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
 }
