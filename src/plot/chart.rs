@@ -225,3 +225,32 @@ fn shorten_categories<DB: DrawingBackend>(
         *label = text::shorten(root, label, &style, slot.saturating_sub(8));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plot::spec::{Axis, Band, Series};
+
+    #[test]
+    fn axes_fit_only_what_can_be_drawn() {
+        let mut chart = Chart::new("t", Axis::linear("x"), Axis::linear("y"));
+        let xy = [
+            (1.0, 1.0),
+            (100.0, f64::NAN),
+            (f64::INFINITY, 50.0),
+            (2.0, 2.0),
+        ];
+        chart
+            .series
+            .push(Series::from_xy("s", xy, SeriesStyle::Line));
+        chart.bands.push(Band {
+            label: String::new(),
+            x: vec![3.0, 300.0],
+            lo: vec![0.5, f64::NAN],
+            hi: vec![3.0, 400.0],
+            color: None,
+        });
+        assert_eq!(x_values(&chart), [1.0, 2.0, 3.0]);
+        assert_eq!(y_values(&chart), [1.0, 2.0, 0.5, 3.0]);
+    }
+}

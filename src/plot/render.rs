@@ -5,7 +5,7 @@
 use plotters::coord::Shift;
 use plotters::prelude::*;
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use super::raster::GlyphText;
 use super::shapes::DrawResult;
@@ -83,7 +83,7 @@ pub fn render_figure(figure: &impl Figure, dir: &Path, stem: &str) -> Result<Ren
     })
 }
 
-fn draw_png(figure: &impl Figure, path: &PathBuf) -> DrawResult {
+fn draw_png(figure: &impl Figure, path: &Path) -> DrawResult {
     let root = GlyphText(BitMapBackend::new(path, SIZE)).into_drawing_area();
     figure.draw(&root)?;
     root.present().map_err(|e| e.to_string())
