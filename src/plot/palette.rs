@@ -20,7 +20,7 @@ pub const REFERENCE: (u8, u8, u8) = (0x55, 0x55, 0x55);
 /// The colour index that draws in [`REFERENCE`] grey (ideal lines, hardware ceilings).
 pub const REFERENCE_INDEX: usize = usize::MAX;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Marker {
     Circle,
     Square,
@@ -43,11 +43,23 @@ pub fn color(index: usize) -> (u8, u8, u8) {
     PALETTE[index % PALETTE.len()]
 }
 
-/// The marker for palette index `index`: shapes cycle faster than colours, so no two of the
-/// first eight indices share both.
+/// The marker for palette index `index`. Shapes cycle faster than colours and shift by one
+/// each time the colours wrap, so no two of the first 32 indices share both.
 pub fn marker(index: usize) -> Marker {
     if index == REFERENCE_INDEX {
         return Marker::Diamond;
     }
-    MARKERS[index % MARKERS.len()]
+    MARKERS[(index + index / PALETTE.len()) % MARKERS.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn colour_and_marker_pairs_stay_distinct_for_many_series() {
+        let pairs: std::collections::HashSet<_> = (0..32).map(|i| (color(i), marker(i))).collect();
+        assert_eq!(pairs.len(), 32);
+        assert_eq!(color(REFERENCE_INDEX), REFERENCE);
+    }
 }
