@@ -17,6 +17,7 @@ pub mod integrator;
 pub mod kernels;
 pub mod output;
 pub mod physics;
+pub mod plot;
 pub mod real;
 pub mod run;
 pub mod scenario;

@@ -1,0 +1,274 @@
+//! Figures that look inside a run: where a step's time goes, how its time is spread, how the
+//! octree trades accuracy for cost, and how measured communication compares with a model.
+
+use super::{Curve, Measured};
+use crate::plot::spec::{
+    Axis, Band, Chart, Point, Region, Scale, Series, SeriesStyle, StackedBars, Unit,
+};
+
+/// Seconds per step spent in each phase of one case.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhaseTimes {
+    pub case: String,
+    pub build: f64,
+    pub interact: f64,
+    pub integrate: f64,
+    pub boundary: f64,
+    pub communication: f64,
+}
+
+/// One horizontal bar per case, split into phases; phases that are zero everywhere are left
+/// out of the legend.
+pub fn phase_breakdown(cases: &[PhaseTimes], caption: &str) -> StackedBars {
+    let column = |f: fn(&PhaseTimes) -> f64| cases.iter().map(f).collect::<Vec<f64>>();
+    StackedBars {
+        title: "Where a step's time goes".into(),
+        caption: caption.into(),
+        value_label: "time per step".into(),
+        value_unit: Unit::Seconds,
+        categories: cases.iter().map(|c| c.case.clone()).collect(),
+        segments: vec![
+            ("force: build".into(), column(|c| c.build)),
+            ("force: interact".into(), column(|c| c.interact)),
+            ("integrate".into(), column(|c| c.integrate)),
+            ("boundary".into(), column(|c| c.boundary)),
+            ("communication".into(), column(|c| c.communication)),
+        ],
+    }
+}
+
+/// The same bars as [`phase_breakdown`] with each case scaled to its own total, to compare
+/// where the time goes in cases of very different cost.
+pub fn phase_shares(cases: &[PhaseTimes], caption: &str) -> StackedBars {
+    let mut bars = phase_breakdown(cases, caption);
+    let totals: Vec<f64> = (0..cases.len())
+        .map(|i| {
+            bars.segments
+                .iter()
+                .map(|(_, v)| v[i])
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .sum()
+        })
+        .collect();
+    for (_, values) in &mut bars.segments {
+        for (v, total) in values.iter_mut().zip(&totals) {
+            *v = if *total > 0.0 { *v / total } else { 0.0 };
+        }
+    }
+    bars.title = "Share of a step's time per phase".into();
+    bars.value_label = "share of time per step".into();
+    bars.value_unit = Unit::Percent;
+    bars
+}
+
+/// Step-time percentiles of one kernel, in seconds.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Percentiles {
+    pub kernel: String,
+    pub p50: f64,
+    pub p90: f64,
+    pub p99: f64,
+    pub max: f64,
+}
+
+/// p50, p90, p99 and max step time per kernel on a log time axis; the four markers of a kernel
+/// sit side by side around its position so that close values stay visible.
+pub fn step_percentiles(rows: &[Percentiles], caption: &str) -> Chart {
+    let names = rows.iter().map(|r| r.kernel.clone()).collect();
+    let x = Axis::categorical("kernel", names);
+    let y = Axis::log("time per step").unit(Unit::Seconds);
+    let mut chart = Chart::new("Step-time percentiles per kernel", x, y).caption(caption);
+    for (k, name) in ["p50", "p90", "p99", "max"].into_iter().enumerate() {
+        let offset = (k as f64 - 1.5) * 0.1;
+        let points = rows
+            .iter()
+            .enumerate()
+            .map(|(i, r)| Point::new(i as f64 + offset, [r.p50, r.p90, r.p99, r.max][k]))
+            .collect();
+        chart
+            .series
+            .push(Series::new(name, points, SeriesStyle::Markers).color(k));
+    }
+    chart
+}
+
+/// One octree run: opening angle, cost (seconds per step) and median relative force error.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThetaPoint {
+    pub theta: f64,
+    pub seconds: f64,
+    pub error: f64,
+}
+
+/// Octree runs over θ for one scenario, in the order to join them (usually by θ).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ThetaSweep {
+    pub name: String,
+    pub points: Vec<ThetaPoint>,
+}
+
+/// Force error against cost over θ on log-log axes, each point labelled with its θ.
+pub fn octree_accuracy(sweeps: &[ThetaSweep], caption: &str) -> Chart {
+    let x = Axis::log("time per step").unit(Unit::Seconds);
+    let y = Axis::log("median relative force error");
+    let mut chart = Chart::new("Octree: force error vs cost over θ", x, y).caption(caption);
+    for (k, sweep) in sweeps.iter().enumerate() {
+        let points = sweep
+            .points
+            .iter()
+            .map(|p| Point::new(p.seconds, p.error).label(format!("θ={}", p.theta)))
+            .collect();
+        chart
+            .series
+            .push(Series::new(sweep.name.as_str(), points, SeriesStyle::LineMarkers).color(k));
+    }
+    chart
+}
+
+/// Palette indices of the communication figure: the model in blue, measurements in vermillion.
+const PREDICTED: usize = 0;
+const MEASURED: usize = 1;
+
+/// Measured communication time per step and the model's prediction over an x (ranks, bytes).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CommTimes {
+    /// The x axis, e.g. `Axis::linear("ranks")` or `Axis::log("message size").unit(Unit::Bytes)`;
+    /// the time axis uses the same scale.
+    pub x: Axis,
+    pub measured: Vec<Measured>,
+    pub predicted: Curve,
+}
+
+/// Measured points with CIs, the predicted line with its uncertainty band, and shaded regions
+/// where the prediction goes beyond the measured x range.
+pub fn comm_time(comm: &CommTimes, caption: &str) -> Chart {
+    let mut y = Axis::log("communication time per step").unit(Unit::Seconds);
+    if comm.x.scale == Scale::Linear {
+        y = Axis {
+            scale: Scale::Linear,
+            ..y
+        }
+        .from_zero();
+    }
+    let mut chart =
+        Chart::new("Communication: measured vs predicted", comm.x.clone(), y).caption(caption);
+    let predicted = &comm.predicted;
+    if !predicted.band.is_empty() {
+        chart.bands.push(Band {
+            label: "prediction uncertainty".into(),
+            x: predicted.band.iter().map(|b| b.0).collect(),
+            lo: predicted.band.iter().map(|b| b.1).collect(),
+            hi: predicted.band.iter().map(|b| b.2).collect(),
+            color: Some(PREDICTED),
+        });
+    }
+    let line = Series::from_xy(
+        predicted.label.as_str(),
+        predicted.points.iter().copied(),
+        SeriesStyle::Dashed,
+    );
+    chart.series.push(line.color(PREDICTED));
+    let points = comm.measured.iter().map(Measured::point).collect();
+    chart.series.push(
+        Series::new("measured (median, 95% CI)", points, SeriesStyle::Markers).color(MEASURED),
+    );
+
+    let finite = |xs: &mut dyn Iterator<Item = f64>| -> Option<(f64, f64)> {
+        let xs: Vec<f64> = xs.filter(|x| x.is_finite()).collect();
+        Some((
+            xs.iter().copied().reduce(f64::min)?,
+            xs.iter().copied().reduce(f64::max)?,
+        ))
+    };
+    let measured = finite(&mut comm.measured.iter().map(|m| m.x));
+    let predicted_x = finite(
+        &mut predicted
+            .points
+            .iter()
+            .map(|p| p.0)
+            .chain(predicted.band.iter().map(|b| b.0)),
+    );
+    if let Some((p_lo, p_hi)) = predicted_x {
+        let label = "prediction only (not measured)";
+        let (m_lo, m_hi) = measured.unwrap_or((p_hi, p_hi));
+        if measured.is_none() {
+            chart.regions.push(Region {
+                label: label.into(),
+                x_from: p_lo,
+                x_to: p_hi,
+            });
+        }
+        if measured.is_some() && p_hi > m_hi {
+            chart.regions.push(Region {
+                label: label.into(),
+                x_from: m_hi,
+                x_to: p_hi,
+            });
+        }
+        if measured.is_some() && p_lo < m_lo {
+            let label = if p_hi > m_hi { "" } else { label };
+            chart.regions.push(Region {
+                label: label.into(),
+                x_from: p_lo,
+                x_to: m_lo,
+            });
+        }
+    }
+    chart
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn prediction_beyond_measurements_is_marked() {
+        let comm = CommTimes {
+            x: Axis::linear("ranks"),
+            measured: vec![Measured::new(1.0, 1e-4), Measured::new(2.0, 2e-4)],
+            predicted: Curve::new("model", vec![(1.0, 1e-4), (8.0, 9e-4)]),
+        };
+        let chart = comm_time(&comm, "");
+        assert_eq!(chart.regions.len(), 1);
+        assert_eq!((chart.regions[0].x_from, chart.regions[0].x_to), (2.0, 8.0));
+        assert_eq!(chart.y.scale, Scale::Linear);
+    }
+
+    #[test]
+    fn percentile_markers_of_a_kernel_stay_within_its_slot() {
+        let rows = [Percentiles {
+            kernel: "naive".into(),
+            p50: 1e-3,
+            p90: 1.1e-3,
+            p99: 2e-3,
+            max: 5e-3,
+        }];
+        let chart = step_percentiles(&rows, "");
+        assert_eq!(chart.series.len(), 4);
+        assert!(chart.series.iter().all(|s| s.points[0].x.abs() < 0.5));
+    }
+
+    #[test]
+    fn phases_keep_case_order() {
+        let case = |name: &str, interact| PhaseTimes {
+            case: name.into(),
+            build: 0.0,
+            interact,
+            integrate: 1e-5,
+            boundary: 0.0,
+            communication: 0.0,
+        };
+        let bars = phase_breakdown(&[case("a", 1e-3), case("b", 2e-3)], "");
+        assert_eq!(bars.categories, ["a", "b"]);
+        assert_eq!(bars.segments[1].1, [1e-3, 2e-3]);
+        let shares = phase_shares(&[case("a", 1e-3), case("b", 0.0)], "");
+        let a: f64 = shares.segments.iter().map(|(_, v)| v[0]).sum();
+        assert!((a - 1.0).abs() < 1e-12);
+        assert!(
+            shares
+                .segments
+                .iter()
+                .all(|(_, v)| v[1] == 0.0 || v[1] == 1.0)
+        );
+    }
+}

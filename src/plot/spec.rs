@@ -1,0 +1,255 @@
+//! What a figure shows, as plain data: axes, series, bands, reference lines and shaded regions
+//! for an x-y chart, and categories with named segments for a stacked bar chart. Nothing here
+//! depends on plotters, so analysis code can build figures whether or not drawing is compiled in.
+
+use std::path::PathBuf;
+
+/// An x-y chart: series of points and lines over two axes, with optional shaded bands,
+/// horizontal reference lines and shaded x-ranges. The legend lists every labelled item.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chart {
+    pub title: String,
+    /// One line under the plot, typically the machine and commit the data came from.
+    pub caption: String,
+    pub x: Axis,
+    pub y: Axis,
+    pub series: Vec<Series>,
+    pub bands: Vec<Band>,
+    pub hlines: Vec<RefLine>,
+    pub regions: Vec<Region>,
+    /// Legend text explaining hollow markers; shown only when some point is hollow.
+    pub hollow_label: String,
+}
+
+impl Chart {
+    pub fn new(title: impl Into<String>, x: Axis, y: Axis) -> Self {
+        Chart {
+            title: title.into(),
+            caption: String::new(),
+            x,
+            y,
+            series: Vec::new(),
+            bands: Vec::new(),
+            hlines: Vec::new(),
+            regions: Vec::new(),
+            hollow_label: "hollow: oversubscribed".into(),
+        }
+    }
+
+    pub fn caption(mut self, caption: impl Into<String>) -> Self {
+        self.caption = caption.into();
+        self
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scale {
+    Linear,
+    /// Base-10 logarithmic. Falls back to linear when any value on the axis is not positive.
+    Log,
+}
+
+/// What the numbers on an axis measure; decides how tick labels are written.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Plain numbers: `0.5`, `12`, `1e-4`.
+    Plain,
+    /// Seconds, written with the prefix that suits each tick: `250 ns`, `10 µs`, `1.5 ms`, `2 s`.
+    Seconds,
+    /// Counts such as particles or threads: `500`, `10k`, `2.5M`; linear ticks are whole numbers.
+    Count,
+    /// Fractions shown as percentages: 0.25 is written `25%`.
+    Percent,
+    /// Bytes with decimal prefixes: `512 B`, `64 kB`, `8 MB`.
+    Bytes,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Axis {
+    pub label: String,
+    pub scale: Scale,
+    pub unit: Unit,
+    /// Fixed bounds; `None` fits the data. Points outside a fixed range are not drawn.
+    pub range: Option<(f64, f64)>,
+    /// Extend the fitted range to include zero (linear axes only).
+    pub include_zero: bool,
+    /// Names for the positions 0, 1, 2, ... ; when non-empty the axis is categorical and linear.
+    pub categories: Vec<String>,
+}
+
+impl Axis {
+    pub fn linear(label: impl Into<String>) -> Self {
+        Axis {
+            label: label.into(),
+            scale: Scale::Linear,
+            unit: Unit::Plain,
+            range: None,
+            include_zero: false,
+            categories: Vec::new(),
+        }
+    }
+
+    pub fn log(label: impl Into<String>) -> Self {
+        Axis {
+            scale: Scale::Log,
+            ..Axis::linear(label)
+        }
+    }
+
+    pub fn categorical(label: impl Into<String>, categories: Vec<String>) -> Self {
+        Axis {
+            categories,
+            ..Axis::linear(label)
+        }
+    }
+
+    pub fn unit(mut self, unit: Unit) -> Self {
+        self.unit = unit;
+        self
+    }
+
+    pub fn range(mut self, lo: f64, hi: f64) -> Self {
+        self.range = Some((lo, hi));
+        self
+    }
+
+    pub fn from_zero(mut self) -> Self {
+        self.include_zero = true;
+        self
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SeriesStyle {
+    Line,
+    Markers,
+    LineMarkers,
+    Dashed,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    /// Legend text; an empty label keeps the series out of the legend.
+    pub label: String,
+    pub points: Vec<Point>,
+    pub style: SeriesStyle,
+    /// Index into the palette ([`super::palette::PALETTE`], wrapping); `None` uses the
+    /// series' position in the chart. Give a kernel's points and its fit the same index.
+    pub color: Option<usize>,
+}
+
+impl Series {
+    pub fn new(label: impl Into<String>, points: Vec<Point>, style: SeriesStyle) -> Self {
+        Series {
+            label: label.into(),
+            points,
+            style,
+            color: None,
+        }
+    }
+
+    /// A series from bare (x, y) pairs.
+    pub fn from_xy(
+        label: impl Into<String>,
+        xy: impl IntoIterator<Item = (f64, f64)>,
+        style: SeriesStyle,
+    ) -> Self {
+        let points = xy.into_iter().map(|(x, y)| Point::new(x, y)).collect();
+        Series::new(label, points, style)
+    }
+
+    pub fn color(mut self, index: usize) -> Self {
+        self.color = Some(index);
+        self
+    }
+}
+
+/// One data point. Non-finite coordinates are skipped when drawing (a line breaks there).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Point {
+    pub x: f64,
+    pub y: f64,
+    /// Error bar from `lo` to `hi` in y (e.g. a 95% confidence interval).
+    pub y_err: Option<(f64, f64)>,
+    /// Drawn as an outline marker, e.g. for an oversubscribed measurement.
+    pub hollow: bool,
+    /// Text written next to the marker, e.g. `θ=0.5`.
+    pub label: Option<String>,
+}
+
+impl Point {
+    pub fn new(x: f64, y: f64) -> Self {
+        Point {
+            x,
+            y,
+            y_err: None,
+            hollow: false,
+            label: None,
+        }
+    }
+
+    pub fn err(mut self, lo: f64, hi: f64) -> Self {
+        self.y_err = Some((lo, hi));
+        self
+    }
+
+    pub fn hollow(mut self, hollow: bool) -> Self {
+        self.hollow = hollow;
+        self
+    }
+
+    pub fn label(mut self, label: impl Into<String>) -> Self {
+        self.label = Some(label.into());
+        self
+    }
+}
+
+/// A shaded band between `lo` and `hi` along `x` (e.g. the confidence band of a fit).
+/// The three vectors are read in step; extra entries of a longer one are ignored.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Band {
+    pub label: String,
+    pub x: Vec<f64>,
+    pub lo: Vec<f64>,
+    pub hi: Vec<f64>,
+    pub color: Option<usize>,
+}
+
+/// A horizontal line across the whole plot at `y` (e.g. ideal efficiency 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct RefLine {
+    pub label: String,
+    pub y: f64,
+    /// Palette index; `None` draws it dark grey.
+    pub color: Option<usize>,
+    pub dashed: bool,
+}
+
+/// A shaded vertical strip from `x_from` to `x_to`, labelled inside the plot and in the
+/// legend (e.g. where a curve is a prediction with no measurement behind it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Region {
+    pub label: String,
+    pub x_from: f64,
+    pub x_to: f64,
+}
+
+/// Horizontal stacked bars: one bar per category, one coloured segment per named part.
+/// `segments[k].1[i]` is the size of part k in category i; missing, negative or non-finite
+/// sizes count as zero.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StackedBars {
+    pub title: String,
+    pub caption: String,
+    pub value_label: String,
+    pub value_unit: Unit,
+    pub categories: Vec<String>,
+    pub segments: Vec<(String, Vec<f64>)>,
+}
+
+/// The files a render wrote.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Rendered {
+    pub svg: PathBuf,
+    pub png: PathBuf,
+}
