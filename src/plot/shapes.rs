@@ -42,7 +42,8 @@ fn outline(marker: Marker, (x, y): Px, r: i32) -> Vec<Px> {
     }
 }
 
-/// A marker centred at `c`. Hollow markers get a white inside so grid lines do not cross them.
+/// A marker centred at `c`. A hollow marker is the filled shape with a white inside, so the
+/// ring is even and grid lines or error bars do not show through it.
 pub fn marker<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     c: Px,
@@ -51,23 +52,30 @@ pub fn marker<DB: DrawingBackend>(
     hollow: bool,
 ) -> DrawResult {
     let r = MARKER_RADIUS;
-    let stroke = color.stroke_width(LINE_WIDTH);
+    shape(area, c, marker, r, color)?;
+    if hollow {
+        // Slanted edges look thinner than straight ones at the same inset.
+        let inset = if matches!(marker, Marker::Triangle | Marker::Diamond) {
+            3
+        } else {
+            2
+        };
+        shape(area, c, marker, r - inset, WHITE)?;
+    }
+    Ok(())
+}
+
+fn shape<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    c: Px,
+    marker: Marker,
+    r: i32,
+    color: RGBColor,
+) -> DrawResult {
     if marker == Marker::Circle {
-        if hollow {
-            area.draw(&Circle::new(c, r, WHITE.filled())).map_err(err)?;
-            return area.draw(&Circle::new(c, r, stroke)).map_err(err);
-        }
         return area.draw(&Circle::new(c, r, color.filled())).map_err(err);
     }
-    let points = outline(marker, c, r);
-    if hollow {
-        area.draw(&Polygon::new(points.clone(), WHITE.filled()))
-            .map_err(err)?;
-        let mut closed = points.clone();
-        closed.push(points[0]);
-        return area.draw(&PathElement::new(closed, stroke)).map_err(err);
-    }
-    area.draw(&Polygon::new(points, color.filled()))
+    area.draw(&Polygon::new(outline(marker, c, r), color.filled()))
         .map_err(err)
 }
 
