@@ -35,6 +35,18 @@ pub enum Command {
     Sweep(SweepArgs),
     /// Fit a scaling model (amdahl, gustafson, power) to a CSV of measurements from any code.
     Fit(FitArgs),
+    /// Refit and re-plot a saved sweep: writes fits.json, summary.md and the figures (SVG + PNG).
+    Analyze(AnalyzeArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct AnalyzeArgs {
+    /// The results file of a sweep, e.g. results/quick/results.json.
+    #[arg(value_name = "RESULTS.json")]
+    pub results: PathBuf,
+    /// Directory for fits.json, summary.md and the figures [default: `analysis/` beside the results file].
+    #[arg(long, value_name = "DIR")]
+    pub out: Option<PathBuf>,
 }
 
 /// Options that define the simulated system.

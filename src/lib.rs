@@ -6,6 +6,7 @@
 //! [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
 //! [`run`] and [`validate`] (measured runs and force checks), [`output`], and the CLI.
 
+pub mod analysis;
 pub mod boundary;
 pub mod calibrate;
 pub mod cli;
@@ -19,6 +20,7 @@ pub mod output;
 pub mod physics;
 pub mod plot;
 pub mod real;
+pub mod report;
 pub mod run;
 pub mod scenario;
 pub mod simd;

@@ -1,5 +1,6 @@
 //! The subcommands. Each returns the process exit code or an error (reported with exit code 2).
 
+mod analyze;
 mod fit;
 mod fit_tables;
 mod list;
@@ -20,6 +21,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
         Command::Sweep(args) => sweep::sweep(args),
+        Command::Analyze(args) => analyze::analyze(args),
         Command::Fit(args) => fit::fit(args),
     }
 }

@@ -33,6 +33,16 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         report.rounds_measured,
         report.path.display()
     );
+    // The analysis is a convenience on top of the measurements: if it fails, the results
+    // are already saved and `analyze` can be run again.
+    let dir = super::analyze::default_dir(&report.path);
+    match super::analyze::run(&results, &report.path, &dir) {
+        Ok(written) => super::analyze::print_written(&written),
+        Err(e) => eprintln!(
+            "warning: analysis failed ({e:#}); the results are saved, retry with `nbody-bench analyze {}`",
+            report.path.display()
+        ),
+    }
     if report.incomplete > 0 {
         println!(
             "{} cases are not complete; run `nbody-bench sweep --config {} --resume` to finish them",

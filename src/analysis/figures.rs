@@ -1,0 +1,418 @@
+//! The figures of an analysis: cost vs n with fitted curves, speedup / efficiency / Karp-Flatt
+//! vs p with the Amdahl fit and the hardware ceiling, weak-scaling efficiency, phase breakdown,
+//! step-time percentiles, and octree error vs cost. Each states machine, commit and sweep in
+//! its caption.
+
+use super::groups::Point;
+use super::{Analysis, ComplexityAnalysis, StrongAnalysis};
+use crate::plot::figures::{
+    self as fig, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
+};
+use crate::plot::{Chart, Scale, StackedBars};
+use serde::Serialize;
+use std::path::Path;
+
+/// A drawn figure: its file stem (the files are `<stem>.svg` and `<stem>.png`) and title.
+#[derive(Clone, Debug, Serialize)]
+pub struct Figure {
+    pub stem: String,
+    pub title: String,
+}
+
+enum Drawing {
+    Chart(Chart),
+    Bars(StackedBars),
+}
+
+/// Renders every figure the analysis supports into `dir`. A figure that fails is reported and
+/// the others are still drawn.
+pub fn render_all(analysis: &Analysis, dir: &Path) -> (Vec<Figure>, Vec<String>) {
+    let mut drawn = Vec::new();
+    let mut errors = Vec::new();
+    for (stem, drawing) in figures(analysis) {
+        let (title, result) = match &drawing {
+            Drawing::Chart(c) => (
+                c.title.clone(),
+                crate::plot::render(c, dir, &stem).map(|_| ()),
+            ),
+            Drawing::Bars(b) => (
+                b.title.clone(),
+                crate::plot::render_stacked(b, dir, &stem).map(|_| ()),
+            ),
+        };
+        match result {
+            Ok(()) => drawn.push(Figure { stem, title }),
+            Err(e) => errors.push(format!("{stem}: {e}")),
+        }
+    }
+    (drawn, errors)
+}
+
+/// "AMD EPYC 9R45 (2 logical CPUs) · commit 1a2b3c4 · sweep strong".
+pub fn caption(analysis: &Analysis) -> String {
+    let machine = match &analysis.calibration {
+        Some(c) => format!("{} ({} logical CPUs)", c.cpu_model, c.logical_cpus),
+        None => analysis.metadata.host.clone(),
+    };
+    let commit: String = analysis.metadata.git_commit.chars().take(7).collect();
+    let dirty = if analysis.metadata.git_dirty {
+        "+dirty"
+    } else {
+        ""
+    };
+    format!(
+        "{machine} · commit {commit}{dirty} · sweep {}",
+        analysis.name
+    )
+}
+
+fn slug(s: &str) -> String {
+    s.chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect::<String>()
+        .split('-')
+        .filter(|p| !p.is_empty())
+        .collect::<Vec<_>>()
+        .join("-")
+}
+
+fn measured(
+    points: &[Point],
+    x: impl Fn(&Point) -> f64,
+    y: impl Fn(&Point) -> (f64, [f64; 2]),
+) -> Vec<Measured> {
+    points
+        .iter()
+        .map(|p| {
+            let (m, [lo, hi]) = y(p);
+            Measured::with_ci(x(p), m, lo, hi).oversubscribed(p.oversubscribed)
+        })
+        .collect()
+}
+
+fn time_of(p: &Point) -> (f64, [f64; 2]) {
+    (p.median_s, p.ci95_s)
+}
+
+fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
+    let cap = caption(a);
+    let mut out = Vec::new();
+    // Cost vs n: one figure per scenario, precision and parallelism.
+    let mut seen: Vec<(String, String, usize, usize)> = Vec::new();
+    for c in &a.complexity {
+        let k = &c.series;
+        let id = (
+            k.scenario.name().to_string(),
+            k.precision.clone(),
+            k.threads.unwrap_or(1),
+            k.ranks.unwrap_or(1),
+        );
+        if seen.contains(&id) {
+            continue;
+        }
+        let same: Vec<&ComplexityAnalysis> = a
+            .complexity
+            .iter()
+            .filter(|o| {
+                o.series.scenario == k.scenario
+                    && o.series.precision == k.precision
+                    && o.series.threads == k.threads
+                    && o.series.ranks == k.ranks
+            })
+            .collect();
+        let series: Vec<KernelSeries> = same.iter().map(|c| time_series(c)).collect();
+        let mut chart = fig::time_per_step(&series, &cap);
+        chart.title = format!(
+            "{} ({}, {} thread{}): time per step vs n",
+            id.0,
+            id.1,
+            id.2,
+            if id.2 == 1 { "" } else { "s" }
+        );
+        out.push((
+            format!("time-vs-n-{}-{}-p{}-r{}", id.0, id.1, id.2, id.3),
+            Drawing::Chart(chart),
+        ));
+        seen.push(id);
+    }
+    // Strong scaling: one set per scenario and n.
+    let mut strong_seen: Vec<(String, Option<usize>, String)> = Vec::new();
+    for s in &a.strong {
+        let id = (
+            s.series.scenario.name().to_string(),
+            s.series.n,
+            s.series.precision.clone(),
+        );
+        if strong_seen.contains(&id) {
+            continue;
+        }
+        let same: Vec<&StrongAnalysis> = a
+            .strong
+            .iter()
+            .filter(|o| {
+                o.series.scenario == s.series.scenario
+                    && o.series.n == s.series.n
+                    && o.series.precision == s.series.precision
+            })
+            .collect();
+        let stem = format!("{}-n{}-{}", id.0, id.1.unwrap_or(0), id.2);
+        let title = format!("{} n={}", id.0, id.1.unwrap_or(0));
+        let ceiling: Vec<(f64, f64)> = same
+            .iter()
+            .filter_map(|s| s.fit.fit.as_ref())
+            .flat_map(|f| f.points.iter().filter_map(|p| p.ceiling.map(|c| (p.p, c))))
+            .fold(Vec::new(), |mut acc, pc| {
+                if !acc.iter().any(|a: &(f64, f64)| a.0 == pc.0) {
+                    acc.push(pc);
+                }
+                acc
+            });
+        let speed: Vec<KernelSeries> = same.iter().map(|s| speedup_series(s)).collect();
+        let mut chart = fig::speedup(&speed, &ceiling, &cap);
+        chart.title = format!("{title}: speedup vs threads");
+        out.push((format!("speedup-{stem}"), Drawing::Chart(chart)));
+        let eff: Vec<KernelSeries> = same
+            .iter()
+            .filter_map(|s| {
+                let f = s.fit.fit.as_ref()?;
+                let m = f
+                    .points
+                    .iter()
+                    .map(|p| {
+                        Measured::with_ci(
+                            p.p,
+                            p.efficiency.estimate,
+                            p.efficiency.ci95[0],
+                            p.efficiency.ci95[1],
+                        )
+                        .oversubscribed(oversubscribed_at(&s.points, p.p))
+                    })
+                    .collect();
+                Some(KernelSeries::new(s.label.clone(), m))
+            })
+            .collect();
+        let mut chart = fig::efficiency(&eff, &cap);
+        chart.title = format!("{title}: parallel efficiency");
+        out.push((format!("efficiency-{stem}"), Drawing::Chart(chart)));
+        let kf: Vec<KernelSeries> = same
+            .iter()
+            .filter_map(|s| {
+                let f = s.fit.fit.as_ref()?;
+                let m = f
+                    .karp_flatt
+                    .iter()
+                    .map(|k| {
+                        Measured::with_ci(k.p, k.e.estimate, k.e.ci95[0], k.e.ci95[1])
+                            .oversubscribed(oversubscribed_at(&s.points, k.p))
+                    })
+                    .collect();
+                Some(KernelSeries::new(
+                    format!("{} ({})", s.label, f.karp_flatt_trend.verdict.name()),
+                    m,
+                ))
+            })
+            .collect();
+        if kf.iter().any(|k| !k.measured.is_empty()) {
+            let mut chart = fig::karp_flatt(&kf, &cap);
+            chart.title = format!("{title}: Karp-Flatt serial fraction e(p)");
+            out.push((format!("karp-flatt-{stem}"), Drawing::Chart(chart)));
+        }
+        strong_seen.push(id);
+    }
+    // Weak scaling: one figure per scenario.
+    let mut weak_seen: Vec<String> = Vec::new();
+    for w in &a.weak {
+        let scen = w.series.scenario.name().to_string();
+        if weak_seen.contains(&scen) {
+            continue;
+        }
+        let series: Vec<KernelSeries> = a
+            .weak
+            .iter()
+            .filter(|o| o.series.scenario == w.series.scenario)
+            .filter_map(|o| {
+                let f = o.fit.fit.as_ref()?;
+                let m = f
+                    .efficiency
+                    .iter()
+                    .map(|e| {
+                        Measured::with_ci(e.p, e.e.estimate, e.e.ci95[0], e.e.ci95[1])
+                            .oversubscribed(oversubscribed_at(&o.points, e.p))
+                    })
+                    .collect();
+                Some(KernelSeries::new(o.label.clone(), m))
+            })
+            .collect();
+        let mut chart = fig::weak_efficiency(&series, &cap);
+        chart.title = format!("{scen}: weak-scaling efficiency T(1)/T(p)");
+        out.push((format!("weak-efficiency-{scen}"), Drawing::Chart(chart)));
+        weak_seen.push(scen);
+    }
+    // Phase breakdown and step-time percentiles per scenario, at each case's largest n.
+    let mut scenarios: Vec<String> = a.cases.iter().map(|c| scenario_of(&c.key)).collect();
+    scenarios.dedup();
+    scenarios.sort();
+    scenarios.dedup();
+    for scen in &scenarios {
+        let cases = representative_cases(a, scen);
+        if cases.is_empty() {
+            continue;
+        }
+        let phases: Vec<PhaseTimes> = cases
+            .iter()
+            .map(|c| PhaseTimes {
+                case: case_label(c),
+                build: c.phases.force_build,
+                interact: c.phases.force_interact,
+                integrate: c.phases.integrate,
+                boundary: c.phases.boundary,
+                communication: 0.0,
+            })
+            .collect();
+        let mut bars = fig::phase_breakdown(&phases, &cap);
+        bars.title = format!("{scen}: time per step by phase");
+        out.push((format!("phases-{}", slug(scen)), Drawing::Bars(bars)));
+        let rows: Vec<Percentiles> = cases
+            .iter()
+            .map(|c| Percentiles {
+                kernel: case_label(c),
+                p50: c.step_ns.p50 as f64 * 1e-9,
+                p90: c.step_ns.p90 as f64 * 1e-9,
+                p99: c.step_ns.p99 as f64 * 1e-9,
+                max: c.step_ns.max as f64 * 1e-9,
+            })
+            .collect();
+        let mut chart = fig::step_percentiles(&rows, &cap);
+        chart.title = format!("{scen}: step-time percentiles");
+        out.push((format!("percentiles-{}", slug(scen)), Drawing::Chart(chart)));
+    }
+    // Octree accuracy vs cost.
+    let sweeps: Vec<ThetaSweep> = a
+        .theta
+        .iter()
+        .map(|t| ThetaSweep {
+            name: format!("{} n={}", t.series.scenario.name(), t.series.n.unwrap_or(0)),
+            points: t
+                .points
+                .iter()
+                .filter_map(|p| {
+                    Some(ThetaPoint {
+                        theta: p.theta?,
+                        seconds: p.median_s,
+                        error: p.force_error?[0],
+                    })
+                })
+                .collect(),
+        })
+        .filter(|s| !s.points.is_empty())
+        .collect();
+    if !sweeps.is_empty() {
+        out.push((
+            "octree-accuracy".into(),
+            Drawing::Chart(fig::octree_accuracy(&sweeps, &cap)),
+        ));
+    }
+    out
+}
+
+fn scenario_of(key: &str) -> String {
+    key.split('/').next().unwrap_or(key).to_string()
+}
+
+/// "octree θ=0.5 p=2 n=16384" — short enough for a category axis.
+pub fn case_label(c: &Point) -> String {
+    let mut parts: Vec<&str> = c.key.split('/').collect();
+    parts.retain(|p| !p.starts_with("seed=") && *p != "r=1");
+    parts[1..].join(" ").replace("theta=", "θ=")
+}
+
+/// The cases of a scenario worth a bar each: for every kernel and p, the largest n measured.
+fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
+    let mut out: Vec<&Point> = Vec::new();
+    for c in a.cases.iter().filter(|c| scenario_of(&c.key) == scenario) {
+        let kernel = |p: &Point| p.key.split('/').nth(1).map(str::to_string);
+        let same = |o: &&Point| {
+            kernel(o) == kernel(c)
+                && o.threads == c.threads
+                && o.ranks == c.ranks
+                && o.theta == c.theta
+        };
+        match out.iter().position(same) {
+            Some(i) if out[i].n < c.n => out[i] = c,
+            Some(_) => {}
+            None => out.push(c),
+        }
+    }
+    out.truncate(16);
+    out
+}
+
+fn oversubscribed_at(points: &[Point], p: f64) -> bool {
+    points.iter().any(|c| c.p() as f64 == p && c.oversubscribed)
+}
+
+fn time_series(c: &ComplexityAnalysis) -> KernelSeries {
+    let mut series = KernelSeries::new(
+        c.label.clone(),
+        measured(&c.points, |p| p.n as f64, time_of),
+    );
+    if let Some(f) = &c.fit.fit {
+        let lo = c.points.first().map(|p| p.n as f64).unwrap_or(1.0);
+        let hi = c.points.last().map(|p| p.n as f64).unwrap_or(1.0);
+        let xs = fig::grid(lo, hi, 40, Scale::Log);
+        series.fit = Some(Curve::from_fn(
+            format!(
+                "{}: {} (n^{:.2})",
+                c.label,
+                f.class.name(),
+                f.exponent.estimate
+            ),
+            &xs,
+            |n| f.predict(n),
+        ));
+    }
+    series
+}
+
+fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
+    let Some(f) = &s.fit.fit else {
+        return KernelSeries::new(s.label.clone(), Vec::new());
+    };
+    let measured = f
+        .points
+        .iter()
+        .map(|p| {
+            Measured::with_ci(
+                p.p,
+                p.speedup.estimate,
+                p.speedup.ci95[0],
+                p.speedup.ci95[1],
+            )
+            .oversubscribed(oversubscribed_at(&s.points, p.p))
+        })
+        .collect();
+    let hi = f.points.iter().map(|p| p.p).fold(1.0, f64::max);
+    let xs = fig::grid(1.0, hi, 30, Scale::Linear);
+    let band = xs
+        .iter()
+        .map(|&p| {
+            let (_, [lo, hi]) = f.amdahl_speedup(p);
+            (p, lo, hi)
+        })
+        .collect();
+    let curve = Curve::from_fn(
+        format!(
+            "{}: Amdahl f = {:.3} [{:.3}, {:.3}]",
+            s.label,
+            f.serial_fraction.estimate,
+            f.serial_fraction.ci95[0],
+            f.serial_fraction.ci95[1]
+        ),
+        &xs,
+        |p| f.amdahl_speedup(p).0,
+    )
+    .with_band(band);
+    let mut series = KernelSeries::new(s.label.clone(), measured);
+    series.fit = Some(curve);
+    series
+}

@@ -1,0 +1,218 @@
+//! Reads the cases of a results file as series: the same code over n (complexity), over p at
+//! fixed n (strong scaling), over p with the work per worker held (weak scaling), and over θ
+//! (octree accuracy). Pure data; the fits and plots are elsewhere.
+
+use crate::engine::PhaseTimes;
+use crate::experiment::config::Study;
+use crate::experiment::results::{CaseRecord, ResultsFile};
+use crate::kernels::KernelKind;
+use crate::scenario::ScenarioKind;
+use crate::stats::StepPercentiles;
+use serde::Serialize;
+
+/// One measured case as the analysis sees it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Point {
+    pub key: String,
+    pub n: usize,
+    pub threads: usize,
+    pub ranks: usize,
+    /// Simulated-time factor of a weak-by-time case (1 otherwise).
+    pub time_factor: u64,
+    pub theta: Option<f64>,
+    /// Seconds per step: every raw sample, the median and its bootstrap 95% CI.
+    #[serde(skip)]
+    pub samples: Vec<f64>,
+    pub median_s: f64,
+    pub ci95_s: [f64; 2],
+    pub oversubscribed: bool,
+    pub ns_per_particle_step: f64,
+    pub pair_evals_per_s: f64,
+    pub phases: PhaseTimes,
+    pub step_ns: StepPercentiles,
+    pub force_error: Option<[f64; 2]>,
+    pub max_energy_drift: f64,
+    pub sanity_ok: bool,
+}
+
+impl Point {
+    /// Workers: threads × ranks.
+    pub fn p(&self) -> usize {
+        self.threads * self.ranks
+    }
+}
+
+/// What a series holds fixed. `None` fields vary along the series or do not apply.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SeriesKey {
+    pub scenario: ScenarioKind,
+    pub kernel: KernelKind,
+    pub precision: String,
+    pub theta: Option<f64>,
+    pub n: Option<usize>,
+    pub threads: Option<usize>,
+    pub ranks: Option<usize>,
+}
+
+impl SeriesKey {
+    /// A short legend label, e.g. "octree θ=0.5" or "naive, 2 threads".
+    pub fn label(&self) -> String {
+        let mut s = self.kernel.name().to_string();
+        if let Some(t) = self.theta {
+            s.push_str(&format!(" θ={t}"));
+        }
+        match (self.threads, self.ranks) {
+            (Some(t), Some(1)) if t > 1 => s.push_str(&format!(", {t} threads")),
+            (Some(1), Some(r)) if r > 1 => s.push_str(&format!(", {r} ranks")),
+            (Some(t), Some(r)) if t > 1 || r > 1 => {
+                s.push_str(&format!(", {t} threads × {r} ranks"))
+            }
+            _ => {}
+        }
+        s
+    }
+}
+
+/// Cases that differ only in the quantity the series varies, sorted by it.
+#[derive(Clone, Debug, Serialize)]
+pub struct Series {
+    pub key: SeriesKey,
+    pub points: Vec<Point>,
+}
+
+/// The series a results file supports.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Groups {
+    /// Over n at fixed threads and ranks (two or more distinct n).
+    pub complexity: Vec<Series>,
+    /// Over p at fixed n, from p = 1 (not in weak studies).
+    pub strong: Vec<Series>,
+    /// Over p with n or simulated time grown by the weak rule (weak studies only).
+    pub weak: Vec<Series>,
+    /// Octree cases over θ at fixed n and p.
+    pub theta: Vec<Series>,
+    /// Every complete case, in file order.
+    pub cases: Vec<Point>,
+}
+
+/// Reads the complete cases of `results` into series.
+pub fn group(results: &ResultsFile) -> Groups {
+    let cases: Vec<Point> = results.cases.iter().filter_map(point).collect();
+    let weak = results.config.study == Study::Weak;
+    let base = |c: &Point, r: &CaseRecord| SeriesKey {
+        scenario: r.case.scenario,
+        kernel: r.case.kernel,
+        precision: precision_name(r),
+        theta: c.theta,
+        n: Some(c.n),
+        threads: Some(c.threads),
+        ranks: Some(c.ranks),
+    };
+    let records: Vec<(&Point, &CaseRecord)> = cases
+        .iter()
+        .map(|c| {
+            let r = results
+                .cases
+                .iter()
+                .find(|r| r.key == c.key)
+                .expect("same file");
+            (c, r)
+        })
+        .collect();
+    let series = |vary: &dyn Fn(&mut SeriesKey), order: &dyn Fn(&Point) -> f64| {
+        let mut out: Vec<Series> = Vec::new();
+        for &(c, r) in &records {
+            let mut key = base(c, r);
+            vary(&mut key);
+            match out.iter_mut().find(|s| s.key == key) {
+                Some(s) => s.points.push(c.clone()),
+                None => out.push(Series {
+                    key,
+                    points: vec![c.clone()],
+                }),
+            }
+        }
+        for s in &mut out {
+            s.points.sort_by(|a, b| order(a).total_cmp(&order(b)));
+        }
+        out
+    };
+    let distinct = |s: &Series, f: &dyn Fn(&Point) -> f64| {
+        let mut v: Vec<f64> = s.points.iter().map(f).collect();
+        v.sort_by(f64::total_cmp);
+        v.dedup();
+        v.len()
+    };
+    let by_n = |p: &Point| p.n as f64;
+    let by_p = |p: &Point| p.p() as f64;
+    let by_theta = |p: &Point| p.theta.unwrap_or(0.0);
+    let complexity = series(&|k| k.n = None, &by_n)
+        .into_iter()
+        .filter(|s| !weak && distinct(s, &by_n) >= 2)
+        .collect();
+    let parallel = series(
+        &|k| {
+            k.threads = None;
+            k.ranks = None;
+            if weak {
+                k.n = None;
+            }
+        },
+        &by_p,
+    );
+    let from_one = |s: &Series| s.points.iter().any(|c| c.p() == 1) && distinct(s, &by_p) >= 2;
+    let (weak_series, strong) = if weak {
+        (parallel.into_iter().filter(from_one).collect(), Vec::new())
+    } else {
+        (Vec::new(), parallel.into_iter().filter(from_one).collect())
+    };
+    let theta = series(&|k| k.theta = None, &by_theta)
+        .into_iter()
+        .filter(|s| s.key.kernel == KernelKind::Octree && distinct(s, &by_theta) >= 2)
+        .collect();
+    Groups {
+        complexity,
+        strong,
+        weak: weak_series,
+        theta,
+        cases,
+    }
+}
+
+fn precision_name(r: &CaseRecord) -> String {
+    match r.case.precision {
+        Some(p) => p.name().to_string(),
+        None => r.case.scenario.defaults().precision.name().to_string(),
+    }
+}
+
+/// The analysis view of a complete case; `None` for a case still being measured.
+fn point(r: &CaseRecord) -> Option<Point> {
+    let s = r.summary.as_ref()?;
+    if !r.is_complete() || s.samples == 0 {
+        return None;
+    }
+    Some(Point {
+        key: r.key.clone(),
+        n: r.n,
+        threads: r.case.threads,
+        ranks: r.case.ranks,
+        time_factor: r.case.time_factor,
+        theta: r.case.theta,
+        samples: r
+            .rounds
+            .iter()
+            .flat_map(|round| round.samples_s.iter().copied())
+            .collect(),
+        median_s: s.median_s,
+        ci95_s: s.ci95_s,
+        oversubscribed: r.oversubscribed,
+        ns_per_particle_step: s.ns_per_particle_step,
+        pair_evals_per_s: s.pair_evals_per_s,
+        phases: s.phases,
+        step_ns: s.step_ns,
+        force_error: s.force_error,
+        max_energy_drift: s.max_energy_drift,
+        sanity_ok: s.sanity_ok,
+    })
+}

@@ -1,0 +1,364 @@
+//! Offline analysis of a sweep: the series of a results file ([`groups`]), the models fitted to
+//! them (complexity in n, strong and weak scaling, crossovers), the figures ([`figures`]) and a
+//! short Markdown summary ([`summary`]). `analyze` and the end of `sweep` both call [`analyze`]
+//! then [`write`]; everything is recomputed from the raw samples, with seeded bootstraps, so the
+//! same results file always gives the same output.
+
+pub mod figures;
+pub mod groups;
+pub mod summary;
+
+use crate::calibrate::Calibration;
+use crate::experiment::config::{Study, WeakRule};
+use crate::experiment::results::{Metadata, ResultsFile};
+use crate::fit::{
+    self, ComplexityClass, PowerFit, Samples, SerialFractionComparison, StrongFit,
+    TimedSerialFraction, WeakFit, WeakSamples,
+};
+use crate::kernels::KernelKind;
+use groups::{Groups, Point, Series, SeriesKey};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+pub const FITS_SCHEMA: &str = "nbody-bench/fits/v1";
+
+/// A fit, or why there is none (too few points, …): a series is never dropped silently.
+#[derive(Clone, Debug, Serialize)]
+pub struct Fitted<T> {
+    pub fit: Option<T>,
+    pub error: Option<String>,
+}
+
+impl<T> Fitted<T> {
+    fn of(result: Result<T, fit::FitError>) -> Self {
+        match result {
+            Ok(fit) => Fitted {
+                fit: Some(fit),
+                error: None,
+            },
+            Err(e) => Fitted {
+                fit: None,
+                error: Some(e.to_string()),
+            },
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ComplexityAnalysis {
+    pub series: SeriesKey,
+    pub label: String,
+    pub points: Vec<Point>,
+    pub fit: Fitted<PowerFit>,
+}
+
+/// Where two kernels' fitted cost curves cross.
+#[derive(Clone, Debug, Serialize)]
+pub struct Crossover {
+    pub scenario: String,
+    pub precision: String,
+    pub threads: usize,
+    /// The kernel that is faster above `n` and the one that is faster below it.
+    pub faster_above: String,
+    pub faster_below: String,
+    pub n: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StrongAnalysis {
+    pub series: SeriesKey,
+    pub label: String,
+    pub points: Vec<Point>,
+    pub fit: Fitted<StrongFit>,
+    /// The serial fraction from the one-worker case's phase timers (source 002's method),
+    /// and how it compares with the fitted one.
+    pub timed_serial: Option<TimedSerialFraction>,
+    pub serial_comparison: Option<SerialFractionComparison>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct WeakAnalysis {
+    pub series: SeriesKey,
+    pub label: String,
+    pub rule: Option<WeakRule>,
+    pub points: Vec<Point>,
+    pub fit: Fitted<WeakFit>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ThetaAnalysis {
+    pub series: SeriesKey,
+    pub label: String,
+    pub points: Vec<Point>,
+}
+
+/// Everything `analyze` derives from one results file (`fits.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Analysis {
+    pub schema: String,
+    pub source: String,
+    pub name: String,
+    pub study: Study,
+    pub metadata: Metadata,
+    pub calibration: Option<Calibration>,
+    pub complexity: Vec<ComplexityAnalysis>,
+    pub crossovers: Vec<Crossover>,
+    pub strong: Vec<StrongAnalysis>,
+    pub weak: Vec<WeakAnalysis>,
+    pub theta: Vec<ThetaAnalysis>,
+    /// Every complete case, with its summary figures and physics checks.
+    pub cases: Vec<Point>,
+    /// Cases of the file still unmeasured or partly measured (left out of the analysis).
+    pub incomplete: Vec<String>,
+}
+
+#[derive(Debug, Error)]
+pub enum AnalysisError {
+    #[error("{path} has no complete case to analyse; finish it with `nbody-bench sweep --resume`")]
+    Empty { path: PathBuf },
+    #[error(transparent)]
+    Write(#[from] crate::output::WriteError),
+    #[error(transparent)]
+    Plot(#[from] crate::plot::PlotError),
+}
+
+/// Fits every series of `results` (read from `source`, for the record).
+pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, AnalysisError> {
+    let groups: Groups = groups::group(results);
+    if groups.cases.is_empty() {
+        return Err(AnalysisError::Empty {
+            path: source.into(),
+        });
+    }
+    let calibration = results
+        .calibration
+        .start
+        .clone()
+        .or(results.calibration.end.clone());
+    let complexity: Vec<ComplexityAnalysis> = groups.complexity.iter().map(complexity).collect();
+    let crossovers = crossovers(&complexity);
+    let strong = groups
+        .strong
+        .iter()
+        .map(|s| strong(s, calibration.as_ref()))
+        .collect();
+    let rule = results.config.weak.as_ref().map(|w| w.rule);
+    let weak = groups.weak.iter().map(|s| weak(s, rule)).collect();
+    let theta = groups
+        .theta
+        .iter()
+        .map(|s| ThetaAnalysis {
+            series: s.key.clone(),
+            label: s.key.label(),
+            points: s.points.clone(),
+        })
+        .collect();
+    Ok(Analysis {
+        schema: FITS_SCHEMA.into(),
+        source: source.display().to_string(),
+        name: results.config.name.clone(),
+        study: results.config.study,
+        metadata: results.metadata.clone(),
+        calibration,
+        complexity,
+        crossovers,
+        strong,
+        weak,
+        theta,
+        incomplete: results
+            .cases
+            .iter()
+            .filter(|c| !c.is_complete())
+            .map(|c| c.key.clone())
+            .collect(),
+        cases: groups.cases,
+    })
+}
+
+/// What `write` produced.
+pub struct Written {
+    pub fits: PathBuf,
+    pub summary: PathBuf,
+    pub figures: Vec<figures::Figure>,
+    /// Figures that could not be drawn (the fits and summary are written regardless).
+    pub figure_errors: Vec<String>,
+}
+
+/// Writes `fits.json`, `summary.md` and the figures into `dir` (atomically, file by file).
+pub fn write(analysis: &Analysis, dir: &Path) -> Result<Written, AnalysisError> {
+    let (figures, figure_errors) = figures::render_all(analysis, dir);
+    let fits = dir.join("fits.json");
+    let text = serde_json::to_string_pretty(analysis).expect("analysis serializes");
+    crate::output::write_atomic(&fits, text.as_bytes())?;
+    let summary = dir.join("summary.md");
+    let md = summary::markdown(analysis, &figures);
+    crate::output::write_atomic(&summary, md.as_bytes())?;
+    Ok(Written {
+        fits,
+        summary,
+        figures,
+        figure_errors,
+    })
+}
+
+fn samples_by(
+    points: &[Point],
+    x: impl Fn(&Point) -> f64,
+    scale: impl Fn(&Point) -> f64,
+) -> Vec<Samples> {
+    let mut out: Vec<Samples> = Vec::new();
+    for p in points {
+        let values = p.samples.iter().map(|v| v * scale(p));
+        match out.iter_mut().find(|s| s.x == x(p)) {
+            Some(s) => s.values.extend(values),
+            None => out.push(Samples::new(x(p), values.collect())),
+        }
+    }
+    out
+}
+
+fn complexity(s: &Series) -> ComplexityAnalysis {
+    let data = samples_by(&s.points, |p| p.n as f64, |_| 1.0);
+    ComplexityAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        points: s.points.clone(),
+        fit: Fitted::of(fit::fit_power(&data, fit::DEFAULT_SEED)),
+    }
+}
+
+fn crossovers(all: &[ComplexityAnalysis]) -> Vec<Crossover> {
+    let mut out = Vec::new();
+    for (i, a) in all.iter().enumerate() {
+        for b in &all[i + 1..] {
+            let same = a.series.scenario == b.series.scenario
+                && a.series.precision == b.series.precision
+                && a.series.threads == b.series.threads
+                && a.series.ranks == b.series.ranks;
+            let (Some(fa), Some(fb)) = (&a.fit.fit, &b.fit.fit) else {
+                continue;
+            };
+            if !same {
+                continue;
+            }
+            let ns = a.points.iter().chain(&b.points).map(|p| p.n as f64);
+            let lo = ns.clone().fold(f64::INFINITY, f64::min);
+            let hi = ns.fold(0.0, f64::max);
+            if let Some(n) = fit::crossover(fa, fb, lo, hi) {
+                let a_faster_above = fa.predict(hi) < fb.predict(hi);
+                let (above, below) = if a_faster_above { (a, b) } else { (b, a) };
+                out.push(Crossover {
+                    scenario: a.series.scenario.name().into(),
+                    precision: a.series.precision.clone(),
+                    threads: a.series.threads.unwrap_or(1),
+                    faster_above: above.label.clone(),
+                    faster_below: below.label.clone(),
+                    n,
+                });
+            }
+        }
+    }
+    out
+}
+
+/// Kernels whose force interaction runs on the rayon pool; their build, integration and
+/// boundary phases stay serial.
+fn parallel_interaction(kernel: KernelKind) -> bool {
+    !matches!(kernel, KernelKind::Symmetric)
+}
+
+fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
+    let data = samples_by(&s.points, |p| p.p() as f64, |_| 1.0);
+    let ceiling: Vec<(f64, f64)> = match calibration {
+        Some(c) => s
+            .points
+            .iter()
+            .filter(|p| p.ranks == 1)
+            .filter_map(|p| {
+                // One thread is the reference of the ceiling by definition.
+                let r = if p.threads == 1 {
+                    Some(1.0)
+                } else {
+                    c.ceiling(p.threads)
+                };
+                r.map(|r| (p.threads as f64, r))
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let mut ceiling = ceiling;
+    ceiling.dedup_by(|a, b| a.0 == b.0);
+    let fit = Fitted::of(fit::fit_strong(&data, &ceiling, fit::DEFAULT_SEED));
+    let timed_serial = s.points.iter().find(|p| p.p() == 1).and_then(|one| {
+        let ph = &one.phases;
+        let (serial, parallel) = if parallel_interaction(s.key.kernel) {
+            (
+                vec![ph.force_build, ph.integrate, ph.boundary, ph.output],
+                vec![ph.force_interact],
+            )
+        } else {
+            (
+                vec![
+                    ph.force_build,
+                    ph.force_interact,
+                    ph.integrate,
+                    ph.boundary,
+                    ph.output,
+                ],
+                vec![],
+            )
+        };
+        fit::timed_serial_fraction(&serial, &parallel).ok()
+    });
+    let serial_comparison = match (&timed_serial, &fit.fit) {
+        (Some(t), Some(f)) => Some(fit::compare_serial_fractions(t, &f.serial_fraction)),
+        _ => None,
+    };
+    StrongAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        points: s.points.clone(),
+        fit,
+        timed_serial,
+        serial_comparison,
+    }
+}
+
+/// The cost model a kernel's work per worker is held constant under.
+fn cost_class(kernel: KernelKind) -> ComplexityClass {
+    match kernel {
+        KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => ComplexityClass::N2,
+        KernelKind::CellList => ComplexityClass::N,
+        KernelKind::Octree => ComplexityClass::NLogN,
+    }
+}
+
+fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
+    let fit = if rule == Some(WeakRule::Time) {
+        // n is fixed and the simulated time grows with p: the time of the scaled work is the
+        // step time times the time factor.
+        let data = samples_by(&s.points, |p| p.p() as f64, |p| p.time_factor as f64);
+        fit::fit_weak(&data, fit::DEFAULT_SEED)
+    } else {
+        let mut data: Vec<WeakSamples> = Vec::new();
+        for p in &s.points {
+            match data.iter_mut().find(|w| w.p == p.p() as f64) {
+                Some(w) => w.values.extend(&p.samples),
+                None => data.push(WeakSamples {
+                    p: p.p() as f64,
+                    n: p.n as f64,
+                    values: p.samples.clone(),
+                }),
+            }
+        }
+        fit::fit_weak_with_n(&data, cost_class(s.key.kernel), fit::DEFAULT_SEED)
+    };
+    WeakAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        rule,
+        points: s.points.clone(),
+        fit: Fitted::of(fit),
+    }
+}

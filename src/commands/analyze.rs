@@ -1,0 +1,38 @@
+//! `analyze`: refit and re-plot a saved sweep.
+
+use crate::analysis::{self, Written};
+use crate::cli::AnalyzeArgs;
+use crate::experiment::results::ResultsFile;
+use std::path::{Path, PathBuf};
+
+pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
+    let results = ResultsFile::load(&args.results)?;
+    let dir = args.out.unwrap_or_else(|| default_dir(&args.results));
+    let written = run(&results, &args.results, &dir)?;
+    print_written(&written);
+    Ok(0)
+}
+
+/// `analysis/` beside the results file.
+pub fn default_dir(results: &Path) -> PathBuf {
+    results.parent().unwrap_or(Path::new(".")).join("analysis")
+}
+
+/// Analyses `results` into `dir`; shared with the end of `sweep`.
+pub fn run(results: &ResultsFile, source: &Path, dir: &Path) -> anyhow::Result<Written> {
+    let analysis = analysis::analyze(results, source)?;
+    Ok(analysis::write(&analysis, dir)?)
+}
+
+pub fn print_written(w: &Written) {
+    println!(
+        "analysis: {} and {} with {} figure(s) in {}",
+        w.fits.display(),
+        w.summary.display(),
+        w.figures.len(),
+        w.fits.parent().unwrap_or(Path::new(".")).display()
+    );
+    for e in &w.figure_errors {
+        eprintln!("warning: figure not drawn: {e}");
+    }
+}

@@ -1,0 +1,159 @@
+//! Hand-written interpretation inside a generated document. Regions between
+//! `<!-- keep:NAME -->` and `<!-- /keep:NAME -->` belong to people: regenerating the document
+//! carries them over from the previous version, so running `report` never destroys analysis.
+
+use std::collections::BTreeMap;
+use thiserror::Error;
+
+#[derive(Debug, Error, PartialEq)]
+pub enum KeepError {
+    #[error(
+        "line {line}: `<!-- keep:{name} -->` is never closed; add `<!-- /keep:{name} -->` after the text to keep"
+    )]
+    Unclosed { name: String, line: usize },
+    #[error("line {line}: the kept region `{name}` appears twice; rename one of them")]
+    Duplicate { name: String, line: usize },
+}
+
+/// The opening marker of a kept region.
+pub fn open(name: &str) -> String {
+    format!("<!-- keep:{name} -->")
+}
+
+/// The closing marker of a kept region.
+pub fn close(name: &str) -> String {
+    format!("<!-- /keep:{name} -->")
+}
+
+/// A kept region with `default` as its text, for a newly generated document.
+pub fn region(name: &str, default: &str) -> String {
+    format!("{}\n{}\n{}\n", open(name), default.trim_end(), close(name))
+}
+
+/// The text of every kept region of `doc`, by name (markers excluded).
+pub fn extract(doc: &str) -> Result<BTreeMap<String, String>, KeepError> {
+    let mut out = BTreeMap::new();
+    let mut current: Option<(String, usize, Vec<&str>)> = None;
+    for (i, line) in doc.lines().enumerate() {
+        let trimmed = line.trim();
+        if let Some((name, start, body)) = current.as_mut() {
+            if trimmed == close(name) {
+                let text = body.join("\n");
+                let (name, start) = (std::mem::take(name), *start);
+                if out.insert(name.clone(), text).is_some() {
+                    return Err(KeepError::Duplicate { name, line: start });
+                }
+                current = None;
+            } else {
+                body.push(line);
+            }
+        } else if let Some(name) = marker_name(trimmed) {
+            current = Some((name.to_string(), i + 1, Vec::new()));
+        }
+    }
+    match current {
+        Some((name, line, _)) => Err(KeepError::Unclosed { name, line }),
+        None => Ok(out),
+    }
+}
+
+/// `generated` with each kept region's text replaced by the one in `kept` (when present).
+/// Regions of `kept` that the new document no longer has are appended at the end under a
+/// heading, so that no hand-written text is ever dropped silently.
+pub fn merge(generated: &str, kept: &BTreeMap<String, String>) -> Result<String, KeepError> {
+    let mut out = String::with_capacity(generated.len());
+    let mut used = Vec::new();
+    let mut skipping: Option<String> = None;
+    for line in generated.lines() {
+        let trimmed = line.trim();
+        if let Some(name) = &skipping {
+            if trimmed == close(name) {
+                out.push_str(line);
+                out.push('\n');
+                skipping = None;
+            }
+            continue;
+        }
+        out.push_str(line);
+        out.push('\n');
+        if let Some(name) = marker_name(trimmed)
+            && let Some(text) = kept.get(name)
+        {
+            if !text.is_empty() {
+                out.push_str(text);
+                out.push('\n');
+            }
+            used.push(name.to_string());
+            skipping = Some(name.to_string());
+        }
+    }
+    if let Some(name) = skipping {
+        return Err(KeepError::Unclosed {
+            name,
+            line: generated.lines().count(),
+        });
+    }
+    let orphans: Vec<_> = kept.iter().filter(|(n, _)| !used.contains(n)).collect();
+    if !orphans.is_empty() {
+        out.push_str("\n## Kept notes whose section no longer exists\n\n");
+        for (name, text) in orphans {
+            out.push_str(&region(name, text));
+            out.push('\n');
+        }
+    }
+    Ok(out)
+}
+
+fn marker_name(line: &str) -> Option<&str> {
+    line.strip_prefix("<!-- keep:")?
+        .strip_suffix("-->")
+        .map(str::trim)
+        .filter(|n| !n.is_empty())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn kept_text_survives_regeneration() {
+        let old = format!(
+            "# Old\nnumber 1\n{}\nfooter\n",
+            region("strong", "My reading:\nserial work dominates.")
+        );
+        let new = format!(
+            "# New\nnumber 2\n{}\nfooter 2\n",
+            region("strong", "(write here)")
+        );
+        let merged = merge(&new, &extract(&old).unwrap()).unwrap();
+        assert!(merged.contains("number 2"));
+        assert!(merged.contains("My reading:\nserial work dominates."));
+        assert!(!merged.contains("(write here)"));
+        // Idempotent: merging again with its own regions changes nothing.
+        assert_eq!(merge(&merged, &extract(&merged).unwrap()).unwrap(), merged);
+    }
+
+    #[test]
+    fn new_regions_keep_their_default_and_orphans_are_not_lost() {
+        let old = region("gone", "text of a removed section");
+        let new = region("fresh", "default");
+        let merged = merge(&new, &extract(&old).unwrap()).unwrap();
+        assert!(merged.contains("default"));
+        assert!(merged.contains("text of a removed section"));
+        assert!(merged.contains("no longer exists"));
+    }
+
+    #[test]
+    fn malformed_markers_are_errors() {
+        let unclosed = "a\n<!-- keep:x -->\nb\n";
+        assert_eq!(
+            extract(unclosed),
+            Err(KeepError::Unclosed {
+                name: "x".into(),
+                line: 2
+            })
+        );
+        let twice = format!("{}{}", region("x", "a"), region("x", "b"));
+        assert!(matches!(extract(&twice), Err(KeepError::Duplicate { .. })));
+    }
+}

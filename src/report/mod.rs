@@ -1,0 +1,3 @@
+//! `report`: REPORT.md generated from committed results.
+
+pub mod keep;

@@ -1,0 +1,87 @@
+//! `analyze` on the committed quick sweep, and on bad input.
+
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_nbody-bench"))
+}
+
+#[test]
+fn analyze_committed_quick_sweep_writes_fits_summary_and_figures() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = bin()
+        .args(["analyze", "results/quick/results.json", "--out"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let fits: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("fits.json")).unwrap())
+            .unwrap();
+    assert_eq!(fits["schema"], "nbody-bench/fits/v1");
+    let strong = fits["strong"].as_array().unwrap();
+    assert!(!strong.is_empty());
+    let f = &strong[0]["fit"]["fit"]["serial_fraction"];
+    assert!(f["estimate"].as_f64().unwrap() >= 0.0 && f["ci95"].as_array().unwrap().len() == 2);
+    let summary = std::fs::read_to_string(dir.path().join("summary.md")).unwrap();
+    assert!(summary.contains("## Strong scaling") && summary.contains("Amdahl f"));
+    for stem in [
+        "speedup-galaxy-n2000-f64",
+        "phases-lj-box",
+        "percentiles-galaxy",
+    ] {
+        for ext in ["svg", "png"] {
+            let path = dir.path().join(format!("{stem}.{ext}"));
+            assert!(
+                std::fs::metadata(&path)
+                    .map(|m| m.len() > 0)
+                    .unwrap_or(false),
+                "{path:?} missing"
+            );
+        }
+        assert!(summary.contains(&format!("({stem}.svg)")));
+    }
+    // Deterministic: a second analysis gives the same fits.
+    let again = tempfile::tempdir().unwrap();
+    let status = bin()
+        .args(["analyze", "results/quick/results.json", "--out"])
+        .arg(again.path())
+        .output()
+        .unwrap()
+        .status;
+    assert!(status.success());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("fits.json")).unwrap(),
+        std::fs::read_to_string(again.path().join("fits.json")).unwrap()
+    );
+}
+
+#[test]
+fn analyze_refuses_truncated_and_foreign_files_with_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let text = std::fs::read_to_string("results/quick/results.json").unwrap();
+    let truncated = dir.path().join("truncated.json");
+    std::fs::write(&truncated, &text[..text.len() / 2]).unwrap();
+    let foreign = dir.path().join("foreign.json");
+    std::fs::write(&foreign, r#"{"schema": "other/v9"}"#).unwrap();
+    for (file, needle) in [
+        (&truncated, "not a valid results file"),
+        (&foreign, "schema"),
+    ] {
+        let out = bin()
+            .arg("analyze")
+            .arg(file)
+            .arg("--out")
+            .arg(dir.path().join("out"))
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{err}");
+        assert!(!dir.path().join("out").join("fits.json").exists());
+    }
+}
