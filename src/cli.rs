@@ -37,6 +37,19 @@ pub enum Command {
     Fit(FitArgs),
     /// Refit and re-plot a saved sweep: writes fits.json, summary.md and the figures (SVG + PNG).
     Analyze(AnalyzeArgs),
+    /// Regenerate REPORT.md from the committed results (every number and figure from a results
+    /// file); hand-written text between `<!-- keep:NAME -->` markers is kept.
+    Report(ReportArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ReportArgs {
+    /// Directory with one sub-directory per sweep, each holding results.json.
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    pub results: PathBuf,
+    /// The report to write (its kept regions are carried over).
+    #[arg(long, value_name = "FILE", default_value = "REPORT.md")]
+    pub out: PathBuf,
 }
 
 #[derive(Debug, Args)]

@@ -4,6 +4,7 @@ mod analyze;
 mod fit;
 mod fit_tables;
 mod list;
+mod report;
 mod run;
 mod sweep;
 mod validate;
@@ -22,6 +23,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Validate(args) => validate::validate(args),
         Command::Sweep(args) => sweep::sweep(args),
         Command::Analyze(args) => analyze::analyze(args),
+        Command::Report(args) => report::report(args),
         Command::Fit(args) => fit::fit(args),
     }
 }

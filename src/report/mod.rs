@@ -1,3 +1,179 @@
-//! `report`: REPORT.md generated from committed results.
+//! `report`: the performance characterization (REPORT.md) generated from committed results.
+//!
+//! Every number and figure comes from a results file under the results directory: each sweep
+//! is analysed into `<results>/<name>/analysis/` (fits and figures), and the document links
+//! those figures by relative path. Hand-written interpretation lives in kept regions
+//! ([`keep`]) that regeneration carries over, so the command never destroys analysis, and the
+//! same files always give the same text.
 
 pub mod keep;
+mod sections;
+
+use crate::analysis::{self, Analysis};
+use crate::experiment::results::{ResultsError, ResultsFile};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum ReportError {
+    #[error(
+        "cannot read the results directory {path}: {source}; pass --results DIR with one sub-directory per sweep"
+    )]
+    Dir {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "no results files (<sweep>/results.json) under {path}; run the sweeps first: scripts/report.sh"
+    )]
+    NoResults { path: PathBuf },
+    #[error(transparent)]
+    Results(#[from] ResultsError),
+    #[error(transparent)]
+    Analysis(#[from] analysis::AnalysisError),
+    #[error("{path}: {source}; fix or remove the kept-region markers and run again")]
+    Keep {
+        path: PathBuf,
+        source: keep::KeepError,
+    },
+    #[error("cannot read the existing report {path}: {source}")]
+    ReadOld {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Write(#[from] crate::output::WriteError),
+}
+
+/// One analysed sweep and where its figures are, relative to the report.
+pub struct Sweep {
+    pub analysis: Analysis,
+    /// Directory of the figures relative to the report's directory, with `/` separators.
+    pub figures_dir: String,
+    pub figures: Vec<analysis::figures::Figure>,
+}
+
+/// What `generate` wrote.
+pub struct Generated {
+    pub path: PathBuf,
+    pub sweeps: usize,
+    pub figures: usize,
+    pub figure_errors: Vec<String>,
+}
+
+/// The results files under `dir`: `dir/<name>/results.json`, sorted by name.
+pub fn find_results(dir: &Path) -> Result<Vec<PathBuf>, ReportError> {
+    let entries = std::fs::read_dir(dir).map_err(|source| ReportError::Dir {
+        path: dir.into(),
+        source,
+    })?;
+    let mut files: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok())
+        .map(|e| e.path().join("results.json"))
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    if files.is_empty() {
+        return Err(ReportError::NoResults { path: dir.into() });
+    }
+    Ok(files)
+}
+
+/// Analyses every sweep under `results_dir` and writes the report to `out`, keeping the
+/// hand-written regions of the report already there.
+pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError> {
+    let files = find_results(results_dir)?;
+    // Load everything before writing anything: a bad file must not leave a half-updated report.
+    let loaded: Vec<(PathBuf, ResultsFile)> = files
+        .into_iter()
+        .map(|f| ResultsFile::load(&f).map(|r| (f, r)))
+        .collect::<Result<_, _>>()?;
+    let analyses: Vec<(PathBuf, Analysis)> = loaded
+        .iter()
+        .map(|(f, r)| analysis::analyze(r, &relative_source(f)).map(|a| (f.clone(), a)))
+        .collect::<Result<_, _>>()?;
+    let report_dir = out
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let mut sweeps = Vec::new();
+    let mut figure_errors = Vec::new();
+    for (file, a) in analyses {
+        let dir = file
+            .parent()
+            .expect("results files are in a directory")
+            .join("analysis");
+        let written = analysis::write(&a, &dir)?;
+        figure_errors.extend(written.figure_errors);
+        sweeps.push(Sweep {
+            figures_dir: relative(&dir, report_dir),
+            figures: written.figures,
+            analysis: a,
+        });
+    }
+    let generated = sections::document(&sweeps, results_dir);
+    let old = match std::fs::read_to_string(out) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(source) => {
+            return Err(ReportError::ReadOld {
+                path: out.into(),
+                source,
+            });
+        }
+    };
+    let keep_err = |source| ReportError::Keep {
+        path: out.into(),
+        source,
+    };
+    let kept = keep::extract(&old).map_err(keep_err)?;
+    let text = keep::merge(&generated, &kept).map_err(keep_err)?;
+    crate::output::write_atomic(out, text.as_bytes())?;
+    Ok(Generated {
+        path: out.into(),
+        sweeps: sweeps.len(),
+        figures: sweeps.iter().map(|s| s.figures.len()).sum(),
+        figure_errors,
+    })
+}
+
+/// The path as given, with `/` separators, so the report does not depend on the machine.
+fn relative_source(path: &Path) -> PathBuf {
+    PathBuf::from(path.to_string_lossy().replace('\\', "/"))
+}
+
+/// `target` relative to `base` when it lies under it (the usual layout: REPORT.md at the top,
+/// results below), else as given.
+fn relative(target: &Path, base: &Path) -> String {
+    let clean = |p: &Path| -> Vec<String> {
+        p.components()
+            .filter(|c| !matches!(c, std::path::Component::CurDir))
+            .map(|c| c.as_os_str().to_string_lossy().into_owned())
+            .collect()
+    };
+    let (t, b) = (clean(target), clean(base));
+    let rel = if t.starts_with(&b) {
+        &t[b.len()..]
+    } else {
+        &t[..]
+    };
+    rel.join("/")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn figure_paths_are_relative_to_the_report() {
+        assert_eq!(
+            relative(Path::new("results/strong/analysis"), Path::new(".")),
+            "results/strong/analysis"
+        );
+        assert_eq!(
+            relative(Path::new("./results/a/analysis"), Path::new("./")),
+            "results/a/analysis"
+        );
+        assert_eq!(relative(Path::new("/x/r/a"), Path::new("/x")), "r/a");
+    }
+}
