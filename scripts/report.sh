@@ -1,0 +1,33 @@
+#!/usr/bin/env bash
+# Measures every sweep REPORT.md uses, then regenerates the report from results/.
+#
+#   scripts/report.sh            measure what is missing or unfinished (resumes), then report
+#   scripts/report.sh --fresh    measure everything again (old results kept as .bak copies)
+#   scripts/report.sh --report   only regenerate REPORT.md from the committed results
+#
+# About 30 minutes on the reference machine (2 vCPUs). Run it on a quiet machine: the sweeps
+# record the background load they saw, and the report shows it.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+CONFIGS=(complexity complexity-large strong weak weak-time octree-accuracy)
+mode="${1:-}"
+cargo build --release --quiet
+bin=target/release/nbody-bench
+
+if [[ "$mode" != "--report" ]]; then
+    for name in "${CONFIGS[@]}"; do
+        echo "== sweep configs/$name.toml"
+        if [[ "$mode" == "--fresh" ]]; then
+            "$bin" sweep --config "configs/$name.toml" --fresh
+        elif [[ -f "results/$name/results.json" ]]; then
+            "$bin" sweep --config "configs/$name.toml" --resume
+        else
+            "$bin" sweep --config "configs/$name.toml"
+        fi
+    done
+    if [[ -x scripts/mpi-report.sh ]]; then
+        scripts/mpi-report.sh
+    fi
+fi
+"$bin" report --results results --out REPORT.md
