@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Measures every sweep REPORT.md uses, then regenerates the report from results/.
 #
-#   scripts/report.sh            measure what is missing or unfinished (resumes), then report
+#   scripts/report.sh            measure what is missing or unfinished (resumes with this build), then report
 #   scripts/report.sh --fresh    measure everything again (old results kept as .bak copies)
 #   scripts/report.sh --report   only regenerate REPORT.md from the committed results
 #
@@ -21,7 +21,7 @@ if [[ "$mode" != "--report" ]]; then
         if [[ "$mode" == "--fresh" ]]; then
             "$bin" sweep --config "configs/$name.toml" --fresh
         elif [[ -f "results/$name/results.json" ]]; then
-            "$bin" sweep --config "configs/$name.toml" --resume
+            "$bin" sweep --config "configs/$name.toml" --resume --force
         else
             "$bin" sweep --config "configs/$name.toml"
         fi
