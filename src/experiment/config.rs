@@ -95,6 +95,11 @@ pub struct Measure {
     /// Also measure the force error against an f64 direct sum on this many sampled particles
     /// (0 = off).
     pub force_error_sample: usize,
+    /// Seconds of a fixed reference workload (see `experiment::reference`) timed around every
+    /// case in every round, half before the warm-up and half after the samples, on the case's
+    /// threads (0 = off). `gate` divides the case's times by it, so a machine that is slower
+    /// while a case runs is not mistaken for a slower kernel.
+    pub reference_s: f64,
 }
 
 impl Default for Measure {
@@ -107,6 +112,7 @@ impl Default for Measure {
             budget_s: 0.0,
             max_energy_drift: 0.05,
             force_error_sample: 0,
+            reference_s: 0.0,
         }
     }
 }
@@ -323,6 +329,7 @@ impl SweepConfig {
             ("measure.warmup_s", m.warmup_s),
             ("measure.min_sample_s", m.min_sample_s),
             ("measure.budget_s", m.budget_s),
+            ("measure.reference_s", m.reference_s),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(bad(key, format!("must be a finite number >= 0 (got {v})")));

@@ -2,6 +2,8 @@
 //! phase timers, work counters and physics sanity.
 
 use super::plan::Case;
+use super::reference::time_reference;
+use super::slowdown::TestSlowdown;
 use crate::engine::{PhaseTimes, Simulation};
 use crate::kernels::{KernelParams, WorkCounters};
 use crate::physics::PairLaw;
@@ -71,6 +73,10 @@ pub struct RoundSpec {
     /// choose from the warm-up.
     pub steps_per_sample: Option<u64>,
     pub force_error_sample: usize,
+    /// Seconds of the reference workload to time around the case (0 = none).
+    pub reference_s: f64,
+    /// The test-only slowdown knob, if set (see `experiment::slowdown`).
+    pub slowdown: Option<TestSlowdown>,
 }
 
 /// What one round measured. Times are per step.
@@ -98,6 +104,14 @@ pub struct RoundOutcome {
     pub n: usize,
     /// Cost of one clock reading relative to the median step (the timing overhead).
     pub clock_overhead: f64,
+    /// Wall time of each repetition of the reference workload on the case's threads, timed
+    /// half before the warm-up and half after the samples, seconds; empty when not asked.
+    #[serde(default)]
+    pub reference_s: Vec<f64>,
+    /// Work of one force computation on the initial state (built from the seed, before the
+    /// warm-up): the same in every run of the same code, whatever the timing.
+    #[serde(default)]
+    pub initial_work: Option<WorkCounters>,
 }
 
 /// Measures a round of `case` on the system it is given.
@@ -116,7 +130,10 @@ impl<C: Clock> SystemJob for MeasureJob<'_, C> {
             ..KernelParams::default()
         };
         let law = system.law;
-        let kernel = self.case.kernel.build::<T, L, D>(law, &params)?;
+        let kernel = TestSlowdown::apply(
+            self.spec.slowdown,
+            self.case.kernel.build::<T, L, D>(law, &params)?,
+        );
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.case.threads)
             .build()
@@ -136,6 +153,11 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
 ) -> Result<RoundOutcome, RunError> {
     let n = sim.state.len();
     let e0 = sim.probe().total();
+    let initial_work = sim.probe_work();
+    let mut reference = Vec::new();
+    if spec.reference_s > 0.0 {
+        reference = time_reference(clock, spec.reference_s / 2.0);
+    }
     // Warm-up: untimed for the results, but its step times choose the sample length.
     let warm_start = clock.now();
     let mut warm = Vec::new();
@@ -166,6 +188,9 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         samples.push(sum as f64 * 1e-9 / k as f64);
     }
     let steps = sim.step - steps0;
+    if spec.reference_s > 0.0 {
+        reference.extend(time_reference(clock, spec.reference_s / 2.0));
+    }
     let e1 = sim.probe().total();
     if !e1.is_finite() {
         return Err(RunError::EnergyBlowUp {
@@ -215,6 +240,8 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         } else {
             0.0
         },
+        reference_s: reference,
+        initial_work: Some(initial_work),
     })
 }
 
