@@ -12,6 +12,7 @@ pub mod cli;
 pub mod commands;
 pub mod engine;
 pub mod experiment;
+pub mod gate;
 pub mod integrator;
 pub mod kernels;
 pub mod output;

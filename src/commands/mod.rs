@@ -1,5 +1,6 @@
 //! The subcommands. Each returns the process exit code or an error (reported with exit code 2).
 
+mod gate;
 mod list;
 mod run;
 mod sweep;
@@ -18,6 +19,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
         Command::Sweep(args) => sweep::sweep(args),
+        Command::Gate(args) => gate::gate(args),
     }
 }
 
