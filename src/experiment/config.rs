@@ -95,10 +95,10 @@ pub struct Measure {
     /// Also measure the force error against an f64 direct sum on this many sampled particles
     /// (0 = off).
     pub force_error_sample: usize,
-    /// Seconds of a fixed reference workload (see `experiment::reference`) timed around every
-    /// case in every round, half before the warm-up and half after the samples, on the case's
-    /// threads (0 = off). `gate` divides the case's times by it, so a machine that is slower
-    /// while a case runs is not mistaken for a slower kernel.
+    /// Seconds of a fixed reference workload (see `experiment::reference`) run on the case's
+    /// threads right before each sample (0 = off); about `min_sample_s` pairs each sample with
+    /// an equally long reference. `gate` divides each sample by its reference, so a machine
+    /// that is slower, or shared, while a case runs is not mistaken for a slower kernel.
     pub reference_s: f64,
 }
 

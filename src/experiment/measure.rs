@@ -73,7 +73,7 @@ pub struct RoundSpec {
     /// choose from the warm-up.
     pub steps_per_sample: Option<u64>,
     pub force_error_sample: usize,
-    /// Seconds of the reference workload to time around the case (0 = none).
+    /// Seconds of the reference workload to time before each sample (0 = none).
     pub reference_s: f64,
     /// The test-only slowdown knob, if set (see `experiment::slowdown`).
     pub slowdown: Option<TestSlowdown>,
@@ -104,8 +104,9 @@ pub struct RoundOutcome {
     pub n: usize,
     /// Cost of one clock reading relative to the median step (the timing overhead).
     pub clock_overhead: f64,
-    /// Wall time of each repetition of the reference workload on the case's threads, timed
-    /// half before the warm-up and half after the samples, seconds; empty when not asked.
+    /// Mean wall time of one repetition of the reference workload on the case's threads, timed
+    /// right before each sample (one value per sample, in the same order), seconds; empty when
+    /// not asked.
     #[serde(default)]
     pub reference_s: Vec<f64>,
     /// Work of one force computation on the initial state (built from the seed, before the
@@ -154,10 +155,6 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
     let n = sim.state.len();
     let e0 = sim.probe().total();
     let initial_work = sim.probe_work();
-    let mut reference = Vec::new();
-    if spec.reference_s > 0.0 {
-        reference = time_reference(clock, spec.reference_s / 2.0);
-    }
     // Warm-up: untimed for the results, but its step times choose the sample length.
     let warm_start = clock.now();
     let mut warm = Vec::new();
@@ -175,8 +172,12 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         .unwrap_or_else(|| ((spec.min_sample_s / typical).ceil() as u64).clamp(1, 1_000_000));
     let (phases0, work0, steps0) = (sim.phases, sim.work, sim.step);
     let mut samples = Vec::with_capacity(spec.samples);
+    let mut reference = Vec::new();
     let mut step_ns = Vec::with_capacity(spec.samples * k as usize);
     for _ in 0..spec.samples {
+        if spec.reference_s > 0.0 {
+            reference.push(time_reference(clock, spec.reference_s));
+        }
         let mut sum = 0u64;
         for _ in 0..k {
             let t = clock.now();
@@ -188,9 +189,6 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         samples.push(sum as f64 * 1e-9 / k as f64);
     }
     let steps = sim.step - steps0;
-    if spec.reference_s > 0.0 {
-        reference.extend(time_reference(clock, spec.reference_s / 2.0));
-    }
     let e1 = sim.probe().total();
     if !e1.is_finite() {
         return Err(RunError::EnergyBlowUp {

@@ -1,38 +1,39 @@
-//! The reference workload: a fixed amount of work, independent of every kernel, timed around
-//! each case of a sweep (`measure.reference_s`) so that `gate` can tell a slower kernel from a
-//! slower machine.
+//! The reference workload: a fixed amount of work, independent of every kernel, timed next to
+//! every sample of a case (`measure.reference_s`) so that `gate` can tell a slower kernel from
+//! a slower machine.
 //!
-//! Shared CI machines change speed from minute to minute (other tenants, the SMT sibling of a
-//! vCPU, frequency): the same code can measure 2-4x apart. Dividing a case's step time by the
-//! time of a fixed workload measured on the same threads, just before and just after the case,
-//! cancels what the two have in common. The workload is the calibration's FMA loop, a fixed
-//! number of iterations run by every thread of the case's pool; it shares no code with the
-//! kernels, so a kernel made slower cannot make the reference slower and hide itself.
+//! On a shared machine most of the noise is time-sharing: other processes take the CPU away
+//! for whole scheduler slices, and the same code measures 2-4x apart from one minute to the
+//! next. A reference that runs in short bursts, or only at the start and end of a sweep, sees
+//! the machine's speed while it ran, not the share of the CPU the case got. So the reference is
+//! run right before each sample, for about as long as a sample, on the same threads: the two
+//! then see nearly the same share of the machine, and their ratio cancels it. The workload is
+//! the calibration's FMA loop, a fixed number of iterations run by every thread of the case's
+//! pool (a 2-thread case waits for its slowest thread at every step; so does the broadcast). It
+//! shares no code with the kernels, so a kernel made slower cannot make the reference slower
+//! and hide itself.
 
 use super::measure::Clock;
 
-/// Iterations of the FMA loop in one repetition: about 0.3 ms with AVX-512 on the reference
-/// machine (12 chains of 16 lanes, ~110 GFLOP/s), long enough for the clock and a rayon
-/// broadcast (~20 us) to be small, short enough for many repetitions in a few milliseconds.
-pub const REFERENCE_ITERS: u64 = 100_000;
+/// Iterations of the FMA loop in one repetition: about 0.1 ms with AVX-512 on the reference
+/// machine (12 chains of 16 lanes at ~110 GFLOP/s), long enough for the clock to be negligible,
+/// short enough to fill a sample's duration closely.
+pub const REFERENCE_ITERS: u64 = 50_000;
 
-/// Fewest repetitions on each side of a case, whatever the budget.
+/// Fewest repetitions in one measurement, whatever the budget.
 const MIN_REPETITIONS: usize = 3;
 
-/// Times repetitions of the reference workload on every thread of the current rayon pool until
-/// `budget_s` has passed (at least [`MIN_REPETITIONS`]); returns the wall time of each, seconds.
-pub fn time_reference<C: Clock>(clock: &C, budget_s: f64) -> Vec<f64> {
+/// Runs repetitions of the reference workload on every thread of the current rayon pool until
+/// `budget_s` has passed (at least [`MIN_REPETITIONS`]); returns the mean wall time of one
+/// repetition, seconds.
+pub fn time_reference<C: Clock>(clock: &C, budget_s: f64) -> f64 {
     let start = clock.now();
-    let mut times = Vec::new();
-    while times.len() < MIN_REPETITIONS || (clock.now() - start).as_secs_f64() < budget_s {
-        let t = clock.now();
+    let mut reps = 0;
+    while reps < MIN_REPETITIONS || (clock.now() - start).as_secs_f64() < budget_s {
         rayon::broadcast(|_| std::hint::black_box(crate::calibrate::fma_burst(REFERENCE_ITERS)));
-        times.push((clock.now() - t).as_secs_f64());
-        if times.len() >= 100_000 {
-            break;
-        }
+        reps += 1;
     }
-    times
+    (clock.now() - start).as_secs_f64() / reps as f64
 }
 
 #[cfg(test)]
@@ -43,20 +44,18 @@ mod tests {
 
     #[test]
     fn repeats_until_the_budget_with_a_minimum() {
-        // Every clock reading advances 1 ms: a repetition reads twice (1 ms), plus one budget
-        // check per repetition.
+        // Every clock reading advances 1 ms: one reading at the start, one budget check per
+        // repetition once the minimum is done, one at the end.
         let clock = MockClock::new(Duration::from_millis(1));
-        let t = time_reference(&clock, 0.0);
-        assert_eq!(t.len(), MIN_REPETITIONS);
-        assert!(t.iter().all(|&x| (x - 1e-3).abs() < 1e-12), "{t:?}");
-        let t = time_reference(&clock, 0.02);
-        assert!(t.len() >= 6 && t.len() <= 11, "{}", t.len());
+        assert!((time_reference(&clock, 0.0) - 2e-3 / 3.0).abs() < 1e-12);
+        // Checks 1, 2, ..., 10 ms after the start: 3 + 9 repetitions in 11 ms.
+        let t = time_reference(&clock, 0.0095);
+        assert!((t - 11e-3 / 12.0).abs() < 1e-12, "{t}");
     }
 
     #[test]
     fn real_repetitions_take_time() {
         let t = time_reference(&WallClock::new(), 0.0);
-        assert_eq!(t.len(), MIN_REPETITIONS);
-        assert!(t.iter().all(|&x| x > 1e-6 && x < 1.0), "{t:?}");
+        assert!(t > 1e-6 && t < 1.0, "{t}");
     }
 }

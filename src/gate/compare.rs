@@ -130,13 +130,12 @@ fn median_of(values: &[f64]) -> f64 {
     median(values).unwrap_or(f64::NAN)
 }
 
-/// Whether every round of the case with samples also timed the reference workload.
+/// Whether every sample of the case has its reference measurement.
 fn has_reference(record: &CaseRecord) -> bool {
-    record
-        .rounds
-        .iter()
-        .filter(|r| !r.samples_s.is_empty())
-        .all(|r| median(&r.reference_s).is_some_and(|m| m > 0.0))
+    record.rounds.iter().all(|r| {
+        r.reference_s.len() == r.samples_s.len()
+            && r.reference_s.iter().all(|x| x.is_finite() && *x > 0.0)
+    })
 }
 
 /// The FMA rate of the sweep's calibrations (mean of start and end), GFLOP/s.
@@ -185,8 +184,9 @@ fn choose_normalization(
     })
 }
 
-/// The case's samples divided by the machine measurement `how` chooses (dimensionless for the
-/// reference, GFLOP for the calibration, seconds for none).
+/// The case's samples divided by the machine measurement `how` chooses: each sample by the
+/// reference timed right before it (dimensionless), or by the time of a GFLOP at the
+/// calibrated rate, or nothing (seconds).
 fn normalized(file: &ResultsFile, record: &CaseRecord, how: Normalization) -> Vec<f64> {
     match how {
         Normalization::None => samples(record),
@@ -197,10 +197,7 @@ fn normalized(file: &ResultsFile, record: &CaseRecord, how: Normalization) -> Ve
         Normalization::Reference => record
             .rounds
             .iter()
-            .flat_map(|r| {
-                let reference = median(&r.reference_s).unwrap_or(f64::NAN);
-                r.samples_s.iter().map(move |s| s / reference)
-            })
+            .flat_map(|r| r.samples_s.iter().zip(&r.reference_s).map(|(s, r)| s / r))
             .filter(|s| s.is_finite() && *s > 0.0)
             .collect(),
     }

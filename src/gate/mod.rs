@@ -75,9 +75,8 @@ pub enum NormalizationChoice {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Normalization {
-    /// Each round's samples by the median time of the reference workload timed around that
-    /// round of that case, on the same threads (`measure.reference_s`): tracks the machine's
-    /// speed while the case ran.
+    /// Each sample by the reference workload timed right before it, on the same threads, for
+    /// about as long (`measure.reference_s`): tracks the share of the machine the case got.
     Reference,
     /// Every sample by the time of the sweep's calibrated FMA rate (mean of the start and end
     /// calibrations): tracks the machine's speed at the start and end of the sweep only.
@@ -89,7 +88,7 @@ pub enum Normalization {
 impl Normalization {
     pub fn describe(self) -> &'static str {
         match self {
-            Normalization::Reference => "the reference workload timed around each case",
+            Normalization::Reference => "the reference workload timed before each sample",
             Normalization::Calibration => "the sweep's calibrated FMA rate",
             Normalization::None => "nothing (raw times)",
         }

@@ -112,7 +112,7 @@ fn results(run: Run) -> ResultsFile {
                 force_error: None,
                 n: 1000,
                 clock_overhead: 1e-5,
-                reference_s: (0..6).map(|_| jitter(3e-4 * run.machine)).collect(),
+                reference_s: (0..4).map(|_| jitter(1e-4 * run.machine)).collect(),
                 initial_work: Some(WorkCounters {
                     pair_checks: 999_000,
                     pairs_interacting: 500,
