@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every check of the project: formatting, lints, unit and integration tests, the benches
-# (once each), the force validation of every scenario, and the performance gate. Works on a fresh machine with a Rust toolchain.
+# (once each), the force validation of every scenario, and the performance gate. Works on a
+# fresh machine with a Rust toolchain.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
