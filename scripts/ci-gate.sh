@@ -22,7 +22,12 @@ lock=()
 if command -v flock >/dev/null 2>&1; then
     lock=(flock /tmp/nbody-bench.lock)
 fi
-"${lock[@]}" cargo run --release --quiet -- sweep --config configs/ci.toml --out "$out" >"$out/sweep.log"
+echo "performance gate: sweeping configs/ci.toml (about 20 s)" >&2
+if ! "${lock[@]}" cargo run --release --quiet -- sweep --config configs/ci.toml --out "$out" \
+    >"$out/sweep.log" 2>&1; then
+    cat "$out/sweep.log" >&2
+    exit 2
+fi
 current="$out/ci/results.json"
 
 status=0

@@ -76,7 +76,13 @@ fn origin(info: &super::RunInfo) -> String {
 
 fn text(report: &GateReport) -> String {
     let mut s = String::new();
-    let verdict = if report.failed() { "FAIL" } else { "ok" };
+    let verdict = if report.failed() {
+        "FAIL"
+    } else if !report.missing.is_empty() {
+        "INCOMPLETE"
+    } else {
+        "ok"
+    };
     let _ = writeln!(s, "gate {verdict}: {}", headline(report));
     let _ = writeln!(s, "baseline {}", origin(&report.baseline));
     let _ = writeln!(s, "current  {}", origin(&report.current));

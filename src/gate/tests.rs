@@ -289,6 +289,7 @@ fn missing_and_extra_cases_are_reported() {
     assert_eq!(report.cases.len(), 1);
     assert_eq!(report.exit_code(), 2);
     let text = render(&report, Format::Text);
+    assert!(text.starts_with("gate INCOMPLETE: 1 cases"), "{text}");
     assert!(
         text.contains(&format!("missing: {}", removed.key)),
         "{text}"
