@@ -22,7 +22,7 @@ pub(super) const CHAINS: usize = 12;
 /// gathers/scatters or shuffled lanes through the stack every iteration, which would have
 /// measured the compiler, not the machine. Explicit vectors compile to exactly `CHAINS` FMAs
 /// per iteration at any optimisation level.
-pub(crate) fn fma_burst(iters: u64) -> f64 {
+pub(super) fn fma_burst(iters: u64) -> f64 {
     let (lanes, result) = fma_loop(iters);
     black_box(result);
     2.0 * (iters as f64) * (CHAINS * lanes) as f64

@@ -199,8 +199,6 @@ mod fork_join;
 mod load;
 mod memory;
 
-/// The FMA loop, also the fixed reference workload of `experiment::reference`.
-pub(crate) use compute::fma_burst;
 use compute::*;
 use fork_join::*;
 use load::*;

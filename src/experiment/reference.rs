@@ -3,22 +3,31 @@
 //! a slower machine.
 //!
 //! On a shared machine most of the noise is time-sharing: other processes take the CPU away
-//! for whole scheduler slices, and the same code measures 2-4x apart from one minute to the
-//! next. A reference that runs in short bursts, or only at the start and end of a sweep, sees
+//! for whole scheduler slices, and the same code measures up to 1.5x apart from one minute to
+//! the next. A reference that runs in short bursts, or only at the start and end of a sweep, sees
 //! the machine's speed while it ran, not the share of the CPU the case got. So the reference is
 //! run right before each sample, for about as long as a sample, on the same threads: the two
-//! then see nearly the same share of the machine, and their ratio cancels it. The workload is
-//! the calibration's FMA loop, a fixed number of iterations run by every thread of the case's
-//! pool (a 2-thread case waits for its slowest thread at every step; so does the broadcast). It
-//! shares no code with the kernels, so a kernel made slower cannot make the reference slower
-//! and hide itself.
+//! then see nearly the same share of the machine, and their ratio cancels it.
+//!
+//! The other noise is the SMT sibling: when another process runs on the other hyperthread of
+//! the core, code slows down by how much it competes for the core's pipes. A peak-rate FMA loop
+//! (the calibration's) suffers more than the kernels do, so it over-corrects: under load a case
+//! looked up to 15% faster than it was, and a baseline taken under load made a quiet run look
+//! up to 15% slower. The workload is therefore a small force loop of the kernels' kind — a
+//! softened 1/r² direct sum in f32 lane arrays with a square root and a division per pair —
+//! written here, not taken from `kernels`, so that a kernel made slower cannot make the
+//! reference slower and hide itself. Every thread of the case's pool runs it (a 2-thread case
+//! waits for its slowest thread at every step; so does the broadcast).
 
 use super::measure::Clock;
+use crate::simd::{self, LANES};
+use std::sync::OnceLock;
 
-/// Iterations of the FMA loop in one repetition: about 0.1 ms with AVX-512 on the reference
-/// machine (12 chains of 16 lanes at ~110 GFLOP/s), long enough for the clock to be negligible,
-/// short enough to fill a sample's duration closely.
-pub const REFERENCE_ITERS: u64 = 50_000;
+/// Target and source particles of one repetition: 128 × 1024 pairs, about 0.1-0.2 ms with
+/// AVX-512 on the reference machine, in a working set of 16 KB (L1).
+const TARGETS: usize = 128;
+const SOURCES: usize = 1024;
+const _: () = assert!(TARGETS <= SOURCES && SOURCES.is_multiple_of(LANES));
 
 /// Fewest repetitions in one measurement, whatever the budget.
 const MIN_REPETITIONS: usize = 3;
@@ -30,10 +39,73 @@ pub fn time_reference<C: Clock>(clock: &C, budget_s: f64) -> f64 {
     let start = clock.now();
     let mut reps = 0;
     while reps < MIN_REPETITIONS || (clock.now() - start).as_secs_f64() < budget_s {
-        rayon::broadcast(|_| std::hint::black_box(crate::calibrate::fma_burst(REFERENCE_ITERS)));
+        if rayon::current_num_threads() > 1 {
+            rayon::broadcast(|_| std::hint::black_box(reference_work()));
+        } else {
+            // On the calling thread: a broadcast's hand-off can sleep and wait to be woken,
+            // which on a busy machine costs whole scheduler slices the case never pays.
+            std::hint::black_box(reference_work());
+        }
         reps += 1;
     }
     (clock.now() - start).as_secs_f64() / reps as f64
+}
+
+/// Fixed particles: positions in the unit cube from a linear congruential generator (the
+/// same on every machine), as structure-of-arrays rows padded to whole lanes.
+struct Particles {
+    pos: [Vec<f32>; 3],
+}
+
+fn particles() -> &'static Particles {
+    static PARTICLES: OnceLock<Particles> = OnceLock::new();
+    PARTICLES.get_or_init(|| {
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let pos = std::array::from_fn(|_| (0..SOURCES).map(|_| next()).collect());
+        Particles { pos }
+    })
+}
+
+/// One repetition: the softened 1/r² field at the first [`TARGETS`] particles from all
+/// [`SOURCES`], compiled for the kernels' instruction set; returns a checksum.
+pub fn reference_work() -> f32 {
+    let p = particles();
+    simd::dispatch(
+        #[inline(always)]
+        || field_sum(&p.pos),
+    )
+}
+
+#[inline(always)]
+fn field_sum(pos: &[Vec<f32>; 3]) -> f32 {
+    const SOFTENING2: f32 = 1e-4;
+    let mut total = 0.0;
+    for i in 0..TARGETS {
+        let xi = [pos[0][i], pos[1][i], pos[2][i]];
+        let mut acc = [[0.0f32; LANES]; 3];
+        for j0 in (0..SOURCES).step_by(LANES) {
+            for l in 0..LANES {
+                let d = [
+                    pos[0][j0 + l] - xi[0],
+                    pos[1][j0 + l] - xi[1],
+                    pos[2][j0 + l] - xi[2],
+                ];
+                let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2] + SOFTENING2;
+                let inv = 1.0 / (r2 * r2.sqrt());
+                for k in 0..3 {
+                    acc[k][l] += d[k] * inv;
+                }
+            }
+        }
+        total += acc.iter().flatten().sum::<f32>();
+    }
+    total
 }
 
 #[cfg(test)]
@@ -51,6 +123,14 @@ mod tests {
         // Checks 1, 2, ..., 10 ms after the start: 3 + 9 repetitions in 11 ms.
         let t = time_reference(&clock, 0.0095);
         assert!((t - 11e-3 / 12.0).abs() < 1e-12, "{t}");
+    }
+
+    #[test]
+    fn the_workload_is_fixed_and_finite() {
+        let a = reference_work();
+        assert!(a.is_finite(), "{a}");
+        assert_eq!(a, reference_work(), "same particles, same order");
+        assert_eq!(particles().pos[0].len(), SOURCES);
     }
 
     #[test]

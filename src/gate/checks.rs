@@ -65,6 +65,13 @@ pub(super) fn check_comparable(
         let differences = config_differences(baseline, current);
         refuse(GateError::OtherConfig { differences }, &mut warnings)?;
     }
+    if let Some(busy) = background_cpus(baseline).filter(|&b| b >= BUSY_BASELINE_CPUS) {
+        warnings.push(format!(
+            "the baseline was measured while other processes used {busy:.1} CPUs: the reference \
+             slows down more than the kernels under load, so a quieter current run reads slower \
+             than it is; refresh the baseline on a quiet machine (scripts/refresh-baseline.sh)"
+        ));
+    }
     for (info, which) in [(&b, "baseline"), (&c, "current")] {
         if let Some(knob) = &info.test_slowdown {
             warnings.push(format!(
@@ -80,6 +87,18 @@ pub(super) fn check_comparable(
         }
     }
     Ok(warnings)
+}
+
+/// Other processes' CPU use, from the calibrations, above which a baseline is called busy.
+const BUSY_BASELINE_CPUS: f64 = 0.25;
+
+/// The most CPUs other processes used during the file's calibrations, if measured.
+fn background_cpus(file: &ResultsFile) -> Option<f64> {
+    [&file.calibration.start, &file.calibration.end]
+        .into_iter()
+        .flatten()
+        .filter_map(|c| c.background_cpus)
+        .reduce(f64::max)
 }
 
 /// The config keys whose values differ, e.g. "n, measure.samples".

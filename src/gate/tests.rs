@@ -351,6 +351,16 @@ fn other_machines_builds_and_configs_are_refused_unless_forced() {
         "{e}"
     );
 
+    let mut busy = results(Run::nominal(SEED_1));
+    busy.calibration.end.as_mut().unwrap().background_cpus = Some(1.4);
+    let report = compare(&busy, &other_host, &GateOptions::default()).unwrap();
+    assert!(
+        report.warnings[0]
+            .starts_with("the baseline was measured while other processes used 1.4 CPUs"),
+        "{:?}",
+        report.warnings
+    );
+
     let forced = GateOptions {
         force: true,
         ..GateOptions::default()
