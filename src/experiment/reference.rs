@@ -9,22 +9,22 @@
 //! run right before each sample, for about as long as a sample, on the same threads: the two
 //! then see nearly the same share of the machine, and their ratio cancels it.
 //!
-//! The other noise is the SMT sibling: when another process runs on the other hyperthread of
-//! the core, code slows down by how much it competes for the core's pipes. A peak-rate FMA loop
-//! (the calibration's) suffers more than the kernels do, so it over-corrects: under load a case
-//! looked up to 15% faster than it was, and a baseline taken under load made a quiet run look
-//! up to 15% slower. The workload is therefore a small force loop of the kernels' kind — a
-//! softened 1/r² direct sum in f32 lane arrays with a square root and a division per pair —
-//! written here, not taken from `kernels`, so that a kernel made slower cannot make the
-//! reference slower and hide itself. Every thread of the case's pool runs it (a 2-thread case
-//! waits for its slowest thread at every step; so does the broadcast).
+//! The workload is a small force loop of the kernels' kind — a softened 1/r² direct sum in f32
+//! lane arrays with a square root and a division per pair, at the kernels' SIMD level — written
+//! here, not taken from `kernels`, so that a kernel made slower cannot make the reference
+//! slower and hide itself. Under load it still slows down a little more than the kernels (about
+//! 3.4x against 2.9x with two busy loops beside it; a peak-rate FMA loop, tried first, did the
+//! same), so a run under more load than its baseline reads slightly faster, and a baseline
+//! should be measured on a quiet machine (README, CI section). Every thread of the case's pool
+//! runs it (a 2-thread case waits for its slowest thread at every step; so does the
+//! broadcast); a 1-thread pool runs it on the calling thread.
 
 use super::measure::Clock;
 use crate::simd::{self, LANES};
 use std::sync::OnceLock;
 
 /// Target and source particles of one repetition: 128 × 1024 pairs, about 0.1-0.2 ms with
-/// AVX-512 on the reference machine, in a working set of 16 KB (L1).
+/// AVX-512 on the reference machine, in a working set of 12 KB (L1).
 const TARGETS: usize = 128;
 const SOURCES: usize = 1024;
 const _: () = assert!(TARGETS <= SOURCES && SOURCES.is_multiple_of(LANES));
