@@ -40,6 +40,9 @@ pub enum Command {
     /// Regenerate REPORT.md from the committed results (every number and figure from a results
     /// file); hand-written text between `<!-- keep:NAME -->` markers is kept.
     Report(ReportArgs),
+    /// Compare a sweep's results with a baseline, case by case; exit 1 if a case got slower
+    /// beyond the threshold (with its whole confidence interval), 2 for bad input.
+    Gate(GateArgs),
 }
 
 #[derive(Debug, Args)]
@@ -265,4 +268,35 @@ pub struct FitArgs {
     /// the one-worker run's work per worker g(n)/p [default: n].
     #[arg(long, value_enum)]
     pub cost: Option<CostModel>,
+}
+
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Example (CI):\n  nbody-bench sweep --config configs/ci.toml --out scratch --fresh\n  \
+    nbody-bench gate --baseline results/baseline/ci.json --current scratch/ci/results.json --format markdown"
+)]
+pub struct GateArgs {
+    /// Results file of the reference run (e.g. results/baseline/ci.json).
+    #[arg(long, value_name = "FILE")]
+    pub baseline: PathBuf,
+    /// Results file of the run to check.
+    #[arg(long, value_name = "FILE")]
+    pub current: PathBuf,
+    /// Relative slowdown a case must exceed, with its whole 95% CI, to count as a regression
+    /// (0.10 = 10%); the same margin below 1 counts as an improvement.
+    #[arg(long, default_value_t = 0.10, value_parser = parse_non_negative, allow_hyphen_values = true)]
+    pub threshold: f64,
+    /// Output format; markdown is made for a CI job summary.
+    #[arg(long, value_enum, default_value = "text")]
+    pub format: crate::gate::Format,
+    /// What the times are divided by before comparing: the reference workload timed around each
+    /// case, the sweep's calibration, or nothing; auto takes the best both files have.
+    #[arg(long, value_enum, default_value = "auto")]
+    pub normalize: crate::gate::NormalizationChoice,
+    /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
+    #[arg(long)]
+    pub force: bool,
+    /// Also fail (exit 1) when a deterministic work counter changed.
+    #[arg(long)]
+    pub fail_on_work_change: bool,
 }

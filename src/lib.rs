@@ -14,6 +14,7 @@ pub mod commands;
 pub mod engine;
 pub mod experiment;
 pub mod fit;
+pub mod gate;
 pub mod integrator;
 pub mod kernels;
 pub mod output;

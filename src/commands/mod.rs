@@ -3,6 +3,7 @@
 mod analyze;
 mod fit;
 mod fit_tables;
+mod gate;
 mod list;
 mod report;
 mod run;
@@ -25,6 +26,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Analyze(args) => analyze::analyze(args),
         Command::Report(args) => report::report(args),
         Command::Fit(args) => fit::fit(args),
+        Command::Gate(args) => gate::gate(args),
     }
 }
 

@@ -95,6 +95,11 @@ pub struct Measure {
     /// Also measure the force error against an f64 direct sum on this many sampled particles
     /// (0 = off).
     pub force_error_sample: usize,
+    /// Seconds of a fixed reference workload (see `experiment::reference`) run on the case's
+    /// threads right before each sample (0 = off); about `min_sample_s` pairs each sample with
+    /// an equally long reference. `gate` divides each sample by its reference, so a machine
+    /// that is slower, or shared, while a case runs is not mistaken for a slower kernel.
+    pub reference_s: f64,
 }
 
 impl Default for Measure {
@@ -107,6 +112,7 @@ impl Default for Measure {
             budget_s: 0.0,
             max_energy_drift: 0.05,
             force_error_sample: 0,
+            reference_s: 0.0,
         }
     }
 }
@@ -323,6 +329,7 @@ impl SweepConfig {
             ("measure.warmup_s", m.warmup_s),
             ("measure.min_sample_s", m.min_sample_s),
             ("measure.budget_s", m.budget_s),
+            ("measure.reference_s", m.reference_s),
         ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err(bad(key, format!("must be a finite number >= 0 (got {v})")));

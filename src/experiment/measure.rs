@@ -2,6 +2,8 @@
 //! phase timers, work counters and physics sanity.
 
 use super::plan::Case;
+use super::reference::time_reference;
+use super::slowdown::TestSlowdown;
 use crate::engine::{PhaseTimes, Simulation};
 use crate::kernels::{KernelParams, WorkCounters};
 use crate::physics::PairLaw;
@@ -71,6 +73,10 @@ pub struct RoundSpec {
     /// choose from the warm-up.
     pub steps_per_sample: Option<u64>,
     pub force_error_sample: usize,
+    /// Seconds of the reference workload to time before each sample (0 = none).
+    pub reference_s: f64,
+    /// The test-only slowdown knob, if set (see `experiment::slowdown`).
+    pub slowdown: Option<TestSlowdown>,
 }
 
 /// What one round measured. Times are per step.
@@ -98,6 +104,15 @@ pub struct RoundOutcome {
     pub n: usize,
     /// Cost of one clock reading relative to the median step (the timing overhead).
     pub clock_overhead: f64,
+    /// Mean wall time of one repetition of the reference workload on the case's threads, timed
+    /// right before each sample (one value per sample, in the same order), seconds; empty when
+    /// not asked.
+    #[serde(default)]
+    pub reference_s: Vec<f64>,
+    /// Work of one force computation on the initial state (built from the seed, before the
+    /// warm-up): the same in every run of the same code, whatever the timing.
+    #[serde(default)]
+    pub initial_work: Option<WorkCounters>,
 }
 
 /// Measures a round of `case` on the system it is given.
@@ -116,7 +131,10 @@ impl<C: Clock> SystemJob for MeasureJob<'_, C> {
             ..KernelParams::default()
         };
         let law = system.law;
-        let kernel = self.case.kernel.build::<T, L, D>(law, &params)?;
+        let kernel = TestSlowdown::apply(
+            self.spec.slowdown,
+            self.case.kernel.build::<T, L, D>(law, &params)?,
+        );
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.case.threads)
             .build()
@@ -136,6 +154,7 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
 ) -> Result<RoundOutcome, RunError> {
     let n = sim.state.len();
     let e0 = sim.probe().total();
+    let initial_work = sim.probe_work();
     // Warm-up: untimed for the results, but its step times choose the sample length.
     let warm_start = clock.now();
     let mut warm = Vec::new();
@@ -153,8 +172,12 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         .unwrap_or_else(|| ((spec.min_sample_s / typical).ceil() as u64).clamp(1, 1_000_000));
     let (phases0, work0, steps0) = (sim.phases, sim.work, sim.step);
     let mut samples = Vec::with_capacity(spec.samples);
+    let mut reference = Vec::new();
     let mut step_ns = Vec::with_capacity(spec.samples * k as usize);
     for _ in 0..spec.samples {
+        if spec.reference_s > 0.0 {
+            reference.push(time_reference(clock, spec.reference_s));
+        }
         let mut sum = 0u64;
         for _ in 0..k {
             let t = clock.now();
@@ -215,6 +238,8 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         } else {
             0.0
         },
+        reference_s: reference,
+        initial_work: Some(initial_work),
     })
 }
 

@@ -4,5 +4,7 @@ pub mod config;
 pub mod measure;
 pub mod plan;
 pub mod progress;
+pub mod reference;
 pub mod results;
 pub mod runner;
+pub mod slowdown;

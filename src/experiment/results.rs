@@ -51,6 +51,10 @@ pub struct Metadata {
     pub os: String,
     /// UTC, ISO 8601, when the sweep started (the first run, not a resume).
     pub started: String,
+    /// The test-only slowdown knob (`NBODY_BENCH_TEST_SLOWDOWN`) the sweep ran with, if any:
+    /// such timings are deliberately wrong.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub test_slowdown: Option<String>,
 }
 
 /// One case: what it is, every raw value, and summaries recomputed from them.
@@ -296,6 +300,7 @@ impl Metadata {
                 .unwrap_or_else(|_| "unknown".into()),
             os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
             started: utc_now(),
+            test_slowdown: None,
         }
     }
 }

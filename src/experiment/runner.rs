@@ -5,6 +5,7 @@ use super::config::SweepConfig;
 use super::measure::{Clock, MeasureJob, RoundSpec};
 use super::plan::{Case, cases};
 use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
+use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
 use crate::scenario::Setup;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -62,6 +63,8 @@ pub enum SweepError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    #[error("{0}")]
+    Slowdown(String),
     #[error("cannot create {path}: {source}")]
     Dir {
         path: PathBuf,
@@ -94,7 +97,16 @@ pub fn run_sweep<C: Clock>(
     observer: &mut dyn Observer,
 ) -> Result<SweepReport, SweepError> {
     let path = results_path(config, options.out.as_deref());
+    let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     let mut results = open(config, config_text, options, &path)?;
+    if let Some(s) = slowdown {
+        observer.message(&format!(
+            "warning: {SLOWDOWN_ENV}={s} is set: {} runs {} times per step (test-only)",
+            s.kernel.name(),
+            s.factor
+        ));
+        results.metadata.test_slowdown = Some(s.to_string());
+    }
     let logical = crate::run::logical_cpus();
     let rounds = config.measure.rounds;
     for case in cases(config) {
@@ -173,6 +185,8 @@ pub fn run_sweep<C: Clock>(
                 min_sample_s: config.measure.min_sample_s,
                 steps_per_sample: (record.rounds_done > 0).then_some(record.steps_per_sample),
                 force_error_sample: config.measure.force_error_sample,
+                reference_s: config.measure.reference_s,
+                slowdown,
             };
             let outcome =
                 measure_case(&record.case, &spec, clock).map_err(|source| SweepError::Case {

@@ -67,6 +67,19 @@ impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
             strips: Strips::new(),
         })
     }
+
+    /// Bins `state` and lays out the source strips without computing any force: the build
+    /// phase of [`ForceKernel::compute`] alone, for benchmarks.
+    pub fn build(&mut self, state: &State<T, D>) {
+        let (strips, rc) = (&mut self.strips, self.rc);
+        simd::dispatch(
+            #[inline(always)]
+            || {
+                strips.sort(state, rc);
+                strips.fill(state);
+            },
+        );
+    }
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T, D> {
@@ -87,14 +100,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
             return report;
         }
         let clock = Instant::now();
-        let (strips, rc) = (&mut self.strips, self.rc);
-        simd::dispatch(
-            #[inline(always)]
-            || {
-                strips.sort(state, rc);
-                strips.fill(state);
-            },
-        );
+        self.build(state);
         report.build_s = clock.elapsed().as_secs_f64();
 
         let (law, strips) = (&self.law, &self.strips);

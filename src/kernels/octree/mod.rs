@@ -64,6 +64,12 @@ impl<L, T: Real, const D: usize> Octree<L, T, D> {
             last_pairs: None,
         }
     }
+
+    /// Builds the tree of `state` (Morton keys, sort, nodes, target groups) without computing
+    /// any force: the build phase of [`ForceKernel::compute`] alone, for benchmarks.
+    pub fn build(&mut self, state: &State<T, D>) {
+        self.tree.build(state);
+    }
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, D> {
@@ -88,7 +94,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
             };
         }
         let started = Instant::now();
-        self.tree.build(state);
+        self.build(state);
         let build_s = started.elapsed().as_secs_f64();
 
         for f in &mut self.sorted_forces {

@@ -1,0 +1,143 @@
+//! Whether two results files may be compared at all: same machine class (CPU model and
+//! logical CPU count, not the host name, since CI runs on a fresh machine of the same class),
+//! same build (SIMD level, profile) and same config. Each mismatch is an error unless forced,
+//! and then a warning in the report.
+
+use super::{GateError, RunInfo};
+use crate::experiment::results::ResultsFile;
+
+/// Checks that the files are comparable; returns the warnings to carry in the report.
+pub(super) fn check_comparable(
+    baseline: &ResultsFile,
+    current: &ResultsFile,
+    force: bool,
+) -> Result<Vec<String>, GateError> {
+    let mut warnings = Vec::new();
+    let refuse = |error: GateError, warnings: &mut Vec<String>| {
+        if force {
+            warnings.push(format!("forced: {error}"));
+            Ok(())
+        } else {
+            Err(error)
+        }
+    };
+    let (b, c) = (RunInfo::of(baseline), RunInfo::of(current));
+    for (info, which) in [(&b, "baseline"), (&c, "current")] {
+        if info.cpu_model.is_none() {
+            refuse(GateError::UnknownMachine { which }, &mut warnings)?;
+        }
+    }
+    if let (Some(bm), Some(cm)) = (&b.cpu_model, &c.cpu_model)
+        && bm != cm
+    {
+        let error = GateError::OtherMachine {
+            what: "CPU model",
+            baseline: bm.clone(),
+            current: cm.clone(),
+        };
+        refuse(error, &mut warnings)?;
+    }
+    if let (Some(bn), Some(cn)) = (b.logical_cpus, c.logical_cpus)
+        && bn != cn
+    {
+        let error = GateError::OtherMachine {
+            what: "logical CPU count",
+            baseline: bn.to_string(),
+            current: cn.to_string(),
+        };
+        refuse(error, &mut warnings)?;
+    }
+    let (bm, cm) = (&baseline.metadata, &current.metadata);
+    for (what, bv, cv) in [
+        ("SIMD level", &bm.simd, &cm.simd),
+        ("profile", &bm.profile, &cm.profile),
+    ] {
+        if bv != cv {
+            let error = GateError::OtherBuild {
+                what,
+                baseline: bv.clone(),
+                current: cv.clone(),
+            };
+            refuse(error, &mut warnings)?;
+        }
+    }
+    if baseline.config != current.config {
+        let differences = config_differences(baseline, current);
+        refuse(GateError::OtherConfig { differences }, &mut warnings)?;
+    }
+    if let Some(busy) = background_cpus(baseline).filter(|&b| b >= BUSY_BASELINE_CPUS) {
+        warnings.push(format!(
+            "the baseline was measured while other processes used {busy:.1} CPUs: the reference \
+             slows down more than the kernels under load, so a quieter current run reads slower \
+             than it is; refresh the baseline on a quiet machine (scripts/refresh-baseline.sh)"
+        ));
+    }
+    for (info, which) in [(&b, "baseline"), (&c, "current")] {
+        if let Some(knob) = &info.test_slowdown {
+            warnings.push(format!(
+                "the {which} run used the test-only slowdown knob ({knob}): its timings are \
+                 deliberately wrong"
+            ));
+        }
+        if info.git_dirty {
+            warnings.push(format!(
+                "the {which} run was measured with uncommitted changes (commit {})",
+                short(&info.git_commit)
+            ));
+        }
+    }
+    Ok(warnings)
+}
+
+/// Other processes' CPU use, from the calibrations, above which a baseline is called busy.
+const BUSY_BASELINE_CPUS: f64 = 0.25;
+
+/// The most CPUs other processes used during the file's calibrations, if measured.
+fn background_cpus(file: &ResultsFile) -> Option<f64> {
+    [&file.calibration.start, &file.calibration.end]
+        .into_iter()
+        .flatten()
+        .filter_map(|c| c.background_cpus)
+        .reduce(f64::max)
+}
+
+/// The config keys whose values differ, e.g. "n, measure.samples".
+fn config_differences(baseline: &ResultsFile, current: &ResultsFile) -> String {
+    let to_value = |f: &ResultsFile| serde_json::to_value(&f.config).unwrap_or_default();
+    let mut out = Vec::new();
+    diff_keys("", &to_value(baseline), &to_value(current), &mut out);
+    if out.is_empty() {
+        "their values".to_string()
+    } else {
+        out.join(", ")
+    }
+}
+
+fn diff_keys(prefix: &str, a: &serde_json::Value, b: &serde_json::Value, out: &mut Vec<String>) {
+    match (a.as_object(), b.as_object()) {
+        (Some(ao), Some(bo)) => {
+            let mut keys: Vec<&String> = ao.keys().chain(bo.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            for k in keys {
+                let (av, bv) = (ao.get(k), bo.get(k));
+                if av != bv {
+                    let name = format!("{prefix}{k}");
+                    match (av, bv) {
+                        (Some(av), Some(bv)) if av.is_object() && bv.is_object() => {
+                            diff_keys(&format!("{name}."), av, bv, out)
+                        }
+                        _ => out.push(name),
+                    }
+                }
+            }
+        }
+        _ if a != b => out.push(prefix.trim_end_matches('.').to_string()),
+        _ => {}
+    }
+}
+
+/// The first 10 characters of a commit hash.
+pub(super) fn short(commit: &str) -> &str {
+    &commit[..commit.len().min(10)]
+}

@@ -1,0 +1,289 @@
+//! Case-by-case comparison: normalisation, the bootstrap CI of the ratio of medians, the
+//! verdict, and the exact comparison of the work counters.
+
+use super::checks::check_comparable;
+use super::{
+    CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, MissingCase, Normalization,
+    NormalizationChoice, RunInfo, Verdict, WorkChange,
+};
+use crate::experiment::results::{CaseRecord, ResultsFile};
+use crate::kernels::WorkCounters;
+use crate::stats::median;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64Mcg;
+
+/// Compares `current` against `baseline`; see the module documentation for the rules.
+pub fn compare(
+    baseline: &ResultsFile,
+    current: &ResultsFile,
+    options: &GateOptions,
+) -> Result<GateReport, GateError> {
+    if !(options.threshold.is_finite() && options.threshold >= 0.0) {
+        return Err(GateError::BadThreshold(options.threshold));
+    }
+    let warnings = check_comparable(baseline, current, options.force)?;
+    let mut report = GateReport {
+        schema: GATE_SCHEMA.to_string(),
+        threshold: options.threshold,
+        fail_on_work_change: options.fail_on_work_change,
+        baseline: RunInfo::of(baseline),
+        current: RunInfo::of(current),
+        cases: Vec::new(),
+        missing: Vec::new(),
+        extra: Vec::new(),
+        warnings,
+    };
+    for base in &baseline.cases {
+        let missing = |reason: &str| MissingCase {
+            key: base.key.clone(),
+            reason: reason.to_string(),
+        };
+        let Some(cur) = current.cases.iter().find(|c| c.key == base.key) else {
+            report.missing.push(missing("not in the current results"));
+            continue;
+        };
+        if samples(base).is_empty() {
+            report.missing.push(missing("no samples in the baseline"));
+        } else if samples(cur).is_empty() {
+            report
+                .missing
+                .push(missing("not measured in the current run"));
+        } else {
+            report
+                .cases
+                .push(compare_case(baseline, base, current, cur, options)?);
+        }
+    }
+    report.extra = current
+        .cases
+        .iter()
+        .filter(|c| !baseline.cases.iter().any(|b| b.key == c.key))
+        .map(|c| c.key.clone())
+        .collect();
+    Ok(report)
+}
+
+fn compare_case(
+    baseline: &ResultsFile,
+    base: &CaseRecord,
+    current: &ResultsFile,
+    cur: &CaseRecord,
+    options: &GateOptions,
+) -> Result<CaseComparison, GateError> {
+    let normalization = choose_normalization(baseline, base, current, cur, options)?;
+    let b = normalized(baseline, base, normalization);
+    let c = normalized(current, cur, normalization);
+    let (b_raw, c_raw) = (samples(base), samples(cur));
+    let (bm, cm) = (median_of(&b_raw), median_of(&c_raw));
+    let ratio = median_of(&c) / median_of(&b);
+    let seed = options.seed ^ fnv1a(&base.key);
+    let ci95 = bootstrap_ratio_ci(&b, &c, options.resamples, seed);
+    let t = options.threshold;
+    let verdict = if ci95[0] > 1.0 + t {
+        Verdict::Regressed
+    } else if ci95[1] < 1.0 - t {
+        Verdict::Improved
+    } else {
+        Verdict::Unchanged
+    };
+    let (work_changes, mut notes) = compare_work(base, cur);
+    for (record, which) in [(base, "baseline"), (cur, "current")] {
+        if !record.is_complete() {
+            notes.push(format!(
+                "{which} incomplete ({}/{} rounds)",
+                record.rounds_done, record.rounds_planned
+            ));
+        }
+        if record.summary.as_ref().is_some_and(|s| !s.sanity_ok) {
+            notes.push(format!("{which} failed its energy-drift check"));
+        }
+    }
+    if cur.oversubscribed {
+        notes.push("oversubscribed".to_string());
+    }
+    Ok(CaseComparison {
+        key: base.key.clone(),
+        verdict,
+        normalization,
+        baseline_median_s: bm,
+        current_median_s: cm,
+        raw_ratio: cm / bm,
+        ratio,
+        ci95,
+        samples: [b_raw.len(), c_raw.len()],
+        work_changes,
+        notes,
+    })
+}
+
+/// Every raw sample of a case (seconds per step), in round order.
+fn samples(record: &CaseRecord) -> Vec<f64> {
+    record
+        .rounds
+        .iter()
+        .flat_map(|r| r.samples_s.iter().copied())
+        .filter(|s| s.is_finite() && *s > 0.0)
+        .collect()
+}
+
+fn median_of(values: &[f64]) -> f64 {
+    median(values).unwrap_or(f64::NAN)
+}
+
+/// Whether every sample of the case has its reference measurement.
+fn has_reference(record: &CaseRecord) -> bool {
+    record.rounds.iter().all(|r| {
+        r.reference_s.len() == r.samples_s.len()
+            && r.reference_s.iter().all(|x| x.is_finite() && *x > 0.0)
+    })
+}
+
+/// The FMA rate of the sweep's calibrations (mean of start and end), GFLOP/s.
+fn calibrated_rate(file: &ResultsFile) -> Option<f64> {
+    let rates: Vec<f64> = [&file.calibration.start, &file.calibration.end]
+        .into_iter()
+        .flatten()
+        .map(|c| c.fma_gflops_1t)
+        .filter(|g| g.is_finite() && *g > 0.0)
+        .collect();
+    (!rates.is_empty()).then(|| rates.iter().sum::<f64>() / rates.len() as f64)
+}
+
+fn choose_normalization(
+    baseline: &ResultsFile,
+    base: &CaseRecord,
+    current: &ResultsFile,
+    cur: &CaseRecord,
+    options: &GateOptions,
+) -> Result<Normalization, GateError> {
+    let reference = has_reference(base) && has_reference(cur);
+    let calibration = calibrated_rate(baseline).is_some() && calibrated_rate(current).is_some();
+    let unavailable = |wanted, why| GateError::NormalizationUnavailable {
+        key: base.key.clone(),
+        wanted,
+        why,
+    };
+    Ok(match options.normalization {
+        NormalizationChoice::Auto if reference => Normalization::Reference,
+        NormalizationChoice::Auto if calibration => Normalization::Calibration,
+        NormalizationChoice::Auto | NormalizationChoice::None => Normalization::None,
+        NormalizationChoice::Reference if reference => Normalization::Reference,
+        NormalizationChoice::Reference => {
+            return Err(unavailable(
+                "reference",
+                "a run did not time the reference workload: set measure.reference_s",
+            ));
+        }
+        NormalizationChoice::Calibration if calibration => Normalization::Calibration,
+        NormalizationChoice::Calibration => {
+            return Err(unavailable(
+                "calibration",
+                "a run was swept with --no-calibration",
+            ));
+        }
+    })
+}
+
+/// The case's samples divided by the machine measurement `how` chooses: each sample by the
+/// reference timed right before it (dimensionless), or by the time of a GFLOP at the
+/// calibrated rate, or nothing (seconds).
+fn normalized(file: &ResultsFile, record: &CaseRecord, how: Normalization) -> Vec<f64> {
+    match how {
+        Normalization::None => samples(record),
+        Normalization::Calibration => {
+            let rate = calibrated_rate(file).unwrap_or(1.0);
+            samples(record).into_iter().map(|s| s * rate).collect()
+        }
+        Normalization::Reference => record
+            .rounds
+            .iter()
+            .flat_map(|r| r.samples_s.iter().zip(&r.reference_s).map(|(s, r)| s / r))
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .collect(),
+    }
+}
+
+/// Percentile bootstrap 95% CI of median(current) / median(baseline): both sample sets are
+/// resampled with replacement, independently, from a generator seeded with `seed`.
+pub(super) fn bootstrap_ratio_ci(
+    baseline: &[f64],
+    current: &[f64],
+    resamples: usize,
+    seed: u64,
+) -> [f64; 2] {
+    let mut rng = Pcg64Mcg::seed_from_u64(seed);
+    let mut resample = |values: &[f64], buf: &mut Vec<f64>| {
+        buf.clear();
+        buf.extend((0..values.len()).map(|_| values[rng.random_range(0..values.len())]));
+        median_of(buf)
+    };
+    let (mut bb, mut cb) = (Vec::new(), Vec::new());
+    let mut ratios: Vec<f64> = (0..resamples.max(1))
+        .map(|_| {
+            let b = resample(baseline, &mut bb);
+            resample(current, &mut cb) / b
+        })
+        .collect();
+    ratios.sort_by(f64::total_cmp);
+    let at = |q: f64| ratios[((q * ratios.len() as f64) as usize).min(ratios.len() - 1)];
+    [at(0.025), at(0.975)]
+}
+
+/// The work of one force computation on the initial state, from the first round that has it.
+fn initial_work(record: &CaseRecord) -> Option<WorkCounters> {
+    record.rounds.iter().find_map(|r| r.initial_work)
+}
+
+/// Exact comparison of the deterministic counters: (changes, notes).
+fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, Vec<String>) {
+    let mut changes = Vec::new();
+    let mut notes = Vec::new();
+    let mut check = |counter: &str, b: u64, c: u64| {
+        if b != c {
+            changes.push(WorkChange {
+                counter: counter.to_string(),
+                baseline: b,
+                current: c,
+            });
+        }
+    };
+    check("particles", base.n as u64, cur.n as u64);
+    match (initial_work(base), initial_work(cur)) {
+        (Some(b), Some(c)) => {
+            check("pair_checks", b.pair_checks, c.pair_checks);
+            check(
+                "pairs_interacting",
+                b.pairs_interacting,
+                c.pairs_interacting,
+            );
+            check("cells_visited", b.cells_visited, c.cells_visited);
+            check("nodes_opened", b.nodes_opened, c.nodes_opened);
+            check("nodes_accepted", b.nodes_accepted, c.nodes_accepted);
+        }
+        _ => notes.push(
+            "work counters not compared (a file has no initial_work: swept by an older version)"
+                .to_string(),
+        ),
+    }
+    // Every round starts from the same seed, so its initial work must be the same too.
+    for (record, which) in [(base, "baseline"), (cur, "current")] {
+        let first = initial_work(record);
+        if record
+            .rounds
+            .iter()
+            .any(|r| r.initial_work.is_some() && r.initial_work != first)
+        {
+            notes.push(format!(
+                "{which}: the initial work differs between rounds of one run (nondeterministic kernel?)"
+            ));
+        }
+    }
+    (changes, notes)
+}
+
+/// FNV-1a of the case key: a seed per case that does not depend on the case's position.
+fn fnv1a(text: &str) -> u64 {
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
+}

@@ -1,0 +1,278 @@
+//! The regression gate: two sweep results files in, a typed verdict per case out.
+//!
+//! [`compare`] is a pure function from a baseline and a current [`ResultsFile`] to a
+//! [`GateReport`]; [`render`] turns the report into text, Markdown (for a CI job summary) or
+//! JSON. The rules:
+//!
+//! - cases are matched by their key; a baseline case the current run did not measure is
+//!   reported as missing (and the gate exits 2), a case only in the current run as extra;
+//! - times are normalised by a measurement of the machine taken in the same run (see
+//!   [`Normalization`]), so a uniformly slower machine is not a slower kernel;
+//! - the statistic is the ratio current / baseline of the normalised medians, with a
+//!   bootstrap 95% CI from the raw samples; a case regressed only when the whole CI lies above
+//!   `1 + threshold`, improved when it lies below `1 − threshold`, else it is unchanged;
+//! - the deterministic work counters of the initial state are compared exactly, and a change
+//!   is reported as such;
+//! - results from another machine (CPU model, logical CPUs), build (SIMD level, profile) or
+//!   config are refused unless forced.
+
+mod checks;
+mod compare;
+mod render;
+#[cfg(test)]
+mod tests;
+
+pub use compare::compare;
+pub use render::{Format, render};
+
+use crate::experiment::results::ResultsFile;
+use serde::Serialize;
+use thiserror::Error;
+
+/// Schema of the JSON rendering of a [`GateReport`].
+pub const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
+
+/// How to compare.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GateOptions {
+    /// Relative change a case must exceed, with its whole CI, to count (0.10 = 10%).
+    pub threshold: f64,
+    /// Compare results from another machine, build or config anyway (with warnings).
+    pub force: bool,
+    pub normalization: NormalizationChoice,
+    /// A change of the work counters makes the gate fail too (exit 1).
+    pub fail_on_work_change: bool,
+    /// Bootstrap resamples per case, and the seed they start from (with the case key mixed in).
+    pub resamples: usize,
+    pub seed: u64,
+}
+
+impl Default for GateOptions {
+    fn default() -> Self {
+        GateOptions {
+            threshold: 0.10,
+            force: false,
+            normalization: NormalizationChoice::Auto,
+            fail_on_work_change: false,
+            resamples: 4000,
+            seed: 0x9a7e,
+        }
+    }
+}
+
+/// Which normalisation to use; `Auto` takes the best one both files have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalizationChoice {
+    /// The reference workload if both runs timed it for the case, else the calibration, else none.
+    Auto,
+    Reference,
+    Calibration,
+    None,
+}
+
+/// What the case's times were divided by before comparing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Normalization {
+    /// Each sample by the reference workload timed right before it, on the same threads, for
+    /// about as long (`measure.reference_s`): tracks the share of the machine the case got.
+    Reference,
+    /// Every sample by the time of the sweep's calibrated FMA rate (mean of the start and end
+    /// calibrations): tracks the machine's speed at the start and end of the sweep only.
+    Calibration,
+    /// Raw seconds per step.
+    None,
+}
+
+impl Normalization {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Normalization::Reference => "the reference workload timed before each sample",
+            Normalization::Calibration => "the sweep's calibrated FMA rate",
+            Normalization::None => "nothing (raw times)",
+        }
+    }
+}
+
+/// The verdict on one case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// The whole CI of the ratio lies above 1 + threshold.
+    Regressed,
+    /// The whole CI lies below 1 − threshold.
+    Improved,
+    Unchanged,
+}
+
+impl Verdict {
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Regressed => "regressed",
+            Verdict::Improved => "improved",
+            Verdict::Unchanged => "unchanged",
+        }
+    }
+}
+
+/// One case measured in both runs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CaseComparison {
+    pub key: String,
+    pub verdict: Verdict,
+    pub normalization: Normalization,
+    /// Raw median seconds per step in each run.
+    pub baseline_median_s: f64,
+    pub current_median_s: f64,
+    /// Ratio of the raw medians, for reference.
+    pub raw_ratio: f64,
+    /// Ratio current / baseline of the normalised medians: the statistic.
+    pub ratio: f64,
+    /// Bootstrap 95% confidence interval of `ratio`.
+    pub ci95: [f64; 2],
+    /// Samples in each run.
+    pub samples: [usize; 2],
+    /// Deterministic work counters that differ between the runs.
+    pub work_changes: Vec<WorkChange>,
+    /// Anything that weakens the comparison (incomplete case, failed sanity check, ...).
+    pub notes: Vec<String>,
+}
+
+/// A work counter of the initial state that differs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct WorkChange {
+    pub counter: String,
+    pub baseline: u64,
+    pub current: u64,
+}
+
+/// A baseline case that could not be compared.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct MissingCase {
+    pub key: String,
+    pub reason: String,
+}
+
+/// Where a results file comes from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunInfo {
+    pub git_commit: String,
+    pub git_dirty: bool,
+    pub started: String,
+    pub host: String,
+    pub cpu_model: Option<String>,
+    pub logical_cpus: Option<usize>,
+    pub test_slowdown: Option<String>,
+}
+
+impl RunInfo {
+    pub fn of(file: &ResultsFile) -> RunInfo {
+        let cal = file
+            .calibration
+            .start
+            .as_ref()
+            .or(file.calibration.end.as_ref());
+        RunInfo {
+            git_commit: file.metadata.git_commit.clone(),
+            git_dirty: file.metadata.git_dirty,
+            started: file.metadata.started.clone(),
+            host: file.metadata.host.clone(),
+            cpu_model: cal.map(|c| c.cpu_model.clone()),
+            logical_cpus: cal.map(|c| c.logical_cpus),
+            test_slowdown: file.metadata.test_slowdown.clone(),
+        }
+    }
+}
+
+/// The result of a gate run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GateReport {
+    pub schema: String,
+    pub threshold: f64,
+    pub fail_on_work_change: bool,
+    pub baseline: RunInfo,
+    pub current: RunInfo,
+    /// Cases measured in both runs, in the baseline's order.
+    pub cases: Vec<CaseComparison>,
+    pub missing: Vec<MissingCase>,
+    /// Cases only the current run measured.
+    pub extra: Vec<String>,
+    pub warnings: Vec<String>,
+}
+
+impl GateReport {
+    pub fn count(&self, verdict: Verdict) -> usize {
+        self.cases.iter().filter(|c| c.verdict == verdict).count()
+    }
+
+    pub fn work_changed(&self) -> usize {
+        self.cases
+            .iter()
+            .filter(|c| !c.work_changes.is_empty())
+            .count()
+    }
+
+    /// Whether the gate fails on this report's findings (regressions, and work changes when
+    /// asked), ignoring missing cases.
+    pub fn failed(&self) -> bool {
+        self.count(Verdict::Regressed) > 0 || (self.fail_on_work_change && self.work_changed() > 0)
+    }
+
+    /// 2 when baseline cases could not be compared (the comparison is incomplete, whatever
+    /// else it found), 1 when something regressed, else 0.
+    pub fn exit_code(&self) -> i32 {
+        if !self.missing.is_empty() {
+            2
+        } else if self.failed() {
+            1
+        } else {
+            0
+        }
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum GateError {
+    #[error("--threshold must be a finite number >= 0 (got {0}); 0.10 means 10%")]
+    BadThreshold(f64),
+    #[error(
+        "the {which} results have no machine calibration (swept with --no-calibration), so \
+         the machine cannot be checked; sweep again with calibration, or pass --force"
+    )]
+    UnknownMachine { which: &'static str },
+    #[error(
+        "the baseline comes from another machine: {what} `{baseline}` there, `{current}` here; \
+         timings are only comparable on the same machine class. Refresh the baseline on this \
+         machine (scripts/refresh-baseline.sh), or pass --force to compare anyway"
+    )]
+    OtherMachine {
+        what: &'static str,
+        baseline: String,
+        current: String,
+    },
+    #[error(
+        "the baseline was built differently: {what} `{baseline}` in the baseline, `{current}` \
+         now; rebuild the same way, refresh the baseline, or pass --force"
+    )]
+    OtherBuild {
+        what: &'static str,
+        baseline: String,
+        current: String,
+    },
+    #[error(
+        "the two runs used different configs (they differ in {differences}); sweep the \
+         baseline's config (its text is in the file's config_text), refresh the baseline, or \
+         pass --force to compare the cases they share"
+    )]
+    OtherConfig { differences: String },
+    #[error(
+        "case {key}: normalisation `{wanted}` is not available in both files ({why}); use \
+         --normalize auto"
+    )]
+    NormalizationUnavailable {
+        key: String,
+        wanted: &'static str,
+        why: &'static str,
+    },
+}

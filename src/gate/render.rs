@@ -1,0 +1,211 @@
+//! Renderings of a [`GateReport`]: a terminal table, Markdown for a CI job summary
+//! (`>> $GITHUB_STEP_SUMMARY`), and JSON (schema `nbody-bench/gate/v1`).
+
+use super::checks::short;
+use super::{CaseComparison, GateReport, Normalization, Verdict};
+use crate::commands::fmt_ns;
+use std::fmt::Write;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Format {
+    Text,
+    Markdown,
+    Json,
+}
+
+pub fn render(report: &GateReport, format: Format) -> String {
+    match format {
+        Format::Text => text(report),
+        Format::Markdown => markdown(report),
+        Format::Json => {
+            serde_json::to_string_pretty(report).expect("gate report serializes") + "\n"
+        }
+    }
+}
+
+/// "3 cases: 1 regressed, 0 improved, 2 unchanged (threshold ±10%)".
+fn headline(report: &GateReport) -> String {
+    let mut s = format!(
+        "{} cases: {} regressed, {} improved, {} unchanged (threshold ±{}%)",
+        report.cases.len(),
+        report.count(Verdict::Regressed),
+        report.count(Verdict::Improved),
+        report.count(Verdict::Unchanged),
+        percent(report.threshold)
+    );
+    if !report.missing.is_empty() {
+        s += &format!(", {} missing", report.missing.len());
+    }
+    if report.work_changed() > 0 {
+        s += &format!(", work changed in {}", report.work_changed());
+    }
+    s
+}
+
+/// The normalisations used, e.g. "the reference workload timed around each case".
+fn normalizations(report: &GateReport) -> String {
+    let mut used: Vec<Normalization> = Vec::new();
+    for c in &report.cases {
+        if !used.contains(&c.normalization) {
+            used.push(c.normalization);
+        }
+    }
+    if used.is_empty() {
+        return "-".to_string();
+    }
+    used.iter()
+        .map(|n| n.describe())
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
+fn percent(fraction: f64) -> String {
+    let p = format!("{:.2}", fraction * 100.0);
+    p.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+fn origin(info: &super::RunInfo) -> String {
+    format!(
+        "{}{} ({}, {})",
+        short(&info.git_commit),
+        if info.git_dirty { "+dirty" } else { "" },
+        info.started,
+        info.cpu_model.as_deref().unwrap_or("unknown CPU")
+    )
+}
+
+fn text(report: &GateReport) -> String {
+    let mut s = String::new();
+    let verdict = if report.failed() {
+        "FAIL"
+    } else if !report.missing.is_empty() {
+        "INCOMPLETE"
+    } else {
+        "ok"
+    };
+    let _ = writeln!(s, "gate {verdict}: {}", headline(report));
+    let _ = writeln!(s, "baseline {}", origin(&report.baseline));
+    let _ = writeln!(s, "current  {}", origin(&report.current));
+    let _ = writeln!(s, "times normalised by {}\n", normalizations(report));
+    let width = report
+        .cases
+        .iter()
+        .map(|c| c.key.len())
+        .max()
+        .unwrap_or(4)
+        .max(4);
+    let _ = writeln!(
+        s,
+        "{:<width$} {:>11} {:>11} {:>7} {:>17} {:>7}  verdict",
+        "case", "baseline", "current", "ratio", "95% CI", "raw"
+    );
+    for c in &report.cases {
+        let _ = writeln!(
+            s,
+            "{:<width$} {:>11} {:>11} {:>7.3} {:>17} {:>7.3}  {}{}",
+            c.key,
+            fmt_ns(c.baseline_median_s * 1e9),
+            fmt_ns(c.current_median_s * 1e9),
+            c.ratio,
+            format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),
+            c.raw_ratio,
+            match c.verdict {
+                Verdict::Regressed => verdict_word(c).to_uppercase(),
+                _ => verdict_word(c),
+            },
+            notes(c).map(|n| format!("  ({n})")).unwrap_or_default()
+        );
+    }
+    for line in findings(report) {
+        let _ = writeln!(s, "{line}");
+    }
+    s
+}
+
+fn markdown(report: &GateReport) -> String {
+    let mut s = String::new();
+    let status = if report.failed() {
+        "regression found"
+    } else if !report.missing.is_empty() {
+        "incomplete"
+    } else {
+        "no regression"
+    };
+    let _ = writeln!(s, "### Performance gate: {status}\n");
+    let _ = writeln!(s, "{}.\n", headline(report));
+    let _ = writeln!(
+        s,
+        "Baseline `{}`, current `{}`; times normalised by {}. A case regresses when the whole \
+         95% CI of the ratio current / baseline lies above {:.2}.\n",
+        origin(&report.baseline),
+        origin(&report.current),
+        normalizations(report),
+        1.0 + report.threshold
+    );
+    s += "| case | baseline | current | ratio | 95% CI | raw ratio | verdict |\n";
+    s += "|---|---:|---:|---:|---:|---:|---|\n";
+    for c in &report.cases {
+        let word = verdict_word(c);
+        let verdict = match c.verdict {
+            Verdict::Regressed => format!("**{word}**"),
+            _ => word.to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "| `{}` | {} | {} | {:.3} | {:.3} – {:.3} | {:.3} | {}{} |",
+            c.key,
+            fmt_ns(c.baseline_median_s * 1e9),
+            fmt_ns(c.current_median_s * 1e9),
+            c.ratio,
+            c.ci95[0],
+            c.ci95[1],
+            c.raw_ratio,
+            verdict,
+            notes(c).map(|n| format!(" ({n})")).unwrap_or_default()
+        );
+    }
+    let lines = findings(report);
+    if !lines.is_empty() {
+        s += "\n";
+        for line in lines {
+            let _ = writeln!(s, "- {line}");
+        }
+    }
+    s
+}
+
+/// "regressed", or "unchanged, work changed" when the counters differ.
+fn verdict_word(c: &CaseComparison) -> String {
+    let mut w = c.verdict.name().to_string();
+    if !c.work_changes.is_empty() {
+        w += ", work changed";
+    }
+    w
+}
+
+fn notes(c: &CaseComparison) -> Option<String> {
+    (!c.notes.is_empty()).then(|| c.notes.join("; "))
+}
+
+/// Lines after the table: missing and extra cases, work changes, warnings.
+fn findings(report: &GateReport) -> Vec<String> {
+    let mut out = Vec::new();
+    for m in &report.missing {
+        out.push(format!("missing: {} ({})", m.key, m.reason));
+    }
+    for key in &report.extra {
+        out.push(format!("extra (no baseline): {key}"));
+    }
+    for c in &report.cases {
+        for w in &c.work_changes {
+            out.push(format!(
+                "work changed: {} {}: {} -> {}",
+                c.key, w.counter, w.baseline, w.current
+            ));
+        }
+    }
+    for w in &report.warnings {
+        out.push(format!("warning: {w}"));
+    }
+    out
+}
