@@ -16,7 +16,15 @@ fn fixture() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     let sweep = dir.path().join("results/quick");
     std::fs::create_dir_all(&sweep).unwrap();
-    std::fs::copy("results/quick/results.json", sweep.join("results.json")).unwrap();
+    // The committed quick sweep, read as a complexity study (its cases are kernels over n).
+    let text = std::fs::read_to_string("results/quick/results.json").unwrap();
+    let mut results: serde_json::Value = serde_json::from_str(&text).unwrap();
+    results["config"]["study"] = "complexity".into();
+    std::fs::write(
+        sweep.join("results.json"),
+        serde_json::to_string(&results).unwrap(),
+    )
+    .unwrap();
     dir
 }
 
@@ -45,21 +53,21 @@ fn report_numbers_come_from_the_results_and_regeneration_is_idempotent() {
         .unwrap();
     let median = case["summary"]["median_s"].as_f64().unwrap();
     assert!(text.contains(&nbody_bench::commands::fmt_ns(median * 1e9)));
-    assert!(text.contains("(results/quick/analysis/speedup-galaxy-n2000-f64.svg)"));
+    assert!(text.contains("(results/quick/analysis/time-vs-n-lj-box-f32-p1-r1.svg)"));
     assert!(
         dir.path()
-            .join("results/quick/analysis/speedup-galaxy-n2000-f64.svg")
+            .join("results/quick/analysis/time-vs-n-lj-box-f32-p1-r1.svg")
             .is_file()
     );
 
     // Hand-written interpretation survives regeneration; the rest is unchanged.
     let edited = text.replace(
-        "<!-- keep:strong -->\n",
-        "<!-- keep:strong -->\nThe symmetric kernel is serial.\n",
+        "<!-- keep:complexity -->\n",
+        "<!-- keep:complexity -->\nThe symmetric kernel is serial.\n",
     );
     let edited = edited.replacen(
-        "_No interpretation written yet: write it here; `nbody-bench report` keeps this region._\n<!-- /keep:strong -->",
-        "<!-- /keep:strong -->",
+        "_No interpretation written yet: write it here; `nbody-bench report` keeps this region._\n<!-- /keep:complexity -->",
+        "<!-- /keep:complexity -->",
         1,
     );
     std::fs::write(dir.path().join("REPORT.md"), &edited).unwrap();

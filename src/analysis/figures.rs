@@ -159,8 +159,11 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         let title = format!("{} n={}", id.0, id.1.unwrap_or(0));
         let ceiling: Vec<(f64, f64)> = same
             .iter()
-            .filter_map(|s| s.fit.fit.as_ref())
-            .flat_map(|f| f.points.iter().filter_map(|p| p.ceiling.map(|c| (p.p, c))))
+            .flat_map(|s| {
+                s.measured
+                    .iter()
+                    .filter_map(|p| p.ceiling.map(|c| (p.p, c)))
+            })
             .fold(Vec::new(), |mut acc, pc| {
                 if !acc.iter().any(|a: &(f64, f64)| a.0 == pc.0) {
                     acc.push(pc);
@@ -174,9 +177,8 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         let eff: Vec<KernelSeries> = same
             .iter()
             .filter_map(|s| {
-                let f = s.fit.fit.as_ref()?;
-                let m = f
-                    .points
+                let m: Vec<Measured> = s
+                    .measured
                     .iter()
                     .map(|p| {
                         Measured::with_ci(
@@ -375,11 +377,8 @@ fn time_series(c: &ComplexityAnalysis) -> KernelSeries {
 }
 
 fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
-    let Some(f) = &s.fit.fit else {
-        return KernelSeries::new(s.label.clone(), Vec::new());
-    };
-    let measured = f
-        .points
+    let measured: Vec<Measured> = s
+        .measured
         .iter()
         .map(|p| {
             Measured::with_ci(
@@ -391,7 +390,10 @@ fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
             .oversubscribed(oversubscribed_at(&s.points, p.p))
         })
         .collect();
-    let hi = f.points.iter().map(|p| p.p).fold(1.0, f64::max);
+    let Some(f) = &s.fit.fit else {
+        return KernelSeries::new(s.label.clone(), measured);
+    };
+    let hi = s.measured.iter().map(|p| p.p).fold(1.0, f64::max);
     let xs = fig::grid(1.0, hi, 30, Scale::Linear);
     let band = xs
         .iter()

@@ -62,7 +62,9 @@ pub struct Crossover {
     /// The kernel that is faster above `n` and the one that is faster below it.
     pub faster_above: String,
     pub faster_below: String,
-    pub n: f64,
+    /// Where the fitted curves cross; `None` when `faster_above` is faster over the whole
+    /// measured range.
+    pub n: Option<f64>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -70,6 +72,10 @@ pub struct StrongAnalysis {
     pub series: SeriesKey,
     pub label: String,
     pub points: Vec<Point>,
+    /// Speedup and efficiency at every measured p, oversubscribed ones included.
+    pub measured: Vec<fit::StrongPoint>,
+    /// The models, fitted to the cases that had a logical CPU per worker only: an
+    /// oversubscribed case measures time-sharing, not parallel speedup.
     pub fit: Fitted<StrongFit>,
     /// The serial fraction from the one-worker case's phase timers (source 002's method),
     /// and how it compares with the fitted one.
@@ -239,24 +245,25 @@ fn crossovers(all: &[ComplexityAnalysis]) -> Vec<Crossover> {
             let (Some(fa), Some(fb)) = (&a.fit.fit, &b.fit.fit) else {
                 continue;
             };
-            if !same {
+            // Kernels of the same class differ by a constant factor: a crossing of their
+            // curves is noise, not an algorithmic crossover.
+            if !same || fa.class == fb.class {
                 continue;
             }
             let ns = a.points.iter().chain(&b.points).map(|p| p.n as f64);
             let lo = ns.clone().fold(f64::INFINITY, f64::min);
             let hi = ns.fold(0.0, f64::max);
-            if let Some(n) = fit::crossover(fa, fb, lo, hi) {
-                let a_faster_above = fa.predict(hi) < fb.predict(hi);
-                let (above, below) = if a_faster_above { (a, b) } else { (b, a) };
-                out.push(Crossover {
-                    scenario: a.series.scenario.name().into(),
-                    precision: a.series.precision.clone(),
-                    threads: a.series.threads.unwrap_or(1),
-                    faster_above: above.label.clone(),
-                    faster_below: below.label.clone(),
-                    n,
-                });
-            }
+            let n = fit::crossover(fa, fb, lo, hi);
+            let a_faster_above = fa.predict(hi) < fb.predict(hi);
+            let (above, below) = if a_faster_above { (a, b) } else { (b, a) };
+            out.push(Crossover {
+                scenario: a.series.scenario.name().into(),
+                precision: a.series.precision.clone(),
+                threads: a.series.threads.unwrap_or(1),
+                faster_above: above.label.clone(),
+                faster_below: below.label.clone(),
+                n,
+            });
         }
     }
     out
@@ -269,7 +276,14 @@ fn parallel_interaction(kernel: KernelKind) -> bool {
 }
 
 fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
-    let data = samples_by(&s.points, |p| p.p() as f64, |_| 1.0);
+    let real: Vec<Point> = s
+        .points
+        .iter()
+        .filter(|p| !p.oversubscribed)
+        .cloned()
+        .collect();
+    let data = samples_by(&real, |p| p.p() as f64, |_| 1.0);
+    let all = samples_by(&s.points, |p| p.p() as f64, |_| 1.0);
     let ceiling: Vec<(f64, f64)> = match calibration {
         Some(c) => s
             .points
@@ -290,6 +304,14 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
     let mut ceiling = ceiling;
     ceiling.dedup_by(|a, b| a.0 == b.0);
     let fit = Fitted::of(fit::fit_strong(&data, &ceiling, fit::DEFAULT_SEED));
+    let measured = match fit::fit_strong(&all, &ceiling, fit::DEFAULT_SEED) {
+        Ok(f) => f.points,
+        Err(_) => fit
+            .fit
+            .as_ref()
+            .map(|f| f.points.clone())
+            .unwrap_or_default(),
+    };
     let timed_serial = s.points.iter().find(|p| p.p() == 1).and_then(|one| {
         let ph = &one.phases;
         let (serial, parallel) = if parallel_interaction(s.key.kernel) {
@@ -319,6 +341,7 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
         series: s.key.clone(),
         label: s.key.label(),
         points: s.points.clone(),
+        measured,
         fit,
         timed_serial,
         serial_comparison,
@@ -360,5 +383,26 @@ fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
         rule,
         points: s.points.clone(),
         fit: Fitted::of(fit),
+    }
+}
+
+/// "galaxy (f64, 1 thread): octree θ=0.5 is faster above n ≈ 574, naive below."
+pub fn crossover_sentence(x: &Crossover) -> String {
+    let head = format!(
+        "{} ({}, {} thread{})",
+        x.scenario,
+        x.precision,
+        x.threads,
+        if x.threads == 1 { "" } else { "s" }
+    );
+    match x.n {
+        Some(n) => format!(
+            "{head}: {} is faster above n ≈ {n:.0}, {} below.",
+            x.faster_above, x.faster_below
+        ),
+        None => format!(
+            "{head}: {} is faster than {} over the whole measured range.",
+            x.faster_above, x.faster_below
+        ),
     }
 }

@@ -1,6 +1,6 @@
 //! The Markdown summary of an analysis: tables of the fits, then the figures.
 
-use super::figures::{Figure, case_label};
+use super::figures::Figure;
 use super::{Analysis, Fitted};
 use crate::commands::fmt_ns;
 use crate::fit::Estimate;
@@ -82,18 +82,14 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.crossovers.is_empty() {
         md.push_str("## Crossovers\n\n");
         for x in &a.crossovers {
-            let _ = writeln!(
-                md,
-                "- {} ({}, {} thread(s)): {} is faster above n ≈ {:.0}, {} below.",
-                x.scenario, x.precision, x.threads, x.faster_above, x.n, x.faster_below
-            );
+            let _ = writeln!(md, "- {}", super::crossover_sentence(x));
         }
         md.push('\n');
     }
     if !a.strong.is_empty() {
         md.push_str("## Strong scaling\n\n| scenario | series | n | p | speedup [95% CI] | efficiency | vs hardware ceiling |\n|---|---|---|---|---|---|---|\n");
         for s in &a.strong {
-            let Some(f) = &s.fit.fit else {
+            if s.measured.is_empty() {
                 let _ = writeln!(
                     md,
                     "| {} | {} | – | – | {} | | |",
@@ -102,8 +98,8 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
                     failed(&s.fit)
                 );
                 continue;
-            };
-            for p in &f.points {
+            }
+            for p in &s.measured {
                 let over = s
                     .points
                     .iter()
@@ -206,8 +202,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             let _ = writeln!(
                 md,
                 "- {}: energy drift {:.2e} over the limit",
-                case_label(c),
-                c.max_energy_drift
+                c.key, c.max_energy_drift
             );
         }
         md.push('\n');
