@@ -10,10 +10,13 @@ pub mod boundary;
 pub mod calibrate;
 pub mod cli;
 pub mod commands;
+pub mod decomp;
 pub mod engine;
 pub mod experiment;
 pub mod integrator;
 pub mod kernels;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 pub mod output;
 pub mod physics;
 pub mod real;
