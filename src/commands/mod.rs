@@ -1,6 +1,7 @@
 //! The subcommands. Each returns the process exit code or an error (reported with exit code 2).
 
 mod list;
+mod mpi;
 mod run;
 mod sweep;
 mod validate;
@@ -18,6 +19,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Run(args) => run::run(args),
         Command::Validate(args) => validate::validate(args),
         Command::Sweep(args) => sweep::sweep(args),
+        Command::MpiBench(args) => mpi::bench(args),
+        Command::MpiCheck(args) => mpi::check(args),
     }
 }
 

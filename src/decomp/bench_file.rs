@@ -61,7 +61,9 @@ pub enum BenchFileError {
         path: PathBuf,
         source: std::io::Error,
     },
-    #[error("{path} is not a valid mpi-bench file ({detail}); it may be truncated or from another tool")]
+    #[error(
+        "{path} is not a valid mpi-bench file ({detail}); it may be truncated or from another tool"
+    )]
     Corrupt { path: PathBuf, detail: String },
     #[error("{path} has schema `{found}`, this version reads `{MPI_BENCH_SCHEMA}`")]
     Schema { path: PathBuf, found: String },
@@ -96,7 +98,10 @@ impl MpiBenchFile {
         }
         let file: MpiBenchFile =
             serde_json::from_value(value).map_err(|e| corrupt(e.to_string()))?;
-        for (name, series) in [("ping_pong", &file.ping_pong), ("allgatherv", &file.allgatherv)] {
+        for (name, series) in [
+            ("ping_pong", &file.ping_pong),
+            ("allgatherv", &file.allgatherv),
+        ] {
             for p in &series.points {
                 if p.seconds.is_empty() || p.seconds.iter().any(|s| !(s.is_finite() && *s >= 0.0)) {
                     return Err(corrupt(format!(

@@ -17,9 +17,7 @@ use thiserror::Error;
 pub const WITHOUT_MPI: &str = "built without the `mpi` feature; rebuild with `--features mpi`";
 
 /// How a run is split over MPI ranks.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Decomposition {
     /// Replicated data (sources 000 and 004): each rank owns a block of particles, computes
@@ -84,6 +82,9 @@ mod tests {
             .check(KernelKind::Naive)
             .unwrap_err()
             .to_string();
-        assert!(msg.contains("cell-list") && msg.contains("allgather"), "{msg}");
+        assert!(
+            msg.contains("cell-list") && msg.contains("allgather"),
+            "{msg}"
+        );
     }
 }

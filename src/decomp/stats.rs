@@ -182,7 +182,11 @@ mod tests {
 
     #[test]
     fn waits_are_the_gaps_to_the_slowest_rank() {
-        let compute = vec![vec![1.0, 2.0, 3.0], vec![2.0, 2.0, 1.0], vec![0.5, 1.0, 1.0]];
+        let compute = vec![
+            vec![1.0, 2.0, 3.0],
+            vec![2.0, 2.0, 1.0],
+            vec![0.5, 1.0, 1.0],
+        ];
         assert_eq!(waits(&compute), vec![1.0, 2.0, 4.5]);
         let mut stats = vec![
             RankStats {
@@ -200,7 +204,10 @@ mod tests {
         ];
         attribute_waits(&mut stats, &compute);
         assert_eq!(
-            stats.iter().map(|s| (s.wait_s, s.transfer_s)).collect::<Vec<_>>(),
+            stats
+                .iter()
+                .map(|s| (s.wait_s, s.transfer_s))
+                .collect::<Vec<_>>(),
             vec![(1.0, 1.0), (1.0, 0.0), (4.5, 0.5)]
         );
     }

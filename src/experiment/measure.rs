@@ -98,6 +98,9 @@ pub struct RoundOutcome {
     pub n: usize,
     /// Cost of one clock reading relative to the median step (the timing overhead).
     pub clock_overhead: f64,
+    /// Ranks, decomposition and per-rank statistics of a case run under an MPI launcher.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mpi: Option<crate::decomp::stats::MpiReport>,
 }
 
 /// Measures a round of `case` on the system it is given.
@@ -215,11 +218,12 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         } else {
             0.0
         },
+        mpi: None,
     })
 }
 
 /// Seconds per clock reading (two readings bracket each timed step).
-fn clock_cost<C: Clock>(clock: &C) -> f64 {
+pub(super) fn clock_cost<C: Clock>(clock: &C) -> f64 {
     let reps = 1000;
     let t0 = clock.now();
     for _ in 0..reps {

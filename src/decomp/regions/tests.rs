@@ -33,7 +33,10 @@ fn regions_tile_the_box_and_owner_finds_the_containing_region() {
     assert_eq!(r.owner([0.0, 0.0]), 0);
     assert_eq!(r.owner([2.0, 1.0]), 5);
     // After rebalancing on a skewed cloud, still a tiling.
-    let skewed: Vec<[f64; 2]> = pts.iter().map(|p| [p[0] * p[0] / 2.0, p[1].powi(3)]).collect();
+    let skewed: Vec<[f64; 2]> = pts
+        .iter()
+        .map(|p| [p[0] * p[0] / 2.0, p[1].powi(3)])
+        .collect();
     for axis in 0..2 {
         let h = r.histogram(axis, 512, skewed.iter().copied());
         r.cut_axis(axis, &h);
@@ -67,7 +70,10 @@ fn rebalancing_equalizes_counts_in_2d_and_3d() {
         assert!(imbalance(&after) < 1.03, "{dims:?}: {after:?}");
     }
     let pts3 = random_points::<3>(20_000, 1.0, crate::testing::SEED_1);
-    let pts3: Vec<[f64; 3]> = pts3.iter().map(|p| [p[0], p[1].powi(2), p[2].powi(4)]).collect();
+    let pts3: Vec<[f64; 3]> = pts3
+        .iter()
+        .map(|p| [p[0], p[1].powi(2), p[2].powi(4)])
+        .collect();
     let mut r = Regions::<3>::uniform([0.0; 3], [1.0; 3], [2, 2, 2]).unwrap();
     for axis in 0..3 {
         let h = r.histogram(axis, 1024, pts3.iter().copied());
@@ -109,7 +115,10 @@ fn neighbours_are_the_regions_within_reach_and_symmetric() {
     assert!(r.neighbours(centre, 1e-9).len() >= 4);
     for a in 0..9 {
         for b in r.neighbours(a, 0.05) {
-            assert!(r.neighbours(b, 0.05).contains(&a), "{a} -> {b} not symmetric");
+            assert!(
+                r.neighbours(b, 0.05).contains(&a),
+                "{a} -> {b} not symmetric"
+            );
         }
     }
 }
@@ -148,8 +157,14 @@ fn grids_parse_with_clear_errors() {
         parse_grid::<2>("3x1", 4),
         Err(RegionsError::GridMismatch { got: 3, .. })
     ));
-    assert!(matches!(parse_grid::<2>("4", 4), Err(RegionsError::BadGrid(_))));
-    assert!(matches!(parse_grid::<2>("0x4", 0), Err(RegionsError::BadGrid(_))));
+    assert!(matches!(
+        parse_grid::<2>("4", 4),
+        Err(RegionsError::BadGrid(_))
+    ));
+    assert!(matches!(
+        parse_grid::<2>("0x4", 0),
+        Err(RegionsError::BadGrid(_))
+    ));
     assert!(
         Regions::<2>::uniform([0.0; 2], [f64::INFINITY, 1.0], [1, 1]).is_err(),
         "an open box has no regions"
