@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# Runs every check of the project: formatting, lints, unit and integration tests, and the
-# force validation of every scenario. Works on a fresh machine with a Rust toolchain.
+# Runs every check of the project: formatting, lints, unit and integration tests, the force
+# validation of every scenario, and the MPI tests. Works on a fresh machine with a Rust
+# toolchain (the MPI tests install Open MPI with apt when run as root).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -14,3 +15,5 @@ cargo fmt --all -- --check
 cargo clippy --all-targets --release -- -D warnings
 cargo test --release
 cargo run --release --quiet -- validate --threads 2
+# The MPI drivers under mpirun (installs Open MPI with apt when missing and run as root).
+scripts/mpi-tests.sh

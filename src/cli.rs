@@ -178,6 +178,9 @@ pub struct MpiCheckArgs {
     /// Also fail unless some rank owns no particle at the end.
     #[arg(long)]
     pub expect_empty_rank: bool,
+    /// Also fail unless the domain boundaries moved to rebalance the load during the run.
+    #[arg(long)]
+    pub expect_rebalance: bool,
 }
 
 #[derive(Debug, Args)]

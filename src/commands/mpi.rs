@@ -209,15 +209,24 @@ mod with_mpi {
             "migration         {} particles changed rank, {} beyond the neighbours",
             report.migrated, report.far_migrated
         );
-        let owned: Vec<u64> = o
+        let (owned, rebalances): (Vec<u64>, u64) = o
             .mpi
             .as_ref()
-            .map(|m| m.per_rank.iter().map(|r| r.particles).collect())
+            .map(|m| {
+                (
+                    m.per_rank.iter().map(|r| r.particles).collect(),
+                    m.rebalances,
+                )
+            })
             .unwrap_or_default();
-        println!("owned at the end  {owned:?}");
+        println!("owned at the end  {owned:?}, {rebalances} rebalance(s)");
         let mut ok = report.passes(tolerance);
         if args.expect_empty_rank && !owned.contains(&0) {
             println!("FAIL: every rank owns particles (--expect-empty-rank)");
+            ok = false;
+        }
+        if args.expect_rebalance && rebalances == 0 {
+            println!("FAIL: the boundaries never moved (--expect-rebalance)");
             ok = false;
         }
         if args.expect_migration && report.migrated == 0 {
