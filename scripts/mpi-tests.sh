@@ -15,10 +15,19 @@ fail() {
     exit 1
 }
 
+# libclang and its headers, which the bindings generator of mpi-sys needs at build time.
+have_libclang() {
+    if command -v dpkg >/dev/null 2>&1; then
+        dpkg -s libclang-dev >/dev/null 2>&1
+    else
+        ldconfig -p 2>/dev/null | grep -q libclang
+    fi
+}
+
 have_mpi() {
     command -v mpirun >/dev/null 2>&1 &&
         { pkg-config --exists ompi 2>/dev/null || pkg-config --exists mpich 2>/dev/null; } &&
-        ldconfig -p 2>/dev/null | grep -q 'libclang\(-[0-9.]*\)\?\.so'
+        have_libclang
 }
 
 if ! have_mpi; then

@@ -192,6 +192,17 @@ fn gather_state<T: Real, const D: usize>(
     Ok(Some((out, f)))
 }
 
+/// Every rank's statistics, combined on rank 0.
+struct Combined {
+    report: MpiReport,
+    /// Work of all ranks.
+    work: WorkCounters,
+    /// Mean over ranks of the seconds spent building cells or trees.
+    build_mean: f64,
+    /// Particles that moved beyond the neighbouring regions, all ranks.
+    far_migrated: u64,
+}
+
 /// The `mpi` block of the result, from every rank's record.
 fn mpi_report(
     spec: &MpiSpec,
@@ -200,7 +211,7 @@ fn mpi_report(
     mut records: Vec<RankRecord>,
     grid: Option<Vec<usize>>,
     rebalances: u64,
-) -> (MpiReport, WorkCounters, f64, u64) {
+) -> Combined {
     let compute: Vec<Vec<f64>> = records.iter().map(|r| r.compute_s.clone()).collect();
     let mut per_rank: Vec<RankStats> = records.iter().map(|r| r.stats.clone()).collect();
     attribute_waits(&mut per_rank, &compute);
@@ -213,7 +224,7 @@ fn mpi_report(
         work.add(&r.work);
     }
     let build_mean = records.iter().map(|r| r.build_s).sum::<f64>() / records.len() as f64;
-    let far: u64 = records.iter().map(|r| r.far_migrated).sum();
+    let far_migrated: u64 = records.iter().map(|r| r.far_migrated).sum();
     let hosts = records.drain(..).map(|r| r.host).collect();
     let library = ::mpi::environment::library_version()
         .map(|v| v.trim_end_matches('\0').trim().to_string())
@@ -237,7 +248,12 @@ fn mpi_report(
         reduced,
         step_ns,
     };
-    (report, work, build_mean, far)
+    Combined {
+        report,
+        work,
+        build_mean,
+        far_migrated,
+    }
 }
 
 /// Rank 0: energies, the dump, the result, and the comparison with a serial run.
@@ -246,9 +262,15 @@ fn finish<T: Real, L: PairLaw<T>, const D: usize>(
     reference: System<T, L, D>,
     state: State<T, D>,
     forces: Field<T, D>,
-    (report, work, build_mean, far): (MpiReport, WorkCounters, f64, u64),
+    combined: Combined,
     line: &Timeline,
 ) -> Result<RootResult, MpiError> {
+    let Combined {
+        report,
+        work,
+        build_mean,
+        far_migrated,
+    } = combined;
     let n = state.len();
     let steps_done = spec.warmup + spec.steps;
     let serial_kernel = || spec.kernel.build::<T, L, D>(reference.law, &spec.params);
@@ -286,7 +308,7 @@ fn finish<T: Real, L: PairLaw<T>, const D: usize>(
                 .map_err(|error| MpiError::Boundary { rank: 0, error })?;
         }
         let migrated = report.per_rank.iter().map(|r| r.migrated_out).sum();
-        Some(compare(&serial.state, &state, migrated, far))
+        Some(compare(&serial.state, &state, migrated, far_migrated))
     } else {
         None
     };
