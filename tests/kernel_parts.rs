@@ -12,6 +12,8 @@ use nbody_bench::validate::{EXACT_ULPS, reference_forces};
 
 struct Parts {
     threads: usize,
+    kernels: Vec<KernelKind>,
+    counts: Vec<usize>,
 }
 
 impl SystemJob for Parts {
@@ -24,14 +26,16 @@ impl SystemJob for Parts {
             .build()
             .unwrap();
         let params = KernelParams::default();
-        for kind in KernelKind::ALL
-            .into_iter()
+        for kind in self
+            .kernels
+            .iter()
+            .copied()
             .filter(|k| k.supports(sys.law.kind()))
         {
             let mut kernel = kind.build::<T, L, D>(sys.law, &params).unwrap();
             let mut whole = zero_field::<T, D>(n);
             pool.install(|| kernel.compute(&sys.state, &mut whole, false));
-            for count in [1, 2, 3, 4, 7] {
+            for &count in &self.counts {
                 let mut sum = zero_field::<f64, D>(n);
                 let mut checks = 0;
                 for index in 0..count {
@@ -87,8 +91,27 @@ fn parts_add_up_to_the_whole() {
                 let mut setup = Setup::new(scenario);
                 setup.n = Some(n);
                 setup.allow_fewer = true;
-                setup.dispatch(Parts { threads }).unwrap();
+                let parts = Parts {
+                    threads,
+                    kernels: KernelKind::ALL.to_vec(),
+                    counts: vec![1, 2, 3, 4, 7],
+                };
+                setup.dispatch(parts).unwrap();
             }
         }
     }
+}
+
+/// Blocks large enough that the octree walks their groups in parallel, with gaps between
+/// the selected groups.
+#[test]
+fn octree_targets_in_parallel() {
+    let mut setup = Setup::new(ScenarioKind::Galaxy);
+    setup.n = Some(6000);
+    let parts = Parts {
+        threads: 2,
+        kernels: vec![KernelKind::Octree],
+        counts: vec![3],
+    };
+    setup.dispatch(parts).unwrap();
 }
