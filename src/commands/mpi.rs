@@ -73,13 +73,15 @@ mod with_mpi {
     }
 
     pub fn run(args: RunArgs, decomp: Decomposition) -> anyhow::Result<i32> {
-        if args.trajectory.is_some() {
-            anyhow::bail!(
-                "--trajectory is not available with --decomp; --dump-state writes the final state"
-            );
-        }
         let mut mpi = Mpi::init()?;
         let rank = mpi.rank();
+        if args.trajectory.is_some() {
+            let err = MpiError::Usage(
+                "--trajectory is not available with --decomp; --dump-state writes the final state"
+                    .into(),
+            );
+            return Ok(fail(rank, err));
+        }
         let setup = setup(args.scenario, &args.system);
         let spec = spec(
             args.kernel,

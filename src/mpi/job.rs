@@ -72,6 +72,11 @@ impl SystemJob for MpiJob<'_> {
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
         let MpiJob { spec, comm } = self;
         spec.decomp.check(spec.kernel)?;
+        if spec.decomp == Decomposition::Allgather && spec.domain.rank_grid.is_some() {
+            return Err(MpiError::Usage(
+                "--rank-grid applies to --decomp domain only".into(),
+            ));
+        }
         let kernel = spec.kernel.build::<T, L, D>(system.law, &spec.params)?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(spec.threads)
