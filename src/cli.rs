@@ -1,5 +1,6 @@
 //! Command-line interface: argument definitions only; the work is in `commands`.
 
+use crate::decomp::Decomposition;
 use crate::kernels::KernelKind;
 use crate::output::nbview::NbviewFormat;
 use crate::scenario::{Precision, ScenarioKind};
@@ -43,6 +44,13 @@ pub enum Command {
     /// Compare a sweep's results with a baseline, case by case; exit 1 if a case got slower
     /// beyond the threshold (with its whole confidence interval), 2 for bad input.
     Gate(GateArgs),
+    /// Measure MPI ping-pong and Allgatherv times over message sizes, for the latency-bandwidth
+    /// model (needs the `mpi` feature; run under `mpirun -n 2` or more).
+    MpiBench(MpiBenchArgs),
+    /// Run a scenario over MPI ranks and compare the final state with a serial run of the same
+    /// kernel: same particles, same positions and velocities to rounding (exit 1 if not; needs
+    /// the `mpi` feature; run under mpirun).
+    MpiCheck(MpiCheckArgs),
 }
 
 #[derive(Debug, Args)]
@@ -137,6 +145,88 @@ pub struct RunArgs {
     /// Write the final positions, velocities and forces (text, id order, nothing run-dependent).
     #[arg(long, value_name = "FILE")]
     pub dump_state: Option<PathBuf>,
+    /// Split the run over MPI ranks (start it under `mpirun -n P`): allgather (replicated data,
+    /// any kernel) or domain (spatial regions, cell list). Needs the `mpi` feature.
+    #[arg(long, value_enum, help_heading = MPI_HEADING)]
+    pub decomp: Option<Decomposition>,
+    #[command(flatten)]
+    pub mpi: MpiOptions,
+}
+
+const MPI_HEADING: &str = "MPI (build with --features mpi, start under mpirun)";
+
+/// Options of distributed runs.
+#[derive(Debug, Args, Clone)]
+#[command(next_help_heading = MPI_HEADING)]
+pub struct MpiOptions {
+    /// Untimed steps before the timed ones.
+    #[arg(long, default_value_t = 0, requires = "decomp")]
+    pub warmup_steps: usize,
+    /// Regions per axis of the domain decomposition, e.g. 4x1 (slabs) or 2x2 (blocks)
+    /// [default: the factorization with the least cut area].
+    #[arg(long, value_name = "AxB[xC]", requires = "decomp")]
+    pub rank_grid: Option<String>,
+    /// Move the domain boundaries when the busiest rank owns more than this times the mean
+    /// particle count.
+    #[arg(long, default_value_t = 1.1, value_parser = parse_positive, requires = "decomp")]
+    pub rebalance_above: f64,
+    /// Keep the domain boundaries fixed: equal regions, never rebalanced.
+    #[arg(long, requires = "decomp")]
+    pub no_rebalance: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct MpiCheckArgs {
+    /// Scenario to simulate.
+    #[arg(long, value_enum)]
+    pub scenario: ScenarioKind,
+    /// Force kernel (the same for the MPI and the serial run).
+    #[arg(long, value_enum)]
+    pub kernel: KernelKind,
+    /// Decomposition to check.
+    #[arg(long, value_enum)]
+    pub decomp: Decomposition,
+    /// Time steps to integrate.
+    #[arg(long, default_value_t = 20, value_parser = parse_count)]
+    pub steps: usize,
+    #[command(flatten)]
+    pub system: SystemArgs,
+    #[command(flatten)]
+    pub kernel_args: KernelArgs,
+    #[command(flatten)]
+    pub mpi: MpiOptions,
+    /// Largest difference allowed, relative to the box size (positions) and the largest speed
+    /// (velocities) [default: 1e-9 in f64, 1e-4 in f32].
+    #[arg(long, value_parser = parse_positive)]
+    pub tolerance: Option<f64>,
+    /// Also fail unless some particle changed rank during the run.
+    #[arg(long)]
+    pub expect_migration: bool,
+    /// Also fail unless some particle moved beyond the neighbouring regions in one step.
+    #[arg(long)]
+    pub expect_far_migration: bool,
+    /// Also fail unless some rank owns no particle at the end.
+    #[arg(long)]
+    pub expect_empty_rank: bool,
+    /// Also fail unless the domain boundaries moved to rebalance the load during the run.
+    #[arg(long)]
+    pub expect_rebalance: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct MpiBenchArgs {
+    /// Where to write the timings (JSON, schema nbody-bench/mpi-bench/v1).
+    #[arg(long, value_name = "FILE", default_value = "mpi-bench.json")]
+    pub out: PathBuf,
+    /// Largest message in bytes (per rank for Allgatherv); sizes are 1, 4, 16, ... up to it.
+    #[arg(long, default_value_t = 4 << 20, value_parser = parse_count)]
+    pub max_bytes: usize,
+    /// Timed repetitions per size up to 64 KiB (fewer above, in proportion, at least 10).
+    #[arg(long, default_value_t = 100, value_parser = parse_count)]
+    pub reps: usize,
+    /// Untimed repetitions before each size.
+    #[arg(long, default_value_t = 5)]
+    pub warmup: usize,
 }
 
 #[derive(Debug, Args)]

@@ -11,12 +11,15 @@ pub mod boundary;
 pub mod calibrate;
 pub mod cli;
 pub mod commands;
+pub mod decomp;
 pub mod engine;
 pub mod experiment;
 pub mod fit;
 pub mod gate;
 pub mod integrator;
 pub mod kernels;
+#[cfg(feature = "mpi")]
+pub mod mpi;
 pub mod output;
 pub mod physics;
 pub mod plot;

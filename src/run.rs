@@ -83,6 +83,9 @@ pub struct RunOutcome {
     pub counters: Counters,
     pub energy: EnergyCheck,
     pub momentum: MomentumCheck,
+    /// Ranks, decomposition and per-rank statistics of an MPI run (`--decomp`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mpi: Option<crate::decomp::stats::MpiReport>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -263,6 +266,7 @@ fn measure<T: Real, const D: usize>(
             initial: p0,
             last: sim.state.momentum().to_vec(),
         },
+        mpi: None,
     })
 }
 

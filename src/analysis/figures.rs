@@ -176,7 +176,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         out.push((format!("speedup-{stem}"), Drawing::Chart(chart)));
         let eff: Vec<KernelSeries> = same
             .iter()
-            .filter_map(|s| {
+            .map(|s| {
                 let m: Vec<Measured> = s
                     .measured
                     .iter()
@@ -190,7 +190,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                         .oversubscribed(oversubscribed_at(&s.points, p.p))
                     })
                     .collect();
-                Some(KernelSeries::new(s.label.clone(), m))
+                KernelSeries::new(s.label.clone(), m)
             })
             .collect();
         let mut chart = fig::efficiency(&eff, &cap);
@@ -232,17 +232,16 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
             .weak
             .iter()
             .filter(|o| o.series.scenario == w.series.scenario)
-            .filter_map(|o| {
-                let f = o.fit.fit.as_ref()?;
-                let m = f
-                    .efficiency
+            .map(|o| {
+                let m: Vec<Measured> = o
+                    .measured
                     .iter()
                     .map(|e| {
                         Measured::with_ci(e.p, e.e.estimate, e.e.ci95[0], e.e.ci95[1])
                             .oversubscribed(oversubscribed_at(&o.points, e.p))
                     })
                     .collect();
-                Some(KernelSeries::new(o.label.clone(), m))
+                KernelSeries::new(o.label.clone(), m)
             })
             .collect();
         let mut chart = fig::weak_efficiency(&series, &cap);
@@ -268,7 +267,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 interact: c.phases.force_interact,
                 integrate: c.phases.integrate,
                 boundary: c.phases.boundary,
-                communication: 0.0,
+                communication: c.comm_s_per_step.unwrap_or(0.0),
             })
             .collect();
         let mut bars = fig::phase_breakdown(&phases, &cap);
@@ -338,6 +337,7 @@ fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
                 && o.threads == c.threads
                 && o.ranks == c.ranks
                 && o.theta == c.theta
+                && o.decomp == c.decomp
         };
         match out.iter().position(same) {
             Some(i) if out[i].n < c.n => out[i] = c,

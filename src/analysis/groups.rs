@@ -20,6 +20,11 @@ pub struct Point {
     /// Simulated-time factor of a weak-by-time case (1 otherwise).
     pub time_factor: u64,
     pub theta: Option<f64>,
+    /// MPI decomposition of a case run under a launcher.
+    pub decomp: Option<String>,
+    /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases).
+    pub comm_s_per_step: Option<f64>,
+    pub bytes_per_step: Option<f64>,
     /// Seconds per step: every raw sample, the median and its bootstrap 95% CI.
     #[serde(skip)]
     pub samples: Vec<f64>,
@@ -52,6 +57,7 @@ pub struct SeriesKey {
     pub n: Option<usize>,
     pub threads: Option<usize>,
     pub ranks: Option<usize>,
+    pub decomp: Option<String>,
 }
 
 impl SeriesKey {
@@ -60,6 +66,9 @@ impl SeriesKey {
         let mut s = self.kernel.name().to_string();
         if let Some(t) = self.theta {
             s.push_str(&format!(" θ={t}"));
+        }
+        if let Some(d) = &self.decomp {
+            s.push_str(&format!(" ({d})"));
         }
         match (self.threads, self.ranks) {
             (Some(t), Some(1)) if t > 1 => s.push_str(&format!(", {t} threads")),
@@ -107,6 +116,7 @@ pub fn group(results: &ResultsFile) -> Groups {
         n: Some(c.n),
         threads: Some(c.threads),
         ranks: Some(c.ranks),
+        decomp: c.decomp.clone(),
     };
     let records: Vec<(&Point, &CaseRecord)> = cases
         .iter()
@@ -199,6 +209,9 @@ fn point(r: &CaseRecord) -> Option<Point> {
         ranks: r.case.ranks,
         time_factor: r.case.time_factor,
         theta: r.case.theta,
+        decomp: r.case.decomp.map(|d| d.name().to_string()),
+        comm_s_per_step: mpi_mean(r, &|m| m.reduced.comm_s.mean),
+        bytes_per_step: mpi_mean(r, &|m| m.reduced.bytes_sent.mean),
         samples: r
             .rounds
             .iter()
@@ -215,4 +228,14 @@ fn point(r: &CaseRecord) -> Option<Point> {
         max_energy_drift: s.max_energy_drift,
         sanity_ok: s.sanity_ok,
     })
+}
+
+/// Mean over the rounds of an MPI statistic (a total over the round's steps), per step.
+fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64) -> Option<f64> {
+    let per_step: Vec<f64> = r
+        .rounds
+        .iter()
+        .filter_map(|round| Some(f(round.mpi.as_ref()?) / round.steps.max(1) as f64))
+        .collect();
+    (!per_step.is_empty()).then(|| per_step.iter().sum::<f64>() / per_step.len() as f64)
 }

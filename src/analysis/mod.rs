@@ -4,6 +4,7 @@
 //! then [`write`]; everything is recomputed from the raw samples, with seeded bootstraps, so the
 //! same results file always gives the same output.
 
+pub mod comm;
 pub mod figures;
 pub mod groups;
 pub mod summary;
@@ -89,6 +90,9 @@ pub struct WeakAnalysis {
     pub label: String,
     pub rule: Option<WeakRule>,
     pub points: Vec<Point>,
+    /// Efficiency at every measured p, oversubscribed ones included.
+    pub measured: Vec<fit::EfficiencyPoint>,
+    /// Gustafson's model, fitted to the cases that had a logical CPU per worker only.
     pub fit: Fitted<WeakFit>,
 }
 
@@ -358,14 +362,44 @@ fn cost_class(kernel: KernelKind) -> ComplexityClass {
 }
 
 fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
-    let fit = if rule == Some(WeakRule::Time) {
+    let real: Vec<Point> = s
+        .points
+        .iter()
+        .filter(|p| !p.oversubscribed)
+        .cloned()
+        .collect();
+    let fit = Fitted::of(fit_weak_points(&real, s.key.kernel, rule));
+    let measured = match fit_weak_points(&s.points, s.key.kernel, rule) {
+        Ok(f) => f.efficiency,
+        Err(_) => fit
+            .fit
+            .as_ref()
+            .map(|f| f.efficiency.clone())
+            .unwrap_or_default(),
+    };
+    WeakAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        rule,
+        points: s.points.clone(),
+        measured,
+        fit,
+    }
+}
+
+fn fit_weak_points(
+    points: &[Point],
+    kernel: KernelKind,
+    rule: Option<WeakRule>,
+) -> Result<WeakFit, fit::FitError> {
+    if rule == Some(WeakRule::Time) {
         // n is fixed and the simulated time grows with p: the time of the scaled work is the
         // step time times the time factor.
-        let data = samples_by(&s.points, |p| p.p() as f64, |p| p.time_factor as f64);
+        let data = samples_by(points, |p| p.p() as f64, |p| p.time_factor as f64);
         fit::fit_weak(&data, fit::DEFAULT_SEED)
     } else {
         let mut data: Vec<WeakSamples> = Vec::new();
-        for p in &s.points {
+        for p in points {
             match data.iter_mut().find(|w| w.p == p.p() as f64) {
                 Some(w) => w.values.extend(&p.samples),
                 None => data.push(WeakSamples {
@@ -375,14 +409,7 @@ fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
                 }),
             }
         }
-        fit::fit_weak_with_n(&data, cost_class(s.key.kernel), fit::DEFAULT_SEED)
-    };
-    WeakAnalysis {
-        series: s.key.clone(),
-        label: s.key.label(),
-        rule,
-        points: s.points.clone(),
-        fit: Fitted::of(fit),
+        fit::fit_weak_with_n(&data, cost_class(kernel), fit::DEFAULT_SEED)
     }
 }
 

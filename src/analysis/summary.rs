@@ -153,8 +153,8 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
                 let _ = writeln!(md, "| {} | {} | |", w.label, failed(&w.fit));
                 continue;
             };
-            let cells: Vec<String> = f
-                .efficiency
+            let cells: Vec<String> = w
+                .measured
                 .iter()
                 .map(|e| {
                     let n = w

@@ -5,6 +5,7 @@ mod fit;
 mod fit_tables;
 mod gate;
 mod list;
+mod mpi;
 mod report;
 mod run;
 mod sweep;
@@ -27,6 +28,8 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Report(args) => report::report(args),
         Command::Fit(args) => fit::fit(args),
         Command::Gate(args) => gate::gate(args),
+        Command::MpiBench(args) => mpi::bench(args),
+        Command::MpiCheck(args) => mpi::check(args),
     }
 }
 

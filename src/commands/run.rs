@@ -4,6 +4,9 @@ use crate::run::{RunJob, RunOutcome, RunSpec, TrajectorySpec, logical_cpus};
 use anyhow::Context;
 
 pub fn run(args: RunArgs) -> anyhow::Result<i32> {
+    if let Some(decomp) = args.decomp {
+        return super::mpi::run(args, decomp);
+    }
     let setup = setup(args.scenario, &args.system);
     let spec = RunSpec {
         kernel: args.kernel,
@@ -34,7 +37,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     Ok(0)
 }
 
-fn print_summary(r: &RunOutcome) {
+pub(super) fn print_summary(r: &RunOutcome) {
     let t = &r.timing;
     println!(
         "{} / {}: n = {}, {} steps, {} thread{}{}, {}-D {}, seed {}, simd {}",

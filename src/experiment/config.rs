@@ -1,6 +1,7 @@
 //! Sweep configurations: TOML files, typed, unknown keys rejected, validated before anything
 //! runs. Every error names the file, the key and what is allowed.
 
+use crate::decomp::Decomposition;
 use crate::kernels::KernelKind;
 use crate::scenario::{Precision, ScenarioKind};
 use serde::{Deserialize, Serialize};
@@ -155,6 +156,52 @@ pub struct SweepConfig {
     pub measure: Measure,
     #[serde(default)]
     pub weak: Option<Weak>,
+    /// Run every case under an MPI launcher (`mpirun -n R nbody-bench run --decomp ...`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mpi: Option<MpiLaunch>,
+}
+
+/// How a sweep starts MPI cases (the `[mpi]` table). Each round of a case is one launch; its
+/// timed steps are split into the round's samples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpiLaunch {
+    /// The launcher program: mpirun, mpiexec, srun, ...
+    #[serde(default = "default_launcher")]
+    pub launcher: String,
+    /// Rank counts; each case runs at every one (weak studies scale n with threads × ranks).
+    pub ranks: Vec<usize>,
+    /// Launcher arguments before the rank count, e.g. ["--oversubscribe", "--bind-to", "none"].
+    #[serde(default)]
+    pub args: Vec<String>,
+    /// The launcher's option that takes the rank count.
+    #[serde(default = "default_rank_flag")]
+    pub rank_flag: String,
+    /// Decompositions; each kernel runs with those that support it.
+    #[serde(default = "default_decomp")]
+    pub decomp: Vec<Decomposition>,
+    /// Timed steps per launch, split into the round's samples.
+    #[serde(default = "default_mpi_steps")]
+    pub steps: usize,
+    /// Untimed steps before them.
+    #[serde(default = "default_mpi_warmup")]
+    pub warmup_steps: usize,
+}
+
+fn default_launcher() -> String {
+    "mpirun".into()
+}
+fn default_rank_flag() -> String {
+    "-n".into()
+}
+fn default_decomp() -> Vec<Decomposition> {
+    vec![Decomposition::Allgather]
+}
+fn default_mpi_steps() -> usize {
+    100
+}
+fn default_mpi_warmup() -> usize {
+    10
 }
 
 fn one_thread() -> Vec<usize> {
@@ -318,6 +365,9 @@ impl SweepConfig {
                 "must include 1 for a strong-scaling study (speedups are relative to it)".into(),
             ));
         }
+        if let Some(mpi) = &self.mpi {
+            self.validate_mpi(mpi, path)?;
+        }
         let m = &self.measure;
         if m.samples == 0 || m.rounds == 0 || m.rounds > m.samples {
             return Err(bad(
@@ -339,6 +389,61 @@ impl SweepConfig {
             return Err(bad(
                 "measure.max_energy_drift",
                 "must be a finite number > 0".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+impl SweepConfig {
+    fn validate_mpi(&self, mpi: &MpiLaunch, path: &Path) -> Result<(), ConfigError> {
+        let bad = |key: &str, problem: String| ConfigError::Invalid {
+            path: path.into(),
+            key: key.into(),
+            problem,
+        };
+        if mpi.launcher.trim().is_empty() {
+            return Err(bad(
+                "mpi.launcher",
+                "must name a program such as mpirun".into(),
+            ));
+        }
+        if mpi.ranks.is_empty() || mpi.ranks.contains(&0) {
+            return Err(bad(
+                "mpi.ranks",
+                "must be a non-empty list of rank counts >= 1".into(),
+            ));
+        }
+        if self.study == Study::Strong && !mpi.ranks.contains(&1) {
+            return Err(bad(
+                "mpi.ranks",
+                "must include 1 for a strong-scaling study (speedups are relative to it)".into(),
+            ));
+        }
+        if mpi.decomp.is_empty() {
+            return Err(bad(
+                "mpi.decomp",
+                "must list at least one of allgather, domain".into(),
+            ));
+        }
+        for &k in &self.kernels {
+            if !mpi.decomp.iter().any(|d| d.supports(k)) {
+                return Err(bad(
+                    "mpi.decomp",
+                    format!(
+                        "has no decomposition for kernel `{}`; domain runs the cell list only, allgather any kernel",
+                        k.name()
+                    ),
+                ));
+            }
+        }
+        let per_round = self.measure.samples.div_ceil(self.measure.rounds.max(1));
+        if mpi.steps < per_round {
+            return Err(bad(
+                "mpi.steps",
+                format!(
+                    "must be at least the samples of a round ({per_round}): each launch's steps are split into them"
+                ),
             ));
         }
         Ok(())

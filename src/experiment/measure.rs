@@ -113,6 +113,9 @@ pub struct RoundOutcome {
     /// warm-up): the same in every run of the same code, whatever the timing.
     #[serde(default)]
     pub initial_work: Option<WorkCounters>,
+    /// Ranks, decomposition and per-rank statistics of a case run under an MPI launcher.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mpi: Option<crate::decomp::stats::MpiReport>,
 }
 
 /// Measures a round of `case` on the system it is given.
@@ -240,11 +243,12 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         },
         reference_s: reference,
         initial_work: Some(initial_work),
+        mpi: None,
     })
 }
 
 /// Seconds per clock reading (two readings bracket each timed step).
-fn clock_cost<C: Clock>(clock: &C) -> f64 {
+pub(super) fn clock_cost<C: Clock>(clock: &C) -> f64 {
     let reps = 1000;
     let t0 = clock.now();
     for _ in 0..reps {

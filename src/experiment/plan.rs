@@ -1,6 +1,7 @@
 //! Expands a sweep config into the list of cases to measure.
 
 use super::config::{Study, SweepConfig, WeakRule};
+use crate::decomp::Decomposition;
 use crate::kernels::KernelKind;
 use crate::scenario::{Precision, ScenarioKind};
 use serde::{Deserialize, Serialize};
@@ -21,6 +22,9 @@ pub struct Case {
     /// Simulated-time factor of a weak-by-time study (the run stands for this many times the
     /// steps of the one-thread case); 1 otherwise.
     pub time_factor: u64,
+    /// How the case is split over MPI ranks (cases run under the config's MPI launcher).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub decomp: Option<Decomposition>,
 }
 
 impl Case {
@@ -44,6 +48,9 @@ impl Case {
         if self.time_factor != 1 {
             k.push_str(&format!("/time-x{}", self.time_factor));
         }
+        if let Some(d) = self.decomp {
+            k.push_str(&format!("/{}", d.name()));
+        }
         k
     }
 }
@@ -58,9 +65,29 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
             } else {
                 vec![None]
             };
-            for &threads in &config.threads {
+            // Without MPI one launch of one rank; under a launcher, every rank count with
+            // every decomposition that runs this kernel.
+            let launches: Vec<(usize, Option<Decomposition>)> = match &config.mpi {
+                None => vec![(1, None)],
+                Some(m) => m
+                    .ranks
+                    .iter()
+                    .flat_map(|&r| {
+                        m.decomp
+                            .iter()
+                            .filter(|d| d.supports(kernel))
+                            .map(move |&d| (r, Some(d)))
+                    })
+                    .collect(),
+            };
+            for (&threads, &(ranks, decomp)) in config
+                .threads
+                .iter()
+                .flat_map(|t| launches.iter().map(move |l| (t, l)))
+            {
+                let workers = threads * ranks;
                 let sizes: Vec<(usize, u64)> = match (&config.study, &config.weak) {
-                    (Study::Weak, Some(w)) => vec![weak_size(kernel, w.rule, w.base_n, threads)],
+                    (Study::Weak, Some(w)) => vec![weak_size(kernel, w.rule, w.base_n, workers)],
                     _ => config
                         .n
                         .as_ref()
@@ -78,11 +105,12 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                                 kernel,
                                 n,
                                 threads,
-                                ranks: 1,
+                                ranks,
                                 theta,
                                 seed,
                                 precision: config.precision,
                                 time_factor,
+                                decomp,
                             });
                         }
                     }
@@ -90,7 +118,18 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
             }
         }
     }
-    out.sort_by_key(|c| (c.scenario as u8, c.kernel as u8, c.n, c.threads, c.seed));
+    out.sort_by_key(|c| {
+        let decomp = c.decomp.map_or(0, |d| d as u8 + 1);
+        (
+            c.scenario as u8,
+            c.kernel as u8,
+            decomp,
+            c.n,
+            c.threads,
+            c.ranks,
+            c.seed,
+        )
+    });
     out
 }
 

@@ -288,7 +288,11 @@ impl Metadata {
                 .to_string(),
             simd: crate::simd::level().name().to_string(),
             target_features: compiled_features(),
-            cargo_features: Vec::new(),
+            cargo_features: [("mpi", cfg!(feature = "mpi"))]
+                .iter()
+                .filter(|(_, on)| *on)
+                .map(|(name, _)| name.to_string())
+                .collect(),
             profile: if cfg!(debug_assertions) {
                 "debug"
             } else {

@@ -65,6 +65,11 @@ pub enum SweepError {
     },
     #[error("{0}")]
     Slowdown(String),
+    #[error(
+        "config `{config}` runs cases under MPI: {}",
+        crate::decomp::WITHOUT_MPI
+    )]
+    WithoutMpi { config: String },
     #[error("cannot create {path}: {source}")]
     Dir {
         path: PathBuf,
@@ -96,6 +101,12 @@ pub fn run_sweep<C: Clock>(
     clock: &C,
     observer: &mut dyn Observer,
 ) -> Result<SweepReport, SweepError> {
+    if config.mpi.is_some() && !cfg!(feature = "mpi") {
+        // The launcher starts this program, which must have the MPI drivers.
+        return Err(SweepError::WithoutMpi {
+            config: config.name.clone(),
+        });
+    }
     let path = results_path(config, options.out.as_deref());
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     let mut results = open(config, config_text, options, &path)?;
@@ -188,11 +199,12 @@ pub fn run_sweep<C: Clock>(
                 reference_s: config.measure.reference_s,
                 slowdown,
             };
-            let outcome =
-                measure_case(&record.case, &spec, clock).map_err(|source| SweepError::Case {
+            let outcome = measure_case(&record.case, &spec, clock, config).map_err(|source| {
+                SweepError::Case {
                     key: record.key.clone(),
                     source,
-                })?;
+                }
+            })?;
             let record = &mut results.cases[i];
             record.add_round(outcome, config.measure.max_energy_drift);
             results.save(&path)?;
@@ -223,7 +235,11 @@ fn measure_case<C: Clock>(
     case: &Case,
     spec: &RoundSpec,
     clock: &C,
+    config: &SweepConfig,
 ) -> Result<super::measure::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
+    if let Some(launch) = &config.mpi {
+        return Ok(super::launcher::measure_round(launch, case, spec)?);
+    }
     let mut setup = Setup::new(case.scenario);
     setup.n = Some(case.n);
     setup.seed = case.seed;

@@ -118,6 +118,7 @@ fn results(run: Run) -> ResultsFile {
                     pairs_interacting: 500,
                     ..Default::default()
                 }),
+                mpi: None,
             };
             record.add_round(round, 0.05);
         }

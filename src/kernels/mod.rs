@@ -12,18 +12,21 @@ mod octree;
 mod par;
 mod per_thread;
 pub mod rows;
+mod share;
 mod symmetric;
 
 pub use cell_list::CellList;
 pub use naive::Naive;
 pub use octree::Octree;
 pub use per_thread::PerThread;
+pub use share::Share;
 pub use symmetric::Symmetric;
 
 use crate::physics::{LawKind, PairLaw};
 use crate::real::Real;
-use crate::state::{Field, State};
+use crate::state::{Field, State, zero_field};
 use serde::Serialize;
+use std::ops::Range;
 use thiserror::Error;
 
 /// The five kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
@@ -211,6 +214,46 @@ pub trait ForceKernel<T: Real, const D: usize>: Send {
     /// curve order), as `order[new_slot] = old_slot`, if the kernel benefits from one.
     fn spatial_order(&mut self, _state: &State<T, D>) -> Option<Vec<u32>> {
         None
+    }
+
+    /// The forces on the particles in slots `targets` only, from every particle of `state`:
+    /// `out[d][k]` receives component `d` of the force on slot `targets.start + k` (the timed
+    /// path: no energy). Drivers that split the targets between processes use it.
+    ///
+    /// The default computes every force and copies the range (correct, but no cheaper);
+    /// kernels that can visit only the targets' pairs override it.
+    fn compute_targets(
+        &mut self,
+        state: &State<T, D>,
+        targets: Range<usize>,
+        out: [&mut [T]; D],
+    ) -> ForceReport {
+        let mut all = zero_field(state.len());
+        let report = self.compute(state, &mut all, false);
+        for (d, o) in out.into_iter().enumerate() {
+            o.copy_from_slice(&all[d][targets.clone()]);
+        }
+        report
+    }
+
+    /// Overwrites `forces` (length n) with `share`'s part of the forces: summed over all the
+    /// shares, `forces` is what [`ForceKernel::compute`] gives.
+    ///
+    /// The default gives the targets of `share.block(n)` their whole force and every other
+    /// particle zero. The symmetric kernels override it to split the pair work instead: each
+    /// share evaluates a balanced part of the pairs, once each, and adds the force to both ends.
+    fn compute_share(
+        &mut self,
+        state: &State<T, D>,
+        share: Share,
+        forces: &mut Field<T, D>,
+    ) -> ForceReport {
+        let block = share.block(state.len());
+        for f in forces.iter_mut() {
+            f.fill(T::zero());
+        }
+        let out = forces.each_mut().map(|f| &mut f[block.clone()]);
+        self.compute_targets(state, block, out)
     }
 }
 

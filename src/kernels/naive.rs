@@ -8,6 +8,7 @@ use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
+use std::ops::Range;
 
 pub struct Naive<L> {
     law: L,
@@ -60,37 +61,62 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
         probe: bool,
     ) -> ForceReport {
         let n = state.len();
-        let law = &self.law;
-        let pair_checks = (n as u64) * (n.saturating_sub(1) as u64);
         let out = forces.each_mut().map(|f| f.as_mut_slice());
-        let mut report = ForceReport {
+        if probe {
+            let law = &self.law;
+            let total = simd::dispatch(
+                #[inline(always)]
+                || rows::<T, L, D, true>(law, state, 0, out),
+            );
+            ForceReport {
+                // Each pair was seen from both ends.
+                energy: Some(0.5 * total.energy.as_f64()),
+                build_s: 0.0,
+                work: WorkCounters {
+                    pair_checks: (n as u64) * (n.saturating_sub(1) as u64),
+                    pairs_interacting: total.interacting / 2,
+                    ..Default::default()
+                },
+            }
+        } else {
+            self.compute_targets(state, 0..n, out)
+        }
+    }
+
+    /// Each target is an independent row, so only the targets' rows are evaluated.
+    fn compute_targets(
+        &mut self,
+        state: &State<T, D>,
+        targets: Range<usize>,
+        out: [&mut [T]; D],
+    ) -> ForceReport {
+        let n = state.len();
+        let law = &self.law;
+        let pair_checks = (targets.len() as u64) * (n.saturating_sub(1) as u64);
+        if worth_parallel(pair_checks) {
+            for_chunks(
+                out,
+                targets.start,
+                chunk_len(targets.len()),
+                &|offset, chunk| {
+                    simd::dispatch(
+                        #[inline(always)]
+                        || rows::<T, L, D, false>(law, state, offset, chunk),
+                    );
+                },
+            );
+        } else {
+            simd::dispatch(
+                #[inline(always)]
+                || rows::<T, L, D, false>(law, state, targets.start, out),
+            );
+        }
+        ForceReport {
             work: WorkCounters {
                 pair_checks,
                 ..Default::default()
             },
             ..Default::default()
-        };
-        if probe {
-            let total = simd::dispatch(
-                #[inline(always)]
-                || rows::<T, L, D, true>(law, state, 0, out),
-            );
-            // Each pair was seen from both ends.
-            report.energy = Some(0.5 * total.energy.as_f64());
-            report.work.pairs_interacting = total.interacting / 2;
-        } else if worth_parallel(pair_checks) {
-            for_chunks(out, 0, chunk_len(n), &|offset, chunk| {
-                simd::dispatch(
-                    #[inline(always)]
-                    || rows::<T, L, D, false>(law, state, offset, chunk),
-                );
-            });
-        } else {
-            simd::dispatch(
-                #[inline(always)]
-                || rows::<T, L, D, false>(law, state, 0, out),
-            );
         }
-        report
     }
 }

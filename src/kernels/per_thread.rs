@@ -5,8 +5,8 @@
 //! Steps too small to pay for a fork/join run the serial symmetric path instead.
 
 use super::par::{chunk_len, for_chunks};
-use super::symmetric::{add_tiles, blocks, tile_pairs};
-use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
+use super::symmetric::{add_tiles, blocks, pairs_of, split_tiles};
+use super::{ForceKernel, ForceReport, KernelKind, Share, WorkCounters, worth_parallel};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -18,7 +18,8 @@ pub struct PerThread<L, T: Real, const D: usize> {
     law: L,
     buffers: Vec<Field<T, D>>,
     partition: Vec<Range<usize>>,
-    partition_key: (usize, usize),
+    /// (n, tiles, parts) of the cached partition.
+    partition_key: (usize, Range<usize>, usize),
 }
 
 impl<L, T: Real, const D: usize> PerThread<L, T, D> {
@@ -27,80 +28,55 @@ impl<L, T: Real, const D: usize> PerThread<L, T, D> {
             law,
             buffers: Vec::new(),
             partition: Vec::new(),
-            partition_key: (0, 0),
+            partition_key: (0, 0..0, 0),
         }
     }
 
-    /// Splits the target tiles into `parts` contiguous ranges of near-equal pair work.
-    fn partition(&mut self, n: usize, parts: usize) {
-        if self.partition_key == (n, parts) {
+    /// Splits the target tiles `tiles` into `parts` contiguous ranges of near-equal pair work.
+    fn partition(&mut self, n: usize, tiles: Range<usize>, parts: usize) {
+        let key = (n, tiles.clone(), parts);
+        if self.partition_key == key {
             return;
         }
-        let tiles = blocks(n);
-        let total: u64 = (0..tiles).map(|b| tile_pairs(n, b)).sum();
-        let mut ranges = Vec::with_capacity(parts);
-        let (mut start, mut acc) = (0, 0u64);
-        for b in 0..tiles {
-            acc += tile_pairs(n, b);
-            let goal = total * (ranges.len() as u64 + 1) / parts as u64;
-            if acc >= goal && ranges.len() + 1 < parts {
-                ranges.push(start..b + 1);
-                start = b + 1;
-            }
-        }
-        ranges.push(start..tiles);
-        self.partition = ranges;
+        self.partition = split_tiles(n, tiles, parts);
         if self.buffers.len() != self.partition.len() || self.buffers[0][0].len() != n {
             self.buffers = (0..self.partition.len()).map(|_| zero_field(n)).collect();
         }
-        self.partition_key = (n, parts);
+        self.partition_key = key;
     }
 }
 
-impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, T, D> {
-    fn kind(&self) -> KernelKind {
-        KernelKind::PerThread
+impl<T: Real, L: PairLaw<T>, const D: usize> PerThread<L, T, D> {
+    /// Overwrites `forces` with the forces of the pairs of target tiles `tiles` (both ends),
+    /// on one thread.
+    fn serial_tiles<const PROBE: bool>(
+        &self,
+        state: &State<T, D>,
+        tiles: Range<usize>,
+        forces: &mut Field<T, D>,
+    ) -> (f64, u64) {
+        let law = &self.law;
+        for f in forces.iter_mut() {
+            f.fill(T::zero());
+        }
+        let mut out = forces.each_mut().map(|f| f.as_mut_slice());
+        let total = simd::dispatch(
+            #[inline(always)]
+            || add_tiles::<T, L, D, PROBE>(law, state, tiles, &mut out),
+        );
+        (total.energy.as_f64(), total.interacting)
     }
 
-    fn compute(
+    /// Overwrites `forces` with the forces of the pairs of target tiles `tiles` (both ends),
+    /// the tiles split over the pool's threads, each into its own buffer, then reduced.
+    fn parallel_tiles(
         &mut self,
         state: &State<T, D>,
+        tiles: Range<usize>,
         forces: &mut Field<T, D>,
-        probe: bool,
-    ) -> ForceReport {
+    ) {
         let n = state.len();
-        let pair_checks = (n as u64) * (n.saturating_sub(1) as u64) / 2;
-        let mut report = ForceReport {
-            work: WorkCounters {
-                pair_checks,
-                ..Default::default()
-            },
-            ..Default::default()
-        };
-        let law = &self.law;
-        if probe || !worth_parallel(pair_checks) || blocks(n) < 2 {
-            // Serial path: the probe runs outside the timed steps; small steps lose to fork/join.
-            for f in forces.iter_mut() {
-                f.fill(T::zero());
-            }
-            let mut out = forces.each_mut().map(|f| f.as_mut_slice());
-            let tiles = 0..blocks(n);
-            let total = if probe {
-                simd::dispatch(
-                    #[inline(always)]
-                    || add_tiles::<T, L, D, true>(law, state, tiles, &mut out),
-                )
-            } else {
-                simd::dispatch(
-                    #[inline(always)]
-                    || add_tiles::<T, L, D, false>(law, state, tiles, &mut out),
-                )
-            };
-            report.energy = probe.then(|| total.energy.as_f64());
-            report.work.pairs_interacting = total.interacting;
-            return report;
-        }
-        self.partition(n, rayon::current_num_threads());
+        self.partition(n, tiles, rayon::current_num_threads());
         let law = &self.law;
         self.buffers
             .par_iter_mut()
@@ -128,6 +104,72 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, 
                 }
             }
         });
-        report
+    }
+
+    /// Forces of the pairs of target tiles `tiles`, in parallel when it pays.
+    fn tiles(&mut self, state: &State<T, D>, tiles: Range<usize>, forces: &mut Field<T, D>) -> u64 {
+        let pair_checks = pairs_of(state.len(), tiles.clone());
+        if !worth_parallel(pair_checks) || tiles.len() < 2 {
+            // Small steps lose to fork/join.
+            self.serial_tiles::<false>(state, tiles, forces);
+        } else {
+            self.parallel_tiles(state, tiles, forces);
+        }
+        pair_checks
+    }
+}
+
+impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, T, D> {
+    fn kind(&self) -> KernelKind {
+        KernelKind::PerThread
+    }
+
+    fn compute(
+        &mut self,
+        state: &State<T, D>,
+        forces: &mut Field<T, D>,
+        probe: bool,
+    ) -> ForceReport {
+        let tiles = 0..blocks(state.len());
+        if probe {
+            // The probe runs outside the timed steps, on one thread.
+            let (energy, interacting) = self.serial_tiles::<true>(state, tiles.clone(), forces);
+            return ForceReport {
+                energy: Some(energy),
+                build_s: 0.0,
+                work: WorkCounters {
+                    pair_checks: pairs_of(state.len(), tiles),
+                    pairs_interacting: interacting,
+                    ..Default::default()
+                },
+            };
+        }
+        let pair_checks = self.tiles(state, tiles, forces);
+        ForceReport {
+            work: WorkCounters {
+                pair_checks,
+                ..Default::default()
+            },
+            ..Default::default()
+        }
+    }
+
+    /// A balanced share of the target tiles, split again over the pool's threads.
+    fn compute_share(
+        &mut self,
+        state: &State<T, D>,
+        share: Share,
+        forces: &mut Field<T, D>,
+    ) -> ForceReport {
+        let n = state.len();
+        let tiles = split_tiles(n, 0..blocks(n), share.count)[share.index].clone();
+        let pair_checks = self.tiles(state, tiles, forces);
+        ForceReport {
+            work: WorkCounters {
+                pair_checks,
+                ..Default::default()
+            },
+            ..Default::default()
+        }
     }
 }

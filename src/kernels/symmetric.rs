@@ -6,11 +6,12 @@
 //! particles meet sources one block at a time.
 
 use super::rows::{Exclude, LANES, RowSum, Sources, Target, scatter};
-use super::{ForceKernel, ForceReport, KernelKind, WorkCounters};
+use super::{ForceKernel, ForceReport, KernelKind, Share, WorkCounters};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
+use std::ops::Range;
 
 /// Particles per tile: positions, source strength and forces of a tile stay inside L1.
 pub const BLOCK: usize = 512;
@@ -36,6 +37,33 @@ pub fn tile_pairs(n: usize, b: usize) -> u64 {
     let hi = ((b + 1) * BLOCK).min(n);
     let len = (hi - lo) as u64;
     len * (len.saturating_sub(1)) / 2 + len * (n - hi) as u64
+}
+
+/// Splits the target tiles `tiles` into `parts` contiguous ranges of near-equal pair work
+/// (some empty when there are fewer tiles than parts).
+pub fn split_tiles(n: usize, tiles: Range<usize>, parts: usize) -> Vec<Range<usize>> {
+    let parts = parts.max(1);
+    let total: u64 = tiles.clone().map(|b| tile_pairs(n, b)).sum();
+    let mut ranges = Vec::with_capacity(parts);
+    let (mut start, mut acc) = (tiles.start, 0u64);
+    for b in tiles.clone() {
+        acc += tile_pairs(n, b);
+        let goal = total * (ranges.len() as u64 + 1) / parts as u64;
+        if acc >= goal && ranges.len() + 1 < parts {
+            ranges.push(start..b + 1);
+            start = b + 1;
+        }
+    }
+    ranges.push(start..tiles.end);
+    while ranges.len() < parts {
+        ranges.push(tiles.end..tiles.end);
+    }
+    ranges
+}
+
+/// The pair work of the target tiles `tiles`.
+pub fn pairs_of(n: usize, tiles: Range<usize>) -> u64 {
+    tiles.map(|b| tile_pairs(n, b)).sum()
 }
 
 /// Adds the forces of every pair (i, j) with i in target tiles `tiles` and j > i to `out`
@@ -124,6 +152,34 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Symmetric<L> 
                 pairs_interacting: total.interacting,
                 ..Default::default()
             },
+        }
+    }
+
+    /// A balanced share of the target tiles, both ends of each of their pairs.
+    fn compute_share(
+        &mut self,
+        state: &State<T, D>,
+        share: Share,
+        forces: &mut Field<T, D>,
+    ) -> ForceReport {
+        let n = state.len();
+        let law = &self.law;
+        let tiles = split_tiles(n, 0..blocks(n), share.count)[share.index].clone();
+        for f in forces.iter_mut() {
+            f.fill(T::zero());
+        }
+        let mut out = forces.each_mut().map(|f| f.as_mut_slice());
+        let pair_checks = pairs_of(n, tiles.clone());
+        simd::dispatch(
+            #[inline(always)]
+            || add_tiles::<T, L, D, false>(law, state, tiles, &mut out),
+        );
+        ForceReport {
+            work: WorkCounters {
+                pair_checks,
+                ..Default::default()
+            },
+            ..Default::default()
         }
     }
 }

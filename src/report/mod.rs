@@ -6,6 +6,7 @@
 //! ([`keep`]) that regeneration carries over, so the command never destroys analysis, and the
 //! same files always give the same text.
 
+mod comm_section;
 pub mod keep;
 mod sections;
 
@@ -43,6 +44,8 @@ pub enum ReportError {
     },
     #[error(transparent)]
     Write(#[from] crate::output::WriteError),
+    #[error("{0}")]
+    Bench(String),
 }
 
 /// One analysed sweep and where its figures are, relative to the report.
@@ -111,7 +114,8 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
             analysis: a,
         });
     }
-    let generated = sections::document(&sweeps, results_dir);
+    let comm = comm_model(results_dir, &sweeps, report_dir, &mut figure_errors)?;
+    let generated = sections::document(&sweeps, comm.as_ref(), results_dir);
     let old = match std::fs::read_to_string(out) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
@@ -135,6 +139,70 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
         figures: sweeps.iter().map(|s| s.figures.len()).sum(),
         figure_errors,
     })
+}
+
+/// The communication model and its figures, from the `mpi-bench-<ranks>.json` files under
+/// the results directory: the benchmark with the most ranks that still had a CPU each.
+fn comm_model(
+    results_dir: &Path,
+    sweeps: &[Sweep],
+    report_dir: &Path,
+    figure_errors: &mut Vec<String>,
+) -> Result<Option<sections::Comm>, ReportError> {
+    use crate::decomp::bench_file::MpiBenchFile;
+    let mut benches: Vec<(PathBuf, MpiBenchFile)> = Vec::new();
+    for dir in std::fs::read_dir(results_dir)
+        .map_err(|source| ReportError::Dir {
+            path: results_dir.into(),
+            source,
+        })?
+        .filter_map(|e| e.ok())
+    {
+        let Ok(files) = std::fs::read_dir(dir.path()) else {
+            continue;
+        };
+        for f in files.filter_map(|e| e.ok()).map(|e| e.path()) {
+            let name = f
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            if name.starts_with("mpi-bench") && name.ends_with(".json") {
+                let bench =
+                    MpiBenchFile::load(&f).map_err(|e| ReportError::Bench(e.to_string()))?;
+                benches.push((f, bench));
+            }
+        }
+    }
+    benches.sort_by(|a, b| a.0.cmp(&b.0));
+    let Some((path, bench)) = benches
+        .iter()
+        .filter(|(_, b)| !b.oversubscribed)
+        .max_by_key(|(_, b)| b.ranks)
+        .or(benches.first())
+    else {
+        return Ok(None);
+    };
+    let weak_mpi = sweeps
+        .iter()
+        .find(|s| s.analysis.cases.iter().any(|c| c.decomp.is_some()));
+    let n_per_rank = weak_mpi
+        .and_then(|s| s.analysis.cases.iter().find(|c| c.ranks == 1).map(|c| c.n))
+        .unwrap_or(20_000);
+    let model = crate::analysis::comm::comm_model(
+        bench,
+        &relative_source(path).to_string_lossy(),
+        n_per_rank,
+        crate::scenario::LJ_GAS_DENSITY,
+        crate::scenario::LJ_CUTOFF,
+    );
+    let dir = path.parent().expect("in a directory").join("analysis");
+    let (figures, errors) = sections::comm_figures(&model, weak_mpi, &dir);
+    figure_errors.extend(errors);
+    Ok(Some(sections::Comm {
+        model,
+        figures_dir: relative(&dir, report_dir),
+        figures,
+    }))
 }
 
 /// The path as given, with `/` separators, so the report does not depend on the machine.

@@ -23,7 +23,9 @@ fn flops_per_pair(law: LawKind) -> f64 {
     }
 }
 
-pub fn document(sweeps: &[Sweep], results_dir: &Path) -> String {
+pub use super::comm_section::{Comm, comm_figures};
+
+pub fn document(sweeps: &[Sweep], comm: Option<&Comm>, results_dir: &Path) -> String {
     let mut md = String::new();
     let dir = results_dir.display().to_string().replace('\\', "/");
     let _ = writeln!(
@@ -39,6 +41,7 @@ pub fn document(sweeps: &[Sweep], results_dir: &Path) -> String {
     complexity(&mut md, sweeps);
     strong(&mut md, sweeps);
     weak(&mut md, sweeps);
+    super::comm_section::section(&mut md, sweeps, comm, NO_NOTES);
     octree(&mut md, sweeps);
     sanity(&mut md, sweeps);
     md.push_str("\n## Comparison with the source documents\n\n");
@@ -299,8 +302,8 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
                 );
                 continue;
             };
-            let cells: Vec<String> = f
-                .efficiency
+            let cells: Vec<String> = w
+                .measured
                 .iter()
                 .map(|e| {
                     let c = w.points.iter().find(|c| c.p() as f64 == e.p);

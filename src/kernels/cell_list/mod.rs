@@ -28,7 +28,8 @@ use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
-use forces::targets;
+use forces::targets as gather_targets;
+use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 use strips::Strips;
@@ -94,9 +95,45 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
         probe: bool,
     ) -> ForceReport {
         let n = state.len();
+        let out = forces.each_mut().map(|f| f.as_mut_slice());
+        if !probe {
+            return self.compute_targets(state, 0..n, out);
+        }
+        if n == 0 {
+            return ForceReport {
+                energy: Some(0.0),
+                ..Default::default()
+            };
+        }
+        let clock = Instant::now();
+        self.build(state);
+        let build_s = clock.elapsed().as_secs_f64();
+        let (law, strips) = (&self.law, &self.strips);
+        let (total, work) = simd::dispatch(
+            #[inline(always)]
+            || gather_targets::<T, L, D, true>(law, strips, state, 0, out),
+        );
+        ForceReport {
+            // Each pair was seen from both ends.
+            energy: Some(0.5 * total.energy.as_f64()),
+            build_s,
+            work: WorkCounters {
+                pairs_interacting: total.interacting / 2,
+                ..work
+            },
+        }
+    }
+
+    /// The bins hold every particle; only the targets gather from their stencils.
+    fn compute_targets(
+        &mut self,
+        state: &State<T, D>,
+        targets: Range<usize>,
+        out: [&mut [T]; D],
+    ) -> ForceReport {
+        let n = state.len();
         let mut report = ForceReport::default();
         if n == 0 {
-            report.energy = probe.then_some(0.0);
             return report;
         }
         let clock = Instant::now();
@@ -104,23 +141,15 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
         report.build_s = clock.elapsed().as_secs_f64();
 
         let (law, strips) = (&self.law, &self.strips);
-        let out = forces.each_mut().map(|f| f.as_mut_slice());
-        if probe {
-            let (total, work) = simd::dispatch(
-                #[inline(always)]
-                || targets::<T, L, D, true>(law, strips, state, 0, out),
-            );
-            report.work = work;
-            // Each pair was seen from both ends.
-            report.energy = Some(0.5 * total.energy.as_f64());
-            report.work.pairs_interacting = total.interacting / 2;
-        } else if worth_parallel(strips.expected_candidates()) {
+        let candidates = strips.expected_candidates() / n as u64 * targets.len() as u64;
+        if worth_parallel(candidates) {
             let pair_checks = AtomicU64::new(0);
             let cells_visited = AtomicU64::new(0);
-            for_chunks(out, 0, chunk_len(n), &|offset, chunk| {
+            let chunk = chunk_len(targets.len());
+            for_chunks(out, targets.start, chunk, &|offset, chunk| {
                 let (_, work) = simd::dispatch(
                     #[inline(always)]
-                    || targets::<T, L, D, false>(law, strips, state, offset, chunk),
+                    || gather_targets::<T, L, D, false>(law, strips, state, offset, chunk),
                 );
                 pair_checks.fetch_add(work.pair_checks, Ordering::Relaxed);
                 cells_visited.fetch_add(work.cells_visited, Ordering::Relaxed);
@@ -133,7 +162,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
         } else {
             let (_, work) = simd::dispatch(
                 #[inline(always)]
-                || targets::<T, L, D, false>(law, strips, state, 0, out),
+                || gather_targets::<T, L, D, false>(law, strips, state, targets.start, out),
             );
             report.work = work;
         }

@@ -31,9 +31,10 @@ use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::state::{Field, State};
+use std::ops::Range;
 use std::sync::Mutex;
 use std::time::Instant;
-use tree::Tree;
+use tree::{Group, Tree};
 use walk::{Scratch, Totals, eval_groups, for_group_runs};
 
 /// Most particles in a target group sharing one interaction list. Larger groups walk the
@@ -141,6 +142,77 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
             }
         }
         report(totals, build_s, probe)
+    }
+
+    /// The tree holds every particle; only the groups that contain a target walk it.
+    fn compute_targets(
+        &mut self,
+        state: &State<T, D>,
+        targets: Range<usize>,
+        out: [&mut [T]; D],
+    ) -> ForceReport {
+        let n = state.len();
+        if targets.is_empty() {
+            return ForceReport::default();
+        }
+        let started = Instant::now();
+        self.tree.build(state);
+        let build_s = started.elapsed().as_secs_f64();
+        for f in &mut self.sorted_forces {
+            f.resize(n, T::zero());
+        }
+        let threads = rayon::current_num_threads().max(1);
+        if self.lists.len() < threads {
+            self.lists
+                .resize_with(threads, || Mutex::new(Scratch::new()));
+        }
+        let order = &self.tree.order;
+        let wanted = |g: &Group| {
+            order[g.start as usize..g.end as usize]
+                .iter()
+                .any(|&i| targets.contains(&(i as usize)))
+        };
+        let groups: Vec<Group> = self.tree.groups.iter().copied().filter(wanted).collect();
+        let (law, tree, lists) = (&self.law, &self.tree, &self.lists);
+        let list = |slot: usize| {
+            lists[slot % lists.len()]
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+        };
+        let mut sorted = self.sorted_forces.each_mut().map(|f| f.as_mut_slice());
+        // The last full step's pair checks, scaled to the targets' share.
+        let estimate = self
+            .last_pairs
+            .unwrap_or((n as u64) * (n as u64 - 1))
+            .saturating_mul(targets.len() as u64)
+            / n as u64;
+        // The selected groups are in sorted order with gaps; the runs split at group starts,
+        // so each part of the sorted force arrays still holds its groups.
+        let totals = if worth_parallel(estimate) {
+            for_group_runs(
+                &groups,
+                sorted,
+                0,
+                chunk_len(targets.len()),
+                &|gs, offset, mut part| {
+                    let mut list = list(rayon::current_thread_index().unwrap_or(0));
+                    eval_groups::<T, L, D, false>(law, tree, gs, offset, &mut part, &mut list)
+                },
+            )
+        } else {
+            eval_groups::<T, L, D, false>(law, tree, &groups, 0, &mut sorted, &mut list(0))
+        };
+        for g in &groups {
+            for k in g.start as usize..g.end as usize {
+                let i = self.tree.order[k] as usize;
+                if targets.contains(&i) {
+                    for d in 0..D {
+                        out[d][i - targets.start] = self.sorted_forces[d][k];
+                    }
+                }
+            }
+        }
+        report(totals, build_s, false)
     }
 
     /// Tree order: Morton order within each sign class (pure Morton order for gravity), which

@@ -1,0 +1,133 @@
+#!/usr/bin/env bash
+# The MPI tests, run for real: builds with `--features mpi` and checks under `mpirun -n 1..4`
+# that distributed runs end in the state of the serial run (to rounding) with every particle
+# present once, for both decompositions, uneven particle counts, ranks left without particles,
+# particles migrating beyond the neighbouring regions and rebalancing; then the error paths,
+# the JSON outputs, `mpi-bench` and a sweep under the launcher.
+#
+# Open MPI and libclang (for the bindings) are installed with apt when missing and this runs as
+# root; otherwise it stops with the command to run. It never skips a test.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+fail() {
+    echo "MPI TESTS FAILED: $*" >&2
+    exit 1
+}
+
+# libclang and its headers, which the bindings generator of mpi-sys needs at build time.
+have_libclang() {
+    if command -v dpkg >/dev/null 2>&1; then
+        dpkg -s libclang-dev >/dev/null 2>&1
+    else
+        ldconfig -p 2>/dev/null | grep -q libclang
+    fi
+}
+
+have_mpi() {
+    command -v mpirun >/dev/null 2>&1 &&
+        { pkg-config --exists ompi 2>/dev/null || pkg-config --exists mpich 2>/dev/null; } &&
+        have_libclang
+}
+
+if ! have_mpi; then
+    packages="libopenmpi-dev openmpi-bin libclang-dev"
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "installing $packages"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $packages >/dev/null
+    else
+        echo "MPI is not installed. Install it, e.g.: sudo apt-get install -y $packages" >&2
+        exit 2
+    fi
+    have_mpi || fail "MPI or libclang still missing after installing $packages"
+fi
+
+cargo clippy --all-targets --release --features mpi -- -D warnings
+cargo test --release --features mpi --lib --test mpi_cli
+cargo build --release --features mpi
+BIN=target/release/nbody-bench
+MPIRUN=(mpirun --oversubscribe --bind-to none)
+if [ "$(id -u)" = 0 ]; then
+    MPIRUN+=(--allow-run-as-root)
+fi
+TMP=$(mktemp -d)
+trap 'rm -rf "$TMP"' EXIT
+
+# mpirun -n RANKS nbody-bench mpi-check ARGS..., which exits 1 on a mismatch.
+check() {
+    local ranks=$1
+    shift
+    echo "--- $ranks rank(s): mpi-check $*"
+    # pipefail: mpi-check's status survives the tail.
+    "${MPIRUN[@]}" -n "$ranks" "$BIN" mpi-check "$@" </dev/null | tail -n 5 ||
+        fail "mpi-check $* on $ranks ranks"
+}
+
+# mpirun -n RANKS nbody-bench ARGS... must exit 2 and print MESSAGE.
+refuses() {
+    local ranks=$1 message=$2
+    shift 2
+    echo "--- $ranks rank(s): $* must be refused with: $message"
+    local out status=0
+    out=$("${MPIRUN[@]}" -n "$ranks" "$BIN" "$@" 2>&1 </dev/null) || status=$?
+    [ "$status" = 2 ] || fail "$* exited with $status, not 2:
+$out"
+    grep -qF -- "$message" <<<"$out" || fail "$* did not say '$message':
+$out"
+}
+
+for ranks in 1 2 3 4; do
+    migration=()
+    if [ "$ranks" -gt 1 ]; then migration=(--expect-migration); fi
+    # Replicated data, uneven n (301 and 2001 divide by none of 2..4): naive (targets) and
+    # symmetric (pair shares + Allreduce), on both laws.
+    check "$ranks" --scenario coulomb --kernel naive --decomp allgather -n 301 --steps 10
+    check "$ranks" --scenario coulomb --kernel symmetric --decomp allgather -n 301 --steps 10
+    check "$ranks" --scenario lj-box --kernel naive --decomp allgather -n 2001 --steps 20
+    check "$ranks" --scenario lj-box --kernel symmetric --decomp allgather -n 2001 --steps 20
+    # Spatial decomposition: particles cross rank borders during the run.
+    check "$ranks" --scenario lj-box --kernel cell-list --decomp domain -n 3001 --steps 60 "${migration[@]}"
+done
+
+# More kernels and shapes.
+check 3 --scenario galaxy --kernel octree --decomp allgather -n 600 --steps 5
+check 2 --scenario coulomb --kernel per-thread --decomp allgather -n 1500 --steps 5 --threads 2
+check 3 --scenario lj-box --kernel cell-list --decomp allgather -n 2001 --steps 20
+check 4 --scenario lj-box --kernel cell-list --decomp domain -n 3001 --steps 60 --rank-grid 2x2 --precision f64 --expect-migration
+check 4 --scenario lj-liquid --kernel cell-list --decomp domain -n 4000 --steps 30 --precision f64 --expect-migration
+# Ranks with no particle at all.
+check 4 --scenario lj-box --kernel cell-list --decomp domain -n 3 --steps 20 --no-rebalance --expect-empty-rank
+check 4 --scenario lj-box --kernel symmetric --decomp allgather -n 3 --steps 20 --expect-empty-rank
+# Particles that jump over a whole region in one step (a dilute gas, thin slabs, a long step):
+# sent to their new owner through an all-to-all.
+check 4 --scenario lj-box --kernel cell-list --decomp domain -n 40 --density 1 --dt 0.5 --steps 8 --rank-grid 1x4 --no-rebalance --precision f64 --expect-far-migration
+# The boundaries move when the load drifts (a low threshold makes it happen early).
+check 4 --scenario lj-box --kernel cell-list --decomp domain -n 400 --steps 100 --rank-grid 4x1 --rebalance-above 1.01 --expect-rebalance
+
+# Errors: clear message, exit 2, every rank stops.
+refuses 2 "needs --kernel cell-list" run --decomp domain --scenario lj-box --kernel naive -n 100
+refuses 1 "needs at least 2 ranks" mpi-bench --out "$TMP/bench.json"
+refuses 3 "still outside the box after one reflection" \
+    run --decomp domain --scenario lj-box --kernel cell-list -n 60 --density 20 --dt 0.1 --steps 20
+refuses 2 "not of the form AxB" run --decomp domain --scenario lj-box --kernel cell-list -n 100 --rank-grid 2y1
+[ ! -e "$TMP/bench.json" ] || fail "a refused mpi-bench left a file"
+
+# Outputs.
+echo "--- run --decomp domain --json"
+"${MPIRUN[@]}" -n 2 "$BIN" run --decomp domain --scenario lj-box --kernel cell-list -n 4000 --steps 20 \
+    --json "$TMP/run.json" </dev/null >/dev/null || fail "run --decomp domain"
+for field in '"decomposition": "domain"' '"ranks": 2' '"comm_s"' '"wait_s"' '"bytes_sent"' \
+    '"source_004"' '"interactions"' '"per_rank"'; do
+    grep -qF "$field" "$TMP/run.json" || fail "run --json lacks $field"
+done
+echo "--- mpi-bench"
+"${MPIRUN[@]}" -n 2 "$BIN" mpi-bench --max-bytes 4096 --reps 20 --out "$TMP/bench.json" </dev/null >/dev/null ||
+    fail "mpi-bench"
+grep -qF '"schema": "nbody-bench/mpi-bench/v1"' "$TMP/bench.json" || fail "mpi-bench schema"
+echo "--- sweep under mpirun"
+"$BIN" sweep --config tests/configs/good/mpi-tiny.toml --out "$TMP" --no-calibration \
+    >"$TMP/sweep.log" 2>&1 || fail "sweep under the MPI launcher: $(tail -n 20 "$TMP/sweep.log")"
+grep -qF '"decomposition": "domain"' "$TMP/mpi-tiny/results.json" || fail "sweep results lack MPI rounds"
+
+echo "MPI tests passed"

@@ -1,0 +1,297 @@
+//! The MPI entry points: `run --decomp`, `mpi-check` and `mpi-bench`. In a build without the
+//! `mpi` feature they exist (in `--help` too) and refuse with exit code 2.
+//!
+//! Every rank runs the same command. Errors that every rank meets alike are printed by rank 0
+//! only; an error of one rank (say, a particle stuck outside a wall) by that rank, and rank 0
+//! points to it. Only rank 0 prints results and writes files.
+
+use crate::cli::{MpiBenchArgs, MpiCheckArgs, RunArgs};
+use crate::decomp::Decomposition;
+
+#[cfg(not(feature = "mpi"))]
+pub fn run(_args: RunArgs, _decomp: Decomposition) -> anyhow::Result<i32> {
+    anyhow::bail!(crate::decomp::WITHOUT_MPI)
+}
+
+#[cfg(not(feature = "mpi"))]
+pub fn check(_args: MpiCheckArgs) -> anyhow::Result<i32> {
+    anyhow::bail!(crate::decomp::WITHOUT_MPI)
+}
+
+#[cfg(not(feature = "mpi"))]
+pub fn bench(_args: MpiBenchArgs) -> anyhow::Result<i32> {
+    anyhow::bail!(crate::decomp::WITHOUT_MPI)
+}
+
+#[cfg(feature = "mpi")]
+pub use with_mpi::{bench, check, run};
+
+#[cfg(feature = "mpi")]
+mod with_mpi {
+    use super::*;
+    use crate::cli::{KernelArgs, MpiOptions};
+    use crate::commands::run::print_summary;
+    use crate::commands::{kernel_params, setup};
+    use crate::decomp::stats::MpiReport;
+    use crate::kernels::KernelKind;
+    use crate::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
+    use crate::scenario::Precision;
+    use anyhow::Context;
+    use std::path::PathBuf;
+
+    /// Prints an error on the ranks that should, and gives exit code 2.
+    fn fail(rank: usize, err: MpiError) -> i32 {
+        if err.printed_by(rank) {
+            eprintln!("error: {:#}", anyhow::Error::from(err));
+        }
+        2
+    }
+
+    fn spec(
+        kernel: KernelKind,
+        decomp: Decomposition,
+        steps: usize,
+        kernel_args: &KernelArgs,
+        mpi: &MpiOptions,
+        dump_state: Option<PathBuf>,
+        check: bool,
+    ) -> MpiSpec {
+        MpiSpec {
+            kernel,
+            params: kernel_params(kernel_args),
+            decomp,
+            steps: steps as u64,
+            warmup: mpi.warmup_steps as u64,
+            threads: kernel_args.threads,
+            domain: DomainOptions {
+                rank_grid: mpi.rank_grid.clone(),
+                rebalance_above: (!mpi.no_rebalance).then_some(mpi.rebalance_above),
+            },
+            dump_state,
+            check,
+        }
+    }
+
+    pub fn run(args: RunArgs, decomp: Decomposition) -> anyhow::Result<i32> {
+        let mut mpi = Mpi::init()?;
+        let rank = mpi.rank();
+        if args.trajectory.is_some() {
+            let err = MpiError::Usage(
+                "--trajectory is not available with --decomp; --dump-state writes the final state"
+                    .into(),
+            );
+            return Ok(fail(rank, err));
+        }
+        let setup = setup(args.scenario, &args.system);
+        let spec = spec(
+            args.kernel,
+            decomp,
+            args.steps,
+            &args.kernel_args,
+            &args.mpi,
+            args.dump_state.clone(),
+            false,
+        );
+        let root = match mpi.run(&setup, &spec) {
+            Ok(Some(root)) => root,
+            Ok(None) => return Ok(0),
+            Err(err) => return Ok(fail(rank, err)),
+        };
+        let outcome = root.outcome;
+        if outcome.oversubscribed {
+            eprintln!(
+                "warning: {} ranks x {} threads on {} logical CPUs: oversubscribed; timings do not show real parallel speedup",
+                mpi.size(),
+                outcome.threads,
+                crate::run::logical_cpus()
+            );
+        }
+        print_summary(&outcome);
+        if let Some(report) = &outcome.mpi {
+            print_mpi(report);
+        }
+        if let Some(path) = &args.json {
+            let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
+            crate::output::write_atomic(path, text.as_bytes())?;
+            println!("result written to {}", path.display());
+        }
+        Ok(0)
+    }
+
+    /// The MPI lines of the summary, then source 004's closing lines.
+    fn print_mpi(r: &MpiReport) {
+        let red = &r.reduced;
+        let grid = r
+            .rank_grid
+            .as_ref()
+            .map(|g| {
+                let g: Vec<String> = g.iter().map(|k| k.to_string()).collect();
+                format!(" on a {} grid", g.join("x"))
+            })
+            .unwrap_or_default();
+        println!(
+            "mpi               {} ranks, {}{grid}, {} rebalance(s); {}",
+            r.ranks,
+            r.decomposition.name(),
+            r.rebalances,
+            r.library.lines().next().unwrap_or("")
+        );
+        let span = |m: &crate::decomp::stats::MinMeanMax| {
+            format!("{:.4}/{:.4}/{:.4}", m.min, m.mean, m.max)
+        };
+        println!(
+            "per rank (s)      compute {}  comm {}  wait {}  (min/mean/max); comm {:.1}% of the time, compute imbalance {:.3}",
+            span(&red.compute_s),
+            span(&red.comm_s),
+            span(&red.wait_s),
+            100.0 * red.comm_fraction,
+            red.compute_imbalance
+        );
+        println!(
+            "traffic per rank  {:.3e} bytes, {:.0} messages sent (mean); particles {:.0}..{:.0}; ghosts received {:.0}, migrated {:.0} (mean)",
+            red.bytes_sent.mean,
+            red.messages_sent.mean,
+            red.particles.min,
+            red.particles.max,
+            red.ghosts_received.mean,
+            red.migrated_out.mean
+        );
+        let s = &r.source_004;
+        println!("Communication time {:8.5} seconds", s.communication_s);
+        println!("Computation time   {:8.5} seconds", s.computation_s);
+        println!("\tEvaluated {} interactions", s.interactions);
+    }
+
+    pub fn check(args: MpiCheckArgs) -> anyhow::Result<i32> {
+        let mut mpi = Mpi::init()?;
+        let rank = mpi.rank();
+        let setup = setup(args.scenario, &args.system);
+        let spec = spec(
+            args.kernel,
+            args.decomp,
+            args.steps,
+            &args.kernel_args,
+            &args.mpi,
+            None,
+            true,
+        );
+        let root = match mpi.run(&setup, &spec) {
+            Ok(Some(root)) => root,
+            Ok(None) => return Ok(0),
+            Err(err) => return Ok(fail(rank, err)),
+        };
+        let report = root.check.expect("rank 0 compares when asked");
+        let tolerance = args.tolerance.unwrap_or(match setup.precision() {
+            Precision::F64 => 1e-9,
+            Precision::F32 => 1e-4,
+        });
+        let o = &root.outcome;
+        println!(
+            "{} / {} / {}: n = {}, {} steps, {} ranks",
+            o.scenario,
+            o.kernel,
+            args.decomp.name(),
+            o.n,
+            args.steps + args.mpi.warmup_steps,
+            mpi.size()
+        );
+        println!(
+            "particles         {} distributed, {} serial, ids complete: {}, id sum {} (expected {})",
+            report.n_distributed,
+            report.n_serial,
+            report.ids_complete,
+            report.id_sum,
+            report.id_sum_expected
+        );
+        println!(
+            "difference        positions {:.3e} of the box, velocities {:.3e} of the top speed (tolerance {tolerance:.1e})",
+            report.position_error, report.velocity_error
+        );
+        println!(
+            "migration         {} particles changed rank, {} beyond the neighbours",
+            report.migrated, report.far_migrated
+        );
+        let (owned, rebalances): (Vec<u64>, u64) = o
+            .mpi
+            .as_ref()
+            .map(|m| {
+                (
+                    m.per_rank.iter().map(|r| r.particles).collect(),
+                    m.rebalances,
+                )
+            })
+            .unwrap_or_default();
+        println!("owned at the end  {owned:?}, {rebalances} rebalance(s)");
+        let mut ok = report.passes(tolerance);
+        if args.expect_empty_rank && !owned.contains(&0) {
+            println!("FAIL: every rank owns particles (--expect-empty-rank)");
+            ok = false;
+        }
+        if args.expect_rebalance && rebalances == 0 {
+            println!("FAIL: the boundaries never moved (--expect-rebalance)");
+            ok = false;
+        }
+        if args.expect_migration && report.migrated == 0 {
+            println!("FAIL: no particle changed rank (--expect-migration)");
+            ok = false;
+        }
+        if args.expect_far_migration && report.far_migrated == 0 {
+            println!(
+                "FAIL: no particle moved beyond the neighbouring regions (--expect-far-migration)"
+            );
+            ok = false;
+        }
+        println!("{}", if ok { "MATCH" } else { "MISMATCH" });
+        Ok(if ok { 0 } else { 1 })
+    }
+
+    pub fn bench(args: MpiBenchArgs) -> anyhow::Result<i32> {
+        let mut mpi = Mpi::init()?;
+        let rank = mpi.rank();
+        let options = BenchOptions {
+            max_bytes: args.max_bytes as u64,
+            reps: args.reps,
+            warmup: args.warmup,
+        };
+        let file = match mpi.bench(&options) {
+            Ok(Some(file)) => file,
+            Ok(None) => return Ok(0),
+            Err(err) => return Ok(fail(rank, err)),
+        };
+        println!(
+            "{} ranks on {} ({}), MPI {}{}",
+            file.ranks,
+            file.host,
+            file.mpi_library.lines().next().unwrap_or(""),
+            file.mpi_standard,
+            if file.oversubscribed {
+                " (oversubscribed)"
+            } else {
+                ""
+            }
+        );
+        println!(
+            "{:>10} {:>14} {:>14} {:>18}",
+            "bytes", "ping-pong p50", "one-way GB/s", "allgatherv p50"
+        );
+        for (p, a) in file.ping_pong.points.iter().zip(&file.allgatherv.points) {
+            let pp = crate::stats::median(&p.seconds).unwrap_or(0.0);
+            let ag = crate::stats::median(&a.seconds).unwrap_or(0.0);
+            println!(
+                "{:>10} {:>14} {:>14.3} {:>18}",
+                p.bytes,
+                crate::commands::fmt_ns(pp * 1e9),
+                if pp > 0.0 {
+                    p.bytes as f64 / pp * 1e-9
+                } else {
+                    0.0
+                },
+                crate::commands::fmt_ns(ag * 1e9)
+            );
+        }
+        let text = serde_json::to_string_pretty(&file).context("serializing the timings")?;
+        crate::output::write_atomic(&args.out, text.as_bytes())?;
+        println!("timings written to {}", args.out.display());
+        Ok(0)
+    }
+}

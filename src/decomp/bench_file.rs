@@ -1,0 +1,176 @@
+//! The results file of `nbody-bench mpi-bench`: raw timings of point-to-point messages and of
+//! Allgatherv over message sizes, from which the analysis fits the α-β model
+//! (`t = α + β · bytes`) and predicts communication at rank counts beyond the machine.
+//! Layout in `docs/mpi.md`.
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+pub const MPI_BENCH_SCHEMA: &str = "nbody-bench/mpi-bench/v1";
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MpiBenchFile {
+    pub schema: String,
+    pub tool_version: String,
+    pub git_commit: String,
+    /// UTC, ISO 8601.
+    pub started: String,
+    /// Ranks in the run.
+    pub ranks: usize,
+    /// Rank 0's processor name, and every rank's.
+    pub host: String,
+    pub hosts: Vec<String>,
+    /// The MPI library's version string and the MPI standard version it implements.
+    pub mpi_library: String,
+    pub mpi_standard: String,
+    pub logical_cpus: usize,
+    /// More ranks than logical CPUs: timings include time-sharing of the CPUs.
+    pub oversubscribed: bool,
+    /// Ranks 0 and 1 (on the first two slots): one-way time of a message of `bytes`, taken as
+    /// half the round trip of a ping-pong.
+    pub ping_pong: Series,
+    /// All ranks: time of one `MPI_Allgatherv` in which every rank contributes `bytes`
+    /// (the slowest rank's time; the ranks start together after a barrier).
+    pub allgatherv: Series,
+}
+
+/// Timings of one operation over message sizes.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Series {
+    /// What a timing is, in words.
+    pub definition: String,
+    /// Ranks taking part.
+    pub ranks: usize,
+    /// Untimed repetitions before the timed ones, per size.
+    pub warmup: usize,
+    pub points: Vec<SizeTimings>,
+}
+
+/// Every timed repetition at one message size.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SizeTimings {
+    pub bytes: u64,
+    pub seconds: Vec<f64>,
+}
+
+#[derive(Debug, Error)]
+pub enum BenchFileError {
+    #[error("cannot read {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(
+        "{path} is not a valid mpi-bench file ({detail}); it may be truncated or from another tool"
+    )]
+    Corrupt { path: PathBuf, detail: String },
+    #[error("{path} has schema `{found}`, this version reads `{MPI_BENCH_SCHEMA}`")]
+    Schema { path: PathBuf, found: String },
+}
+
+impl MpiBenchFile {
+    pub fn load(path: &Path) -> Result<MpiBenchFile, BenchFileError> {
+        let text = std::fs::read_to_string(path).map_err(|source| BenchFileError::Read {
+            path: path.into(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Parses and checks file text; `path` is only used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<MpiBenchFile, BenchFileError> {
+        let corrupt = |detail: String| BenchFileError::Corrupt {
+            path: path.into(),
+            detail,
+        };
+        let value: serde_json::Value =
+            serde_json::from_str(text).map_err(|e| corrupt(e.to_string()))?;
+        let found = value
+            .get("schema")
+            .and_then(|s| s.as_str())
+            .unwrap_or("(none)");
+        if found != MPI_BENCH_SCHEMA {
+            return Err(BenchFileError::Schema {
+                path: path.into(),
+                found: found.into(),
+            });
+        }
+        let file: MpiBenchFile =
+            serde_json::from_value(value).map_err(|e| corrupt(e.to_string()))?;
+        for (name, series) in [
+            ("ping_pong", &file.ping_pong),
+            ("allgatherv", &file.allgatherv),
+        ] {
+            for p in &series.points {
+                if p.seconds.is_empty() || p.seconds.iter().any(|s| !(s.is_finite() && *s >= 0.0)) {
+                    return Err(corrupt(format!(
+                        "{name} at {} bytes: timings must be finite, non-negative and present",
+                        p.bytes
+                    )));
+                }
+            }
+        }
+        Ok(file)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> MpiBenchFile {
+        let series = |ranks| Series {
+            definition: "test".into(),
+            ranks,
+            warmup: 2,
+            points: vec![
+                SizeTimings {
+                    bytes: 8,
+                    seconds: vec![1e-6, 1.1e-6],
+                },
+                SizeTimings {
+                    bytes: 1 << 20,
+                    seconds: vec![1e-4],
+                },
+            ],
+        };
+        MpiBenchFile {
+            schema: MPI_BENCH_SCHEMA.into(),
+            tool_version: "0.1.0".into(),
+            git_commit: "abc".into(),
+            started: "2026-01-01T00:00:00Z".into(),
+            ranks: 4,
+            host: "h".into(),
+            hosts: vec!["h".into(); 4],
+            mpi_library: "Open MPI v4.1.4".into(),
+            mpi_standard: "3.1".into(),
+            logical_cpus: 2,
+            oversubscribed: true,
+            ping_pong: series(2),
+            allgatherv: series(4),
+        }
+    }
+
+    #[test]
+    fn round_trips_and_refuses_bad_files() {
+        let path = Path::new("b.json");
+        let file = sample();
+        let text = serde_json::to_string(&file).unwrap();
+        assert_eq!(MpiBenchFile::parse(&text, path).unwrap(), file);
+        let other = text.replace(MPI_BENCH_SCHEMA, "nbody-bench/results/v1");
+        assert!(matches!(
+            MpiBenchFile::parse(&other, path),
+            Err(BenchFileError::Schema { .. })
+        ));
+        assert!(matches!(
+            MpiBenchFile::parse(&text[..text.len() / 2], path),
+            Err(BenchFileError::Corrupt { .. })
+        ));
+        let mut bad = sample();
+        bad.allgatherv.points[1].seconds = vec![];
+        let text = serde_json::to_string(&bad).unwrap();
+        let err = MpiBenchFile::parse(&text, path).unwrap_err().to_string();
+        assert!(err.contains("allgatherv at 1048576 bytes"), "{err}");
+    }
+}

@@ -1,0 +1,242 @@
+//! Per-rank statistics of a distributed run, their reduction over ranks, and the `mpi` block
+//! of the `run --json` result (documented in `docs/mpi.md`).
+//!
+//! Time is split three ways on every rank: *compute* (everything outside MPI calls: forces,
+//! integration, walls, packing), *communication* (time inside MPI calls, source 004's
+//! "communication time"), and, within communication, *waiting*: the time a rank spends in a
+//! call because another rank is still computing. Waiting is not observable inside one call,
+//! so it is derived from the per-step compute times of all ranks: in a step where the slowest
+//! rank computes for `max_r c_r`, rank `i` waits about `max_r c_r − c_i`. The rest of the
+//! communication time (`transfer_s`) is moving data and MPI overhead.
+
+use super::Decomposition;
+use serde::{Deserialize, Serialize};
+
+/// What one rank measured over the timed steps.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RankStats {
+    pub rank: usize,
+    /// Particles owned at the end, and the mean over the timed steps.
+    pub particles: u64,
+    pub particles_mean: f64,
+    /// Seconds outside MPI calls (forces, integration, walls, packing), summed over steps.
+    pub compute_s: f64,
+    /// Of `compute_s`, the force computation.
+    pub force_s: f64,
+    /// Seconds inside MPI calls, including waiting for other ranks.
+    pub comm_s: f64,
+    /// Of `comm_s`, the estimated wait for slower ranks (load imbalance).
+    pub wait_s: f64,
+    /// `comm_s − wait_s`, at least 0: moving data and MPI overhead.
+    pub transfer_s: f64,
+    /// Payload bytes and messages this rank sent (collectives: see `docs/mpi.md`).
+    pub bytes_sent: u64,
+    pub messages_sent: u64,
+    /// Collective calls made.
+    pub collectives: u64,
+    /// Ghost particles received, summed over steps (domain decomposition).
+    pub ghosts_received: u64,
+    /// Particles that left this rank's region, summed over steps (domain decomposition).
+    pub migrated_out: u64,
+    /// Pair distance evaluations this rank's force computations made.
+    pub pair_checks: u64,
+}
+
+/// Minimum, mean and maximum of a quantity over the ranks.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct MinMeanMax {
+    pub min: f64,
+    pub mean: f64,
+    pub max: f64,
+}
+
+impl MinMeanMax {
+    pub fn of(values: impl IntoIterator<Item = f64>) -> MinMeanMax {
+        let (mut min, mut max, mut sum, mut k) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0);
+        for v in values {
+            min = min.min(v);
+            max = max.max(v);
+            sum += v;
+            k += 1;
+        }
+        if k == 0 {
+            return MinMeanMax::default();
+        }
+        MinMeanMax {
+            min,
+            mean: sum / k as f64,
+            max,
+        }
+    }
+}
+
+/// The per-rank statistics reduced over the ranks.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ReducedStats {
+    pub particles: MinMeanMax,
+    pub compute_s: MinMeanMax,
+    pub force_s: MinMeanMax,
+    pub comm_s: MinMeanMax,
+    pub wait_s: MinMeanMax,
+    pub transfer_s: MinMeanMax,
+    pub bytes_sent: MinMeanMax,
+    pub messages_sent: MinMeanMax,
+    pub ghosts_received: MinMeanMax,
+    pub migrated_out: MinMeanMax,
+    /// Slowest rank's compute time over the mean (1 = perfectly balanced).
+    pub compute_imbalance: f64,
+    /// Mean communication time over mean (compute + communication) time.
+    pub comm_fraction: f64,
+}
+
+/// Reduces per-rank statistics to min/mean/max over the ranks.
+pub fn reduce(per_rank: &[RankStats]) -> ReducedStats {
+    let of = |f: &dyn Fn(&RankStats) -> f64| MinMeanMax::of(per_rank.iter().map(f));
+    let compute = of(&|r| r.compute_s);
+    let comm = of(&|r| r.comm_s);
+    ReducedStats {
+        particles: of(&|r| r.particles as f64),
+        compute_s: compute,
+        force_s: of(&|r| r.force_s),
+        comm_s: comm,
+        wait_s: of(&|r| r.wait_s),
+        transfer_s: of(&|r| r.transfer_s),
+        bytes_sent: of(&|r| r.bytes_sent as f64),
+        messages_sent: of(&|r| r.messages_sent as f64),
+        ghosts_received: of(&|r| r.ghosts_received as f64),
+        migrated_out: of(&|r| r.migrated_out as f64),
+        compute_imbalance: if compute.mean > 0.0 {
+            compute.max / compute.mean
+        } else {
+            1.0
+        },
+        comm_fraction: if compute.mean + comm.mean > 0.0 {
+            comm.mean / (compute.mean + comm.mean)
+        } else {
+            0.0
+        },
+    }
+}
+
+/// Each rank's wait for slower ranks, from every rank's compute seconds per step
+/// (`compute[rank][step]`, all of one length): `Σ_step (max_r compute[r][step] − compute[i][step])`.
+pub fn waits(compute: &[Vec<f64>]) -> Vec<f64> {
+    let steps = compute.iter().map(Vec::len).min().unwrap_or(0);
+    let slowest: Vec<f64> = (0..steps)
+        .map(|s| compute.iter().map(|c| c[s]).fold(0.0, f64::max))
+        .collect();
+    compute
+        .iter()
+        .map(|c| (0..steps).map(|s| slowest[s] - c[s]).sum())
+        .collect()
+}
+
+/// Fills in `wait_s` and `transfer_s` of every rank from the per-step compute times.
+pub fn attribute_waits(per_rank: &mut [RankStats], compute: &[Vec<f64>]) {
+    for (stats, wait) in per_rank.iter_mut().zip(waits(compute)) {
+        // The estimate cannot exceed the time actually spent inside MPI calls.
+        stats.wait_s = wait.min(stats.comm_s);
+        stats.transfer_s = (stats.comm_s - stats.wait_s).max(0.0);
+    }
+}
+
+/// Source 004's closing summary, as its master rank prints it.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Source004 {
+    /// Rank 0's seconds inside MPI calls over the timed steps.
+    pub communication_s: f64,
+    /// Rank 0's wall time of the timed steps minus its communication time.
+    pub computation_s: f64,
+    /// Pair interactions evaluated by all ranks over the timed steps.
+    pub interactions: u64,
+}
+
+/// The `mpi` block of a distributed run's result.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MpiReport {
+    pub ranks: usize,
+    pub decomposition: Decomposition,
+    pub threads_per_rank: usize,
+    /// Regions per axis (domain decomposition).
+    pub rank_grid: Option<Vec<usize>>,
+    /// The MPI library's version string.
+    pub library: String,
+    /// Processor name of every rank.
+    pub hosts: Vec<String>,
+    /// Untimed steps before the timed ones.
+    pub warmup_steps: u64,
+    /// Times the domain boundaries moved to rebalance particle counts.
+    pub rebalances: u64,
+    pub per_rank: Vec<RankStats>,
+    pub reduced: ReducedStats,
+    pub source_004: Source004,
+    /// Wall time of every timed step, nanoseconds: the slowest rank's. Dropped from sweep
+    /// results, whose samples carry the same information.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub step_ns: Vec<u64>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn waits_are_the_gaps_to_the_slowest_rank() {
+        let compute = vec![
+            vec![1.0, 2.0, 3.0],
+            vec![2.0, 2.0, 1.0],
+            vec![0.5, 1.0, 1.0],
+        ];
+        assert_eq!(waits(&compute), vec![1.0, 2.0, 4.5]);
+        let mut stats = vec![
+            RankStats {
+                comm_s: 2.0,
+                ..Default::default()
+            },
+            RankStats {
+                comm_s: 1.0,
+                ..Default::default()
+            },
+            RankStats {
+                comm_s: 5.0,
+                ..Default::default()
+            },
+        ];
+        attribute_waits(&mut stats, &compute);
+        assert_eq!(
+            stats
+                .iter()
+                .map(|s| (s.wait_s, s.transfer_s))
+                .collect::<Vec<_>>(),
+            vec![(1.0, 1.0), (1.0, 0.0), (4.5, 0.5)]
+        );
+    }
+
+    #[test]
+    fn reduction_gives_min_mean_max_and_ratios() {
+        let ranks: Vec<RankStats> = (0..4)
+            .map(|r| RankStats {
+                rank: r,
+                particles: 100 + r as u64,
+                compute_s: 1.0 + r as f64,
+                comm_s: 1.0,
+                bytes_sent: 10 * r as u64,
+                ..Default::default()
+            })
+            .collect();
+        let red = reduce(&ranks);
+        assert_eq!(
+            red.particles,
+            MinMeanMax {
+                min: 100.0,
+                mean: 101.5,
+                max: 103.0
+            }
+        );
+        assert_eq!(red.compute_s.mean, 2.5);
+        assert_eq!(red.compute_imbalance, 4.0 / 2.5);
+        assert_eq!(red.comm_fraction, 1.0 / 3.5);
+        assert_eq!(red.bytes_sent.max, 30.0);
+        assert_eq!(MinMeanMax::of([]), MinMeanMax::default());
+    }
+}

@@ -1,0 +1,122 @@
+use super::*;
+use crate::decomp::Decomposition;
+use crate::decomp::stats::{RankStats, Source004, reduce};
+use crate::kernels::KernelKind;
+use crate::scenario::{Precision, ScenarioKind};
+
+fn launch() -> MpiLaunch {
+    MpiLaunch {
+        launcher: "mpirun".into(),
+        ranks: vec![1, 2],
+        args: vec!["--oversubscribe".into()],
+        rank_flag: "-n".into(),
+        decomp: vec![Decomposition::Domain],
+        steps: 40,
+        warmup_steps: 5,
+    }
+}
+
+fn case() -> Case {
+    Case {
+        scenario: ScenarioKind::LjBox,
+        kernel: KernelKind::CellList,
+        n: 2000,
+        threads: 1,
+        ranks: 4,
+        theta: None,
+        seed: 3,
+        precision: Some(Precision::F64),
+        time_factor: 1,
+        decomp: Some(Decomposition::Domain),
+    }
+}
+
+#[test]
+fn a_launch_runs_this_program_under_the_launcher() {
+    let args = launch_args(
+        &launch(),
+        &case(),
+        Path::new("/bin/nb"),
+        Path::new("/tmp/r.json"),
+    );
+    assert_eq!(
+        args.join(" "),
+        "--oversubscribe -n 4 /bin/nb run --scenario lj-box --kernel cell-list -n 2000 --seed 3 \
+         --threads 1 --decomp domain --steps 40 --warmup-steps 5 --json /tmp/r.json --precision f64"
+    );
+    assert!(
+        case().key().ends_with("/r=4/seed=3/f64/domain"),
+        "{}",
+        case().key()
+    );
+}
+
+fn run_json(step_ns: Vec<u64>) -> String {
+    let per_rank = vec![
+        RankStats {
+            rank: 0,
+            compute_s: 1.0,
+            comm_s: 0.5,
+            ..Default::default()
+        },
+        RankStats {
+            rank: 1,
+            compute_s: 1.2,
+            comm_s: 0.3,
+            ..Default::default()
+        },
+    ];
+    let report = MpiReport {
+        ranks: 2,
+        decomposition: Decomposition::Domain,
+        threads_per_rank: 1,
+        rank_grid: Some(vec![2, 1]),
+        library: "Open MPI".into(),
+        hosts: vec!["h".into(), "h".into()],
+        warmup_steps: 5,
+        rebalances: 0,
+        reduced: reduce(&per_rank),
+        per_rank,
+        source_004: Source004::default(),
+        step_ns,
+    };
+    serde_json::json!({
+        "schema": "nbody-bench/run/v1",
+        "n": 2000,
+        "steps": 10,
+        "timing": {"phases": {"force_build": 0.1, "force_interact": 0.2, "integrate": 0.05,
+                              "boundary": 0.0, "output": 0.0}},
+        "counters": {"total": {"pair_checks": 500, "pairs_interacting": 0, "cells_visited": 10,
+                               "nodes_opened": 0, "nodes_accepted": 0},
+                     "pairs_interacting_final": 77},
+        "energy": {"rel_drift": -1e-6},
+        "mpi": report,
+    })
+    .to_string()
+}
+
+#[test]
+fn a_round_groups_the_slowest_rank_step_times_into_samples() {
+    let steps: Vec<u64> = (1..=10).map(|k| k * 1000).collect();
+    let round = round_from_json(&run_json(steps), 3, 5).unwrap();
+    // 10 steps into 3 samples of 3 steps; the last step is left out.
+    assert_eq!(round.steps_per_sample, 3);
+    assert_eq!(round.samples_s, vec![2e-6, 5e-6, 8e-6]);
+    assert_eq!(round.step_ns.len(), 9);
+    assert_eq!(round.steps, 10);
+    assert_eq!(round.warmup_steps, 5);
+    assert!((round.phases.force_interact - 0.02).abs() < 1e-15);
+    assert_eq!(round.work.pair_checks, 500);
+    assert_eq!(round.pairs_interacting, 77);
+    assert_eq!(round.n, 2000);
+    let mpi = round.mpi.unwrap();
+    assert!(mpi.step_ns.is_empty(), "kept out of the results file");
+    assert_eq!(mpi.per_rank.len(), 2);
+}
+
+#[test]
+fn a_round_needs_a_step_per_sample_and_a_complete_result() {
+    let err = round_from_json(&run_json(vec![1, 2]), 3, 0).unwrap_err();
+    assert!(err.contains("fewer than the 3 samples"), "{err}");
+    assert!(round_from_json("{\"n\": 3}", 3, 0).is_err());
+}

@@ -1,0 +1,72 @@
+//! The MPI drivers (cargo feature `mpi`): the replicated-data and the spatial decomposition
+//! of a run over MPI ranks, the comparison with a serial run, and the communication benchmark.
+//! The physics, kernels and integrator are the engine's; this module only decides which
+//! particles each rank integrates and moves data between ranks. What does not need MPI
+//! (regions, statistics, byte counts, file formats) is in [`crate::decomp`].
+
+mod allgather;
+mod bench;
+mod check;
+mod comm;
+mod domain;
+mod driver;
+mod error;
+mod job;
+mod wire;
+
+pub use bench::BenchOptions;
+pub use check::CheckReport;
+pub use domain::DomainOptions;
+pub use error::MpiError;
+pub use job::{MpiSpec, RootResult};
+
+use crate::decomp::bench_file::MpiBenchFile;
+use crate::scenario::Setup;
+use ::mpi::Threading;
+use ::mpi::environment::Universe;
+use comm::Comm;
+
+/// The MPI environment of this process: initialized by [`Mpi::init`], finalized on drop.
+pub struct Mpi {
+    comm: Comm,
+    // Dropped last: finalizes MPI.
+    _universe: Universe,
+}
+
+impl Mpi {
+    /// Initializes MPI (at most once per process) with thread level `serialized`: the drivers
+    /// run on a rayon thread while the kernels use the rest of the pool.
+    pub fn init() -> Result<Mpi, MpiError> {
+        let (universe, level) =
+            ::mpi::initialize_with_threading(Threading::Serialized).ok_or(MpiError::Init)?;
+        if level < Threading::Serialized {
+            return Err(MpiError::Threading(format!("{level:?}").to_lowercase()));
+        }
+        Ok(Mpi {
+            comm: Comm::new(universe.world()),
+            _universe: universe,
+        })
+    }
+
+    pub fn rank(&self) -> usize {
+        self.comm.rank()
+    }
+
+    pub fn size(&self) -> usize {
+        self.comm.size()
+    }
+
+    /// Runs `spec` on the system of `setup` on every rank; rank 0 gets the result.
+    pub fn run(&mut self, setup: &Setup, spec: &MpiSpec) -> Result<Option<RootResult>, MpiError> {
+        let job = job::MpiJob {
+            spec,
+            comm: &mut self.comm,
+        };
+        setup.dispatch(job)?
+    }
+
+    /// Measures point-to-point and Allgatherv timings; rank 0 gets the file contents.
+    pub fn bench(&mut self, options: &BenchOptions) -> Result<Option<MpiBenchFile>, MpiError> {
+        bench::run(&mut self.comm, options)
+    }
+}
