@@ -57,8 +57,13 @@ fn figure_links(md: &mut String, sweep: &Sweep, prefix: &str) {
 
 fn machine(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## The machine and the sweeps\n\n");
-    if let Some(c) = sweeps.iter().find_map(|s| s.analysis.calibration.as_ref()) {
-        let m = &sweeps[0].analysis.metadata;
+    // The calibration that measured the most thread counts (a one-thread sweep does not
+    // measure the parallel ceiling).
+    let calibrated = sweeps
+        .iter()
+        .filter_map(|s| Some((s.analysis.calibration.as_ref()?, &s.analysis.metadata)))
+        .max_by_key(|(c, _)| c.parallel_ceiling.len());
+    if let Some((c, m)) = calibrated {
         let _ = writeln!(
             md,
             "| | |\n|---|---|\n| CPU | {} |\n| logical CPUs | {} |\n| SIMD level of the pair loops | {} |\n\
