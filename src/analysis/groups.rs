@@ -118,16 +118,10 @@ pub fn group(results: &ResultsFile) -> Groups {
         ranks: Some(c.ranks),
         decomp: c.decomp.clone(),
     };
+    // Each complete case with its record (`cases` was built from these records, in order).
     let records: Vec<(&Point, &CaseRecord)> = cases
         .iter()
-        .map(|c| {
-            let r = results
-                .cases
-                .iter()
-                .find(|r| r.key == c.key)
-                .expect("same file");
-            (c, r)
-        })
+        .zip(results.cases.iter().filter(|r| point(r).is_some()))
         .collect();
     let series = |vary: &dyn Fn(&mut SeriesKey), order: &dyn Fn(&Point) -> f64| {
         let mut out: Vec<Series> = Vec::new();

@@ -57,7 +57,9 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.complexity.is_empty() {
         md.push_str("## Cost vs n\n\n| series | scenario | exponent k [95% CI] | class (LOO SMAPE) | largest n: time/step | ns/particle-step |\n|---|---|---|---|---|---|\n");
         for c in &a.complexity {
-            let last = c.points.last().expect("series have points");
+            let Some(last) = c.points.last() else {
+                continue;
+            };
             let fit = match &c.fit.fit {
                 Some(f) => format!(
                     "{} | {} ({:.1}%)",

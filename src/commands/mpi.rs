@@ -180,7 +180,11 @@ mod with_mpi {
             Ok(None) => return Ok(0),
             Err(err) => return Ok(fail(rank, err)),
         };
-        let report = root.check.expect("rank 0 compares when asked");
+        let Some(report) = root.check else {
+            anyhow::bail!(
+                "rank 0 returned no comparison with the serial run; this is a bug, please report it"
+            );
+        };
         let tolerance = args.tolerance.unwrap_or(match setup.precision() {
             Precision::F64 => 1e-9,
             Precision::F32 => 1e-4,

@@ -91,7 +91,17 @@ const TIME: Column = Column {
 /// Parsed rows: for each row its line number and one value per requested column, in the order
 /// the columns were requested (absent optional columns are `None`).
 struct Table {
-    rows: Vec<(usize, Vec<Option<f64>>)>,
+    rows: Vec<Row>,
+    /// Whether each optional column is in the header (then every row has its value).
+    has_optional: Vec<bool>,
+}
+
+/// One data row: its line number, the required columns' values in the order asked, and the
+/// optional ones (`None` when the header does not have that column).
+struct Row {
+    line: usize,
+    required: Vec<f64>,
+    optional: Vec<Option<f64>>,
 }
 
 fn parse_table(text: &str, required: &[Column], optional: &[Column]) -> Result<Table, CsvError> {
@@ -169,10 +179,15 @@ fn parse_table(text: &str, required: &[Column], optional: &[Column]) -> Result<T
                 expected: names.len(),
             });
         }
-        let mut values = Vec::with_capacity(known.len());
-        for (column, pos) in known.iter().zip(&position) {
+        let mut row = Row {
+            line,
+            required: Vec::with_capacity(required.len()),
+            optional: Vec::with_capacity(optional.len()),
+        };
+        for (i, (column, pos)) in known.iter().zip(&position).enumerate() {
             let Some(pos) = *pos else {
-                values.push(None);
+                // Only optional columns can be absent: required ones were checked above.
+                row.optional.push(None);
                 continue;
             };
             let v = raw[pos]
@@ -192,14 +207,22 @@ fn parse_table(text: &str, required: &[Column], optional: &[Column]) -> Result<T
                     requirement: column.requirement,
                 });
             }
-            values.push(Some(v));
+            if i < required.len() {
+                row.required.push(v);
+            } else {
+                row.optional.push(Some(v));
+            }
         }
-        rows.push((line, values));
+        rows.push(row);
     }
     if rows.is_empty() {
         return Err(CsvError::NoRows { header_line });
     }
-    Ok(Table { rows })
+    let has_optional = position[required.len()..]
+        .iter()
+        .map(Option::is_some)
+        .collect();
+    Ok(Table { rows, has_optional })
 }
 
 /// The fields of a line, trimmed and without surrounding double quotes.
@@ -229,10 +252,7 @@ fn group(rows: impl Iterator<Item = (f64, f64)>) -> Vec<Samples> {
 pub fn parse_threads(text: &str) -> Result<Vec<Samples>, CsvError> {
     let table = parse_table(text, &[P, TIME], &[])?;
     Ok(group(
-        table
-            .rows
-            .iter()
-            .map(|(_, v)| (v[0].unwrap(), v[1].unwrap())),
+        table.rows.iter().map(|r| (r.required[0], r.required[1])),
     ))
 }
 
@@ -240,10 +260,7 @@ pub fn parse_threads(text: &str) -> Result<Vec<Samples>, CsvError> {
 pub fn parse_sizes(text: &str) -> Result<Vec<Samples>, CsvError> {
     let table = parse_table(text, &[N, TIME], &[])?;
     Ok(group(
-        table
-            .rows
-            .iter()
-            .map(|(_, v)| (v[0].unwrap(), v[1].unwrap())),
+        table.rows.iter().map(|r| (r.required[0], r.required[1])),
     ))
 }
 
@@ -256,17 +273,21 @@ pub enum WeakTable {
 
 pub fn parse_weak(text: &str) -> Result<WeakTable, CsvError> {
     let table = parse_table(text, &[P, TIME], &[N])?;
-    let has_n = table.rows[0].1[2].is_some();
-    let pairs = table
-        .rows
-        .iter()
-        .map(|(_, v)| (v[0].unwrap(), v[1].unwrap()));
-    if !has_n {
+    let pairs = table.rows.iter().map(|r| (r.required[0], r.required[1]));
+    if !table.has_optional[0] {
         return Ok(WeakTable::Times(group(pairs)));
     }
     let mut out: Vec<(usize, WeakSamples)> = Vec::new();
-    for (line, v) in &table.rows {
-        let (p, time, n) = (v[0].unwrap(), v[1].unwrap(), v[2].unwrap());
+    for row in &table.rows {
+        let line = &row.line;
+        let (p, time) = (row.required[0], row.required[1]);
+        let Some(n) = row.optional[0] else {
+            return Err(CsvError::MissingColumn {
+                line: row.line,
+                name: N.name,
+                expected: "p,n,time".into(),
+            });
+        };
         match out.iter_mut().find(|(_, s)| s.p == p) {
             Some((first_line, s)) if s.n != n => {
                 return Err(CsvError::InconsistentN {

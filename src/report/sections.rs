@@ -152,8 +152,9 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
         );
         md.push_str("| scenario | kernel | n | time/step | ns/particle-step | pair-evals/s | peak | k [95% CI] | class |\n|---|---|---|---|---|---|---|---|---|\n");
         for c in &a.complexity {
-            let last = c.points.last().expect("series have points");
-            let first = c.points.first().expect("series have points");
+            let (Some(first), Some(last)) = (c.points.first(), c.points.last()) else {
+                continue;
+            };
             let (k, class) = match &c.fit.fit {
                 Some(f) => (est(&f.exponent, 2), f.class.name().to_string()),
                 None => ("–".into(), "not fitted".into()),
