@@ -1,5 +1,7 @@
 #!/usr/bin/env bash
-# Measures every sweep REPORT.md uses, then regenerates the report from results/.
+# Measures every sweep REPORT.md uses into the committed reference results (results/<name>/,
+# the only place besides an explicit --out that sweeps write to; a user's sweeps go to
+# results/runs/), then regenerates the report from results/.
 #
 #   scripts/report.sh            measure what is missing or unfinished (resumes with this build), then report
 #   scripts/report.sh --fresh    measure everything again (old results kept as .bak copies)
@@ -19,11 +21,11 @@ if [[ "$mode" != "--report" ]]; then
     for name in "${CONFIGS[@]}"; do
         echo "== sweep configs/$name.toml"
         if [[ "$mode" == "--fresh" ]]; then
-            "$bin" sweep --config "configs/$name.toml" --fresh
+            "$bin" sweep --config "configs/$name.toml" --out results --fresh
         elif [[ -f "results/$name/results.json" ]]; then
-            "$bin" sweep --config "configs/$name.toml" --resume --force
+            "$bin" sweep --config "configs/$name.toml" --out results --resume --force
         else
-            "$bin" sweep --config "configs/$name.toml"
+            "$bin" sweep --config "configs/$name.toml" --out results
         fi
     done
     if [[ -x scripts/mpi-report.sh ]]; then

@@ -65,8 +65,9 @@ pub struct ReportArgs {
 
 #[derive(Debug, Args)]
 pub struct AnalyzeArgs {
-    /// The results file of a sweep, e.g. results/quick/results.json.
-    #[arg(value_name = "RESULTS.json")]
+    /// The results of a sweep: a results.json, a run directory, or a config name (its latest
+    /// run under results/runs/, else its reference results results/<name>/).
+    #[arg(value_name = "RESULTS")]
     pub results: PathBuf,
     /// Directory for fits.json, summary.md and the figures [default: `analysis/` beside the results file].
     #[arg(long, value_name = "DIR")]
@@ -284,19 +285,24 @@ fn parse_non_negative(s: &str) -> Result<f64, String> {
 
 #[derive(Debug, Args)]
 pub struct SweepArgs {
-    /// The sweep config (TOML), e.g. configs/quick.toml.
-    #[arg(long, value_name = "FILE")]
+    /// The sweep config: a path, or a name looked up in configs/ (`strong`, `strong.toml`).
+    #[arg(long, value_name = "FILE|NAME")]
     pub config: PathBuf,
-    /// Continue an interrupted sweep: cases already measured are kept and not repeated.
-    #[arg(long, conflicts_with = "fresh")]
-    pub resume: bool,
+    /// Continue an interrupted sweep: cases already measured are kept and not repeated. Without
+    /// a value, the latest unfinished run of the config (or, with --out, DIR/<name>/); with
+    /// one, that run directory or results.json.
+    #[arg(long, value_name = "RUN", num_args = 0..=1, conflicts_with = "fresh")]
+    pub resume: Option<Option<PathBuf>>,
     /// With --resume: accept a results file from a different config or commit.
     #[arg(long, requires = "resume")]
     pub force: bool,
-    /// Start over; an existing results file is kept under a .bak name.
+    /// Start over; an existing results file is kept under a .bak name (with --out; a run
+    /// without --out always starts in a new run directory).
     #[arg(long)]
     pub fresh: bool,
-    /// Output directory instead of the config's `out` (results go to DIR/<name>/results.json).
+    /// Write to DIR/<name>/results.json (the layout of the committed reference results)
+    /// instead of a new run directory <out>/runs/<name>/<UTC time>/ (<out> is the config's
+    /// `out`, default `results`).
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Skip the machine calibration at the start and end (faster; speedups then have no ceiling).
@@ -362,20 +368,47 @@ pub struct FitArgs {
 
 #[derive(Debug, Args)]
 #[command(
-    after_help = "Example (CI):\n  nbody-bench sweep --config configs/ci.toml --out scratch --fresh\n  \
-    nbody-bench gate --baseline results/baseline/ci.json --current scratch/ci/results.json --format markdown"
+    long_about = "Compare this build's timings with a baseline, case by case; exit 1 if a case got \
+        slower beyond the threshold (with its whole confidence interval), 2 for bad input or a \
+        comparison that cannot be made.\n\n\
+        Three ways:\n\
+        - with --current: compare two results files (they must come from one machine class);\n\
+        - without --current: the gate sweeps the baseline's config with this build; if the \
+        baseline comes from this machine class it is compared with the baseline file (the fast \
+        path), else the gate builds the baseline's revision (a git worktree, cached in \
+        target/gate-base/) and measures both builds here, interleaved case by case (A/B);\n\
+        - with --against REV: always A/B against REV.",
+    after_help = "Examples:\n  nbody-bench gate                       # CI: judge this build on any machine\n  \
+    nbody-bench gate --against origin/main  # a pull request against its base\n  \
+    nbody-bench gate --baseline results/baseline/ci.json --current ci --format markdown"
 )]
 pub struct GateArgs {
-    /// Results file of the reference run (e.g. results/baseline/ci.json).
-    #[arg(long, value_name = "FILE")]
+    /// Results of the reference run.
+    #[arg(long, value_name = "FILE", default_value = "results/baseline/ci.json")]
     pub baseline: PathBuf,
-    /// Results file of the run to check.
-    #[arg(long, value_name = "FILE")]
-    pub current: PathBuf,
+    /// Results of the run to check: a results.json, a run directory or a config name (its
+    /// latest run). Without it the gate measures this build itself.
+    #[arg(long, value_name = "RESULTS")]
+    pub current: Option<PathBuf>,
+    /// Measure this build and revision REV side by side (A/B), whatever machine the baseline
+    /// comes from [default base when A/B is needed: the commit recorded in the baseline].
+    #[arg(long, value_name = "REV", conflicts_with = "current")]
+    pub against: Option<String>,
+    /// The config to measure when the gate measures [default: the baseline's own config].
+    #[arg(long, value_name = "FILE|NAME", conflicts_with = "current")]
+    pub config: Option<PathBuf>,
+    /// Rounds of every case per build in an A/B run.
+    #[arg(long, default_value_t = crate::gate::AB_ROUNDS, value_parser = parse_count, conflicts_with = "current")]
+    pub rounds: usize,
+    /// Where a measuring gate keeps what it measured [default: results/runs/gate/<UTC time>/].
+    #[arg(long, value_name = "DIR", conflicts_with = "current")]
+    pub out: Option<PathBuf>,
     /// Relative slowdown a case must exceed, with its whole 95% CI, to count as a regression
-    /// (0.10 = 10%); the same margin below 1 counts as an improvement.
-    #[arg(long, default_value_t = 0.10, value_parser = parse_non_negative, allow_hyphen_values = true)]
-    pub threshold: f64,
+    /// (0.10 = 10%); the same margin below 1 counts as an improvement [default: 0.10 for two
+    /// files and for A/B runs, 0.25 when the gate sweeps and compares with a baseline file
+    /// measured at another time: the margins the noise studies in the README found safe].
+    #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
+    pub threshold: Option<f64>,
     /// Output format; markdown is made for a CI job summary.
     #[arg(long, value_enum, default_value = "text")]
     pub format: crate::gate::Format,

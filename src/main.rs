@@ -8,7 +8,7 @@ fn main() -> ExitCode {
     match nbody_bench::commands::dispatch(cli) {
         Ok(code) => ExitCode::from(code as u8),
         Err(err) => {
-            eprintln!("error: {err:#}");
+            eprintln!("error: {}", nbody_bench::commands::error_chain(&err));
             ExitCode::from(2)
         }
     }

@@ -30,6 +30,12 @@ use crate::stats::median;
 pub struct Calibration {
     /// "model name" from `/proc/cpuinfo`, or "unknown".
     pub cpu_model: String,
+    /// Vendor, family, model and stepping from `/proc/cpuinfo`, e.g. `AuthenticAMD 26/2/1`:
+    /// a virtual machine often reports only a generic model name ("AMD EPYC") for processors
+    /// of different generations, and this tells them apart. `None` where unknown (and in
+    /// files written before it was recorded).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu_signature: Option<String>,
     /// `std::thread::available_parallelism()` (1 if it cannot be determined).
     pub logical_cpus: usize,
     /// The SIMD level the kernels (and these loops) run with.
@@ -166,6 +172,7 @@ pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibrati
 
     Calibration {
         cpu_model: cpu_model(),
+        cpu_signature: cpu_signature(),
         logical_cpus,
         simd: simd::level().name().to_string(),
         fma_gflops_1t,
@@ -181,7 +188,7 @@ pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibrati
 }
 
 /// "model name" of the first processor in `/proc/cpuinfo` (Linux), else "unknown".
-fn cpu_model() -> String {
+pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
         .and_then(|text| {
@@ -192,6 +199,28 @@ fn cpu_model() -> String {
         })
         .filter(|model| !model.is_empty())
         .unwrap_or_else(|| "unknown".to_string())
+}
+
+/// Vendor, family, model and stepping of the first processor in `/proc/cpuinfo` (Linux).
+pub fn cpu_signature() -> Option<String> {
+    let text = std::fs::read_to_string("/proc/cpuinfo").ok()?;
+    signature_of(&text)
+}
+
+fn signature_of(cpuinfo: &str) -> Option<String> {
+    let field = |name: &str| {
+        cpuinfo.lines().find_map(|line| {
+            let (key, value) = line.split_once(':')?;
+            (key.trim() == name).then(|| value.trim().to_string())
+        })
+    };
+    let vendor = field("vendor_id")?;
+    Some(format!(
+        "{vendor} {}/{}/{}",
+        field("cpu family")?,
+        field("model")?,
+        field("stepping").unwrap_or_else(|| "?".into())
+    ))
 }
 
 mod compute;
@@ -306,6 +335,7 @@ mod tests {
     fn sample() -> Calibration {
         Calibration {
             cpu_model: "AMD EPYC 9R14".to_string(),
+            cpu_signature: Some("AuthenticAMD 25/17/1".to_string()),
             logical_cpus: 2,
             simd: "avx512".to_string(),
             fma_gflops_1t: 108.3,
@@ -399,6 +429,14 @@ mod tests {
         // 100 of 400 ticks busy with other work, on 2 CPUs: half a CPU.
         assert_eq!(before.background_cpus(&after), Some(0.5));
         assert_eq!(before.background_cpus(&before), None);
+    }
+
+    #[test]
+    fn signature_from_cpuinfo() {
+        let text = "processor\t: 0\nvendor_id\t: GenuineIntel\ncpu family\t: 6\n\
+                    model\t\t: 143\nmodel name\t: Intel(R) Xeon(R)\nstepping\t: 8\n";
+        assert_eq!(signature_of(text).as_deref(), Some("GenuineIntel 6/143/8"));
+        assert_eq!(signature_of("model name : x\n"), None);
     }
 
     #[test]

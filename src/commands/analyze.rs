@@ -2,13 +2,18 @@
 
 use crate::analysis::{self, Written};
 use crate::cli::AnalyzeArgs;
+use crate::experiment::locate;
 use crate::experiment::results::ResultsFile;
 use std::path::{Path, PathBuf};
 
 pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
-    let results = ResultsFile::load(&args.results)?;
-    let dir = args.out.unwrap_or_else(|| default_dir(&args.results));
-    let written = run(&results, &args.results, &dir)?;
+    let path = locate::find_results(&args.results, Path::new("results"))?;
+    if path != args.results {
+        eprintln!("analyzing {}", path.display());
+    }
+    let results = ResultsFile::load(&path)?;
+    let dir = args.out.unwrap_or_else(|| default_dir(&path));
+    let written = run(&results, &path, &dir)?;
     print_written(&written);
     Ok(0)
 }

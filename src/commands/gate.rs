@@ -1,21 +1,48 @@
-use crate::cli::GateArgs;
-use crate::experiment::results::ResultsFile;
-use crate::gate::{GateOptions, compare, render};
+//! `gate`: compare two results files, or measure this build and judge it (against the
+//! baseline file on its machine class, else A/B against the baseline's revision).
 
-/// Compares a current sweep with a baseline: exit 0 when nothing regressed, 1 when something
-/// did, 2 for bad input (including baseline cases the current run did not measure).
+use crate::cli::GateArgs;
+use crate::experiment::config::SweepConfig;
+use crate::experiment::locate;
+use crate::experiment::measure::WallClock;
+use crate::experiment::results::{ResultsFile, utc_now};
+use crate::experiment::runner::{SweepOptions, run_sweep};
+use crate::gate::ab::{self, AbPlan};
+use crate::gate::{
+    AB_THRESHOLD, FILE_THRESHOLD, GateOptions, GateReport, RunInfo, base_build, compare, render,
+};
+use std::path::{Path, PathBuf};
+
 pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
-    let baseline = ResultsFile::load(&args.baseline)?;
-    let current = ResultsFile::load(&args.current)?;
-    let options = GateOptions {
-        threshold: args.threshold,
+    match &args.current {
+        Some(current) => {
+            let root = Path::new("results");
+            let baseline = ResultsFile::load(&locate::find_results(&args.baseline, root)?)?;
+            let current = ResultsFile::load(&locate::find_results(current, root)?)?;
+            let report = compare(&baseline, &current, &options(&args, 0.10))?;
+            Ok(finish(&report, &args, None)?)
+        }
+        None => measure_and_judge(&args),
+    }
+}
+
+fn options(args: &GateArgs, default_threshold: f64) -> GateOptions {
+    GateOptions {
+        threshold: args.threshold.unwrap_or(default_threshold),
         force: args.force,
         normalization: args.normalize,
         fail_on_work_change: args.fail_on_work_change,
         ..GateOptions::default()
-    };
-    let report = compare(&baseline, &current, &options)?;
-    print!("{}", render(&report, args.format));
+    }
+}
+
+/// Prints the report (and keeps it as `gate.json` in `dir`); the exit code.
+fn finish(report: &GateReport, args: &GateArgs, dir: Option<&Path>) -> anyhow::Result<i32> {
+    print!("{}", render(report, args.format));
+    if let Some(dir) = dir {
+        let json = render(report, crate::gate::Format::Json);
+        crate::output::write_atomic(&dir.join("gate.json"), json.as_bytes())?;
+    }
     if !report.missing.is_empty() {
         let keys: Vec<&str> = report.missing.iter().map(|m| m.key.as_str()).collect();
         eprintln!(
@@ -26,5 +53,155 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
             keys.join(", ")
         );
     }
+    if report.cases.is_empty() {
+        anyhow::bail!("the gate compared no case: nothing was judged, which is not a pass");
+    }
     Ok(report.exit_code())
+}
+
+/// The machine this process runs on, as a gate sees a results file's.
+fn this_machine() -> RunInfo {
+    RunInfo {
+        git_commit: String::new(),
+        git_dirty: false,
+        started: String::new(),
+        host: String::new(),
+        cpu_model: Some(crate::calibrate::cpu_model()),
+        cpu_signature: crate::calibrate::cpu_signature(),
+        logical_cpus: Some(crate::run::logical_cpus()),
+        test_slowdown: None,
+    }
+}
+
+fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
+    let baseline = if args.baseline.is_file() || args.against.is_none() {
+        Some(ResultsFile::load(&args.baseline)?)
+    } else {
+        None
+    };
+    let (config_path, config_text) = match (&args.config, &baseline) {
+        (Some(name), _) => {
+            let path = locate::find_config(name)?;
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
+            (path, text)
+        }
+        (None, Some(b)) => (args.baseline.clone(), b.config_text.clone()),
+        (None, None) => {
+            let path = locate::find_config(Path::new("ci"))?;
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
+            (path, text)
+        }
+    };
+    let config = SweepConfig::parse(&config_text, &config_path)?;
+    let out = match &args.out {
+        Some(dir) => {
+            std::fs::create_dir_all(dir)
+                .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+            dir.clone()
+        }
+        None => locate::new_run_dir(Path::new("results"), "gate", &utc_now())?,
+    };
+    let against = match (&args.against, &baseline) {
+        (Some(rev), _) => rev.clone(),
+        (None, Some(b)) => match RunInfo::of(b).machine_class_differs(&this_machine()) {
+            None => return fast_path(args, b, &config, &config_text, &out),
+            Some(why) => {
+                eprintln!(
+                    "gate: the baseline {} comes from another machine class ({why}); measuring \
+                     its revision {} and this build side by side here (A/B)",
+                    args.baseline.display(),
+                    short(&b.metadata.git_commit)
+                );
+                b.metadata.git_commit.clone()
+            }
+        },
+        (None, None) => unreachable!("a baseline is loaded unless --against is given"),
+    };
+    a_b(args, &against, &config, &config_text, &out)
+}
+
+/// The baseline file comes from this machine class: sweep this build and compare.
+fn fast_path(
+    args: &GateArgs,
+    baseline: &ResultsFile,
+    config: &SweepConfig,
+    text: &str,
+    out: &Path,
+) -> anyhow::Result<i32> {
+    eprintln!(
+        "gate: sweeping {} with this build, to compare with {} (same machine class)",
+        config.name,
+        args.baseline.display()
+    );
+    let sweep = SweepOptions {
+        run_dir: Some(out.to_path_buf()),
+        calibrate: true,
+        ..Default::default()
+    };
+    let mut quiet = crate::experiment::runner::Silent;
+    let report = run_sweep(config, text, &sweep, &WallClock::new(), &mut quiet)?;
+    let current = ResultsFile::load(&report.path)?;
+    let judged = compare(baseline, &current, &options(args, FILE_THRESHOLD))?;
+    eprintln!("gate: results kept in {}", out.display());
+    finish(&judged, args, Some(out))
+}
+
+/// Builds `rev` (or takes it from the cache), measures both builds interleaved, and judges.
+fn a_b(
+    args: &GateArgs,
+    rev: &str,
+    config: &SweepConfig,
+    text: &str,
+    out: &Path,
+) -> anyhow::Result<i32> {
+    let started = std::time::Instant::now();
+    let repo = base_build::repository_root(&std::env::current_dir()?)?;
+    let commit = base_build::resolve(&repo, rev)?;
+    let mut say = |line: &str| eprintln!("gate: {line}");
+    let base = base_build::base_binary(&repo, &commit, &mut say)?;
+    if base.built {
+        say(&format!("base built in {:.0} s", base.build_s));
+    }
+    let current: PathBuf = std::env::current_exe()
+        .map_err(|e| anyhow::anyhow!("cannot find this program's binary: {e}"))?;
+    say("calibrating the machine...");
+    let calibration = crate::calibrate::calibrate(&[1]);
+    let work = out.join("scratch");
+    let plan = AbPlan {
+        config,
+        config_text: text,
+        base: &base,
+        current: &current,
+        rounds: args.rounds,
+        work: &work,
+    };
+    let mut results = ab::measure(&plan, &mut say)?;
+    let _ = std::fs::remove_dir_all(&work);
+    for file in [&mut results.base, &mut results.current] {
+        file.calibration.start = Some(calibration.clone());
+    }
+    results.base.save(&out.join("base.json"))?;
+    results.current.save(&out.join("current.json"))?;
+    let report = compare(
+        &results.base,
+        &results.current,
+        &options(args, AB_THRESHOLD),
+    )?;
+    say(&format!(
+        "A/B against {} ({}): {} rounds per build, measured in {:.0} s, {:.0} s in all; \
+         results kept in {}",
+        rev,
+        short(&commit),
+        args.rounds,
+        results.measure_s,
+        started.elapsed().as_secs_f64(),
+        out.display()
+    ));
+    finish(&report, args, Some(out))
+}
+
+fn short(commit: &str) -> &str {
+    &commit[..commit.len().min(12)]
 }

@@ -33,6 +33,24 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
     }
 }
 
+/// An error and its causes on one line, `outer: cause: root cause`, leaving out a cause whose
+/// text the message already carries (an error type that prints its source in its own
+/// message, as most of ours do, would otherwise show it twice).
+pub fn error_chain(err: &anyhow::Error) -> String {
+    let mut line = String::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if line.contains(&text) {
+            continue;
+        }
+        if !line.is_empty() {
+            line.push_str(": ");
+        }
+        line.push_str(&text);
+    }
+    line
+}
+
 fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
     Setup {
         scenario,
@@ -49,5 +67,41 @@ fn kernel_params(args: &KernelArgs) -> KernelParams {
     KernelParams {
         theta: args.theta,
         leaf_size: args.leaf_size,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::error_chain;
+
+    #[derive(Debug, thiserror::Error)]
+    #[error("cannot read config {path}: {source}")]
+    struct ReadError {
+        path: String,
+        source: std::io::Error,
+    }
+
+    #[test]
+    fn a_cause_is_printed_once() {
+        let io = std::io::Error::new(std::io::ErrorKind::NotFound, "No such file or directory");
+        let err = anyhow::Error::from(ReadError {
+            path: "strong.toml".into(),
+            source: io,
+        });
+        assert_eq!(
+            error_chain(&err),
+            "cannot read config strong.toml: No such file or directory"
+        );
+        let wrapped = err.context("sweep");
+        assert_eq!(
+            error_chain(&wrapped),
+            "sweep: cannot read config strong.toml: No such file or directory"
+        );
+    }
+
+    #[test]
+    fn distinct_causes_are_all_kept() {
+        let err = anyhow::anyhow!("root").context("middle").context("top");
+        assert_eq!(error_chain(&err), "top: middle: root");
     }
 }

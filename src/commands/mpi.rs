@@ -42,7 +42,10 @@ mod with_mpi {
     /// Prints an error on the ranks that should, and gives exit code 2.
     fn fail(rank: usize, err: MpiError) -> i32 {
         if err.printed_by(rank) {
-            eprintln!("error: {:#}", anyhow::Error::from(err));
+            eprintln!(
+                "error: {}",
+                crate::commands::error_chain(&anyhow::Error::from(err))
+            );
         }
         2
     }

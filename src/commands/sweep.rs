@@ -1,18 +1,23 @@
 use crate::cli::SweepArgs;
 use crate::commands::fmt_ns;
 use crate::experiment::config::SweepConfig;
+use crate::experiment::locate;
 use crate::experiment::measure::WallClock;
 use crate::experiment::progress;
-use crate::experiment::results::ResultsFile;
+use crate::experiment::results::{ResultsFile, utc_now};
 use crate::experiment::runner::{SweepOptions, run_sweep};
+use std::path::{Path, PathBuf};
 
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
-    let (config, text) = SweepConfig::load(&args.config)?;
+    let config_path = locate::find_config(&args.config)?;
+    let (config, text) = SweepConfig::load(&config_path)?;
+    let (resume, run_dir) = where_to_write(&args, &config)?;
     let options = SweepOptions {
-        resume: args.resume,
+        resume,
         force: args.force,
         fresh: args.fresh,
-        out: args.out,
+        out: args.out.clone(),
+        run_dir,
         calibrate: !args.no_calibration,
         stop_after: None,
     };
@@ -23,7 +28,15 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         &options,
         &WallClock::new(),
         observer.as_mut(),
-    )?;
+    )
+    .inspect_err(|_| {
+        // A new run directory that never received results is not a run: leave nothing.
+        if let Some(dir) = &options.run_dir
+            && !resume
+        {
+            let _ = std::fs::remove_dir(dir);
+        }
+    })?;
     let results = ResultsFile::load(&report.path)?;
     print_table(&results);
     print_speedups(&results);
@@ -39,18 +52,74 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     match super::analyze::run(&results, &report.path, &dir) {
         Ok(written) => super::analyze::print_written(&written),
         Err(e) => eprintln!(
-            "warning: analysis failed ({e:#}); the results are saved, retry with `nbody-bench analyze {}`",
+            "warning: analysis failed ({}); the results are saved, retry with `nbody-bench analyze {}`",
+            super::error_chain(&e),
             report.path.display()
         ),
     }
     if report.incomplete > 0 {
         println!(
-            "{} cases are not complete; run `nbody-bench sweep --config {} --resume` to finish them",
+            "{} cases are not complete; run `nbody-bench sweep --config {} --resume{}` to finish them",
             report.incomplete,
-            args.config.display()
+            args.config.display(),
+            match &args.out {
+                Some(out) => format!(" --out {}", out.display()),
+                None => String::new(),
+            }
         );
     }
     Ok(0)
+}
+
+/// Whether to resume, and the run directory to write in (`None`: `<out>/<name>/`, with --out).
+///
+/// Without --out every sweep gets a new run directory, so the same command can be typed again
+/// and never touches the committed reference results; `--resume` continues the latest
+/// unfinished run of the config, `--resume RUN` the one given.
+fn where_to_write(
+    args: &SweepArgs,
+    config: &SweepConfig,
+) -> anyhow::Result<(bool, Option<PathBuf>)> {
+    let root = &config.out;
+    match (&args.resume, &args.out) {
+        (Some(Some(_)), Some(_)) => anyhow::bail!(
+            "--resume RUN names the run itself; drop --out, or pass --resume without a value to \
+             resume DIR/{}/",
+            config.name
+        ),
+        (Some(None), Some(_)) => Ok((true, None)),
+        (None, Some(_)) => Ok((false, None)),
+        (Some(Some(run)), None) => {
+            let dir = if run.is_file() {
+                run.parent().unwrap_or(Path::new(".")).to_path_buf()
+            } else {
+                run.clone()
+            };
+            if !dir.join("results.json").is_file() {
+                anyhow::bail!(
+                    "--resume {}: no results.json there; pass a run directory such as {}/<UTC time>",
+                    run.display(),
+                    locate::runs_dir(root, &config.name).display()
+                );
+            }
+            Ok((true, Some(dir)))
+        }
+        (Some(None), None) => {
+            let dir = locate::latest_unfinished(root, &config.name)?;
+            eprintln!("resuming {}", dir.display());
+            Ok((true, Some(dir)))
+        }
+        (None, None) => {
+            if let Ok(dir) = locate::latest_unfinished(root, &config.name) {
+                eprintln!(
+                    "note: {} is an unfinished run of this config; `--resume` continues it",
+                    dir.display()
+                );
+            }
+            let dir = locate::new_run_dir(root, &config.name, &utc_now())?;
+            Ok((false, Some(dir)))
+        }
+    }
 }
 
 fn print_table(results: &ResultsFile) {

@@ -2,6 +2,7 @@
 
 pub mod config;
 pub mod launcher;
+pub mod locate;
 pub mod measure;
 pub mod plan;
 pub mod progress;

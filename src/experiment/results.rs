@@ -202,6 +202,26 @@ impl CaseRecord {
         self.summary = Some(self.summarize(&hist, max_drift));
     }
 
+    /// Adds every round of `other`, the same case measured by another sweep (an A/B gate's
+    /// one-case runs), with its step-time histogram.
+    pub fn absorb(&mut self, other: CaseRecord, max_drift: f64) {
+        let mut hist = self.histogram();
+        for &[value, count] in &other.step_histogram {
+            hist.saturating_record_n(value, count);
+        }
+        self.step_histogram = hist
+            .iter_recorded()
+            .map(|v| [v.value_iterated_to(), v.count_at_value()])
+            .collect();
+        for round in other.rounds {
+            self.n = round.n;
+            self.steps_per_sample = round.steps_per_sample;
+            self.rounds.push(round);
+            self.rounds_done += 1;
+        }
+        self.summary = Some(self.summarize(&hist, max_drift));
+    }
+
     fn histogram(&self) -> Histogram<u64> {
         let mut h = Histogram::<u64>::new_with_bounds(1, 3_600_000_000_000, 3)
             .expect("valid histogram bounds");

@@ -19,8 +19,10 @@ pub struct SweepOptions {
     pub force: bool,
     /// Start over: an existing results file is kept under a `.bak` name.
     pub fresh: bool,
-    /// Output directory instead of the config's `out`.
+    /// Output directory instead of the config's `out`: results go to `<out>/<name>/`.
     pub out: Option<PathBuf>,
+    /// The directory of the results file itself (a user's run directory); wins over `out`.
+    pub run_dir: Option<PathBuf>,
     /// Calibrate the machine at the start and end (tests turn it off).
     pub calibrate: bool,
     /// Stop after this many measured rounds, as if interrupted (tests).
@@ -107,7 +109,10 @@ pub fn run_sweep<C: Clock>(
             config: config.name.clone(),
         });
     }
-    let path = results_path(config, options.out.as_deref());
+    let path = match &options.run_dir {
+        Some(dir) => dir.join("results.json"),
+        None => results_path(config, options.out.as_deref()),
+    };
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     let mut results = open(config, config_text, options, &path)?;
     if let Some(s) = slowdown {

@@ -1,6 +1,9 @@
 //! A test-only knob that makes one kernel genuinely slower, so that the regression gate can be
 //! tested on real sweeps: `NBODY_BENCH_TEST_SLOWDOWN=KERNEL:K` makes every timed force
-//! computation of KERNEL run K times (the forces and work counters are those of one run).
+//! computation of KERNEL take K times as long (the forces and work counters are those of one
+//! run): the whole part of K repeats the computation, a fractional part spins for that share of
+//! the last repetition's time, so `naive:1.2` is a 20 % slower force computation (the step,
+//! which also integrates, slows a little less).
 //!
 //! Not for measurements: a sweep run with it records it in `metadata.test_slowdown`, and `gate`
 //! warns about such a file. When the variable is unset the knob costs nothing: it is read once
@@ -15,13 +18,13 @@ use std::fmt;
 pub const SLOWDOWN_ENV: &str = "NBODY_BENCH_TEST_SLOWDOWN";
 
 /// Largest accepted factor (a mistyped one should not make a sweep run for hours).
-const MAX_FACTOR: u32 = 100;
+const MAX_FACTOR: f64 = 100.0;
 
-/// One kernel's force computation repeated `factor` times.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// One kernel's force computation made `factor` times as long.
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TestSlowdown {
     pub kernel: KernelKind,
-    pub factor: u32,
+    pub factor: f64,
 }
 
 impl fmt::Display for TestSlowdown {
@@ -53,10 +56,11 @@ impl TestSlowdown {
             .find(|k| k.name() == name)
             .ok_or_else(|| bad(format!("unknown kernel `{name}`")))?;
         let factor = factor
-            .parse::<u32>()
+            .trim()
+            .parse::<f64>()
             .ok()
-            .filter(|k| (1..=MAX_FACTOR).contains(k))
-            .ok_or_else(|| bad(format!("K must be a whole number from 1 to {MAX_FACTOR}")))?;
+            .filter(|k| (1.0..=MAX_FACTOR).contains(k))
+            .ok_or_else(|| bad(format!("K must be a number from 1 to {MAX_FACTOR}")))?;
         Ok(TestSlowdown { kernel, factor })
     }
 
@@ -66,19 +70,19 @@ impl TestSlowdown {
         kernel: Box<dyn ForceKernel<T, D>>,
     ) -> Box<dyn ForceKernel<T, D>> {
         match slowdown {
-            Some(s) if s.kernel == kernel.kind() && s.factor > 1 => Box::new(Repeated {
+            Some(s) if s.kernel == kernel.kind() && s.factor > 1.0 => Box::new(Repeated {
                 inner: kernel,
-                times: s.factor,
+                factor: s.factor,
             }),
             _ => kernel,
         }
     }
 }
 
-/// A kernel whose timed computations run `times` times; probes (untimed) run once.
+/// A kernel whose timed computations take `factor` times as long; probes (untimed) run once.
 struct Repeated<T: Real, const D: usize> {
     inner: Box<dyn ForceKernel<T, D>>,
-    times: u32,
+    factor: f64,
 }
 
 impl<T: Real, const D: usize> ForceKernel<T, D> for Repeated<T, D> {
@@ -92,12 +96,21 @@ impl<T: Real, const D: usize> ForceKernel<T, D> for Repeated<T, D> {
         forces: &mut Field<T, D>,
         probe: bool,
     ) -> ForceReport {
-        if !probe {
-            for _ in 1..self.times {
-                self.inner.compute(state, forces, false);
-            }
+        if probe {
+            return self.inner.compute(state, forces, true);
         }
-        self.inner.compute(state, forces, probe)
+        let whole = self.factor.floor();
+        for _ in 1..whole as u32 {
+            self.inner.compute(state, forces, false);
+        }
+        let start = std::time::Instant::now();
+        let report = self.inner.compute(state, forces, false);
+        let extra = start.elapsed().mul_f64(self.factor - whole);
+        let spin = std::time::Instant::now();
+        while spin.elapsed() < extra {
+            std::hint::spin_loop();
+        }
+        report
     }
 
     fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
@@ -119,14 +132,23 @@ mod tests {
             TestSlowdown::parse("symmetric:3"),
             Ok(TestSlowdown {
                 kernel: KernelKind::Symmetric,
-                factor: 3
+                factor: 3.0
             })
         );
+        assert_eq!(TestSlowdown::parse("naive:1.2").unwrap().factor, 1.2);
         assert_eq!(
             TestSlowdown::parse("per-thread:1").unwrap().to_string(),
             "per-thread:1"
         );
-        for bad in ["symmetric", "fast:2", "naive:0", "naive:x", "naive:1000"] {
+        for bad in [
+            "symmetric",
+            "fast:2",
+            "naive:0",
+            "naive:0.5",
+            "naive:x",
+            "naive:1000",
+            "naive:NaN",
+        ] {
             let e = TestSlowdown::parse(bad).unwrap_err();
             assert!(e.contains(SLOWDOWN_ENV) && e.contains(bad), "{e}");
         }
@@ -139,7 +161,7 @@ mod tests {
         let build = |k: KernelKind| k.build::<f64, _, 3>(law, &KernelParams::default()).unwrap();
         let slow = Some(TestSlowdown {
             kernel: KernelKind::Symmetric,
-            factor: 3,
+            factor: 3.0,
         });
         let mut plain = build(KernelKind::Symmetric);
         let mut wrapped = TestSlowdown::apply(slow, build(KernelKind::Symmetric));

@@ -37,6 +37,15 @@ pub(super) fn check_comparable(
         };
         refuse(error, &mut warnings)?;
     }
+    if b.cpu_signature != c.cpu_signature {
+        let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "not recorded".into());
+        let error = GateError::OtherMachine {
+            what: "CPU signature",
+            baseline: show(&b.cpu_signature),
+            current: show(&c.cpu_signature),
+        };
+        refuse(error, &mut warnings)?;
+    }
     if let (Some(bn), Some(cn)) = (b.logical_cpus, c.logical_cpus)
         && bn != cn
     {

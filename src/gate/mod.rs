@@ -16,6 +16,8 @@
 //! - results from another machine (CPU model, logical CPUs), build (SIMD level, profile) or
 //!   config are refused unless forced.
 
+pub mod ab;
+pub mod base_build;
 mod checks;
 mod compare;
 mod render;
@@ -28,6 +30,14 @@ pub use render::{Format, render};
 use crate::experiment::results::ResultsFile;
 use serde::Serialize;
 use thiserror::Error;
+
+/// Default threshold of an A/B run (both builds interleaved in one run): see the README's CI
+/// section for the A/A runs it was chosen from.
+pub const AB_THRESHOLD: f64 = 0.10;
+/// Default threshold against a baseline file measured at another time.
+pub const FILE_THRESHOLD: f64 = 0.25;
+/// Default rounds of every case per build in an A/B run.
+pub const AB_ROUNDS: usize = 4;
 
 /// Schema of the JSON rendering of a [`GateReport`].
 pub const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
@@ -162,11 +172,42 @@ pub struct RunInfo {
     pub started: String,
     pub host: String,
     pub cpu_model: Option<String>,
+    pub cpu_signature: Option<String>,
     pub logical_cpus: Option<usize>,
     pub test_slowdown: Option<String>,
 }
 
 impl RunInfo {
+    /// Why the two runs are not known to come from one machine class (CPU model, CPU
+    /// signature, logical CPU count), or `None` when they are. A run that did not record a
+    /// CPU signature is of an unknown class: its timings cannot be trusted to match.
+    pub fn machine_class_differs(&self, other: &RunInfo) -> Option<String> {
+        let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "not recorded".into());
+        if self.cpu_model != other.cpu_model {
+            return Some(format!(
+                "CPU model `{}` there, `{}` here",
+                show(&self.cpu_model),
+                show(&other.cpu_model)
+            ));
+        }
+        if self.cpu_signature.is_none() || self.cpu_signature != other.cpu_signature {
+            return Some(format!(
+                "CPU signature `{}` there, `{}` here",
+                show(&self.cpu_signature),
+                show(&other.cpu_signature)
+            ));
+        }
+        if self.logical_cpus != other.logical_cpus {
+            let show = |v: Option<usize>| v.map_or("not recorded".into(), |n| n.to_string());
+            return Some(format!(
+                "{} logical CPUs there, {} here",
+                show(self.logical_cpus),
+                show(other.logical_cpus)
+            ));
+        }
+        None
+    }
+
     pub fn of(file: &ResultsFile) -> RunInfo {
         let cal = file
             .calibration
@@ -179,6 +220,7 @@ impl RunInfo {
             started: file.metadata.started.clone(),
             host: file.metadata.host.clone(),
             cpu_model: cal.map(|c| c.cpu_model.clone()),
+            cpu_signature: cal.and_then(|c| c.cpu_signature.clone()),
             logical_cpus: cal.map(|c| c.logical_cpus),
             test_slowdown: file.metadata.test_slowdown.clone(),
         }
@@ -243,8 +285,10 @@ pub enum GateError {
     UnknownMachine { which: &'static str },
     #[error(
         "the baseline comes from another machine: {what} `{baseline}` there, `{current}` here; \
-         timings are only comparable on the same machine class. Refresh the baseline on this \
-         machine (scripts/refresh-baseline.sh), or pass --force to compare anyway"
+         timings are only comparable on the same machine class. Run the gate without --current \
+         to measure the baseline's revision and this build side by side here (A/B), refresh the \
+         baseline on this machine (scripts/refresh-baseline.sh), or pass --force to compare \
+         anyway"
     )]
     OtherMachine {
         what: &'static str,

@@ -53,6 +53,7 @@ impl Run {
 fn calibration(gflops: f64) -> Calibration {
     Calibration {
         cpu_model: "AMD EPYC 9R14".to_string(),
+        cpu_signature: Some("AuthenticAMD 25/17/1".to_string()),
         logical_cpus: 2,
         simd: "avx512".to_string(),
         fma_gflops_1t: gflops,

@@ -250,8 +250,12 @@ fn bad_input_exits_2_with_a_message() {
 
     assert_bad_input(
         &gate(&base, &dir.path().join("nope.json"), &[]),
-        "cannot read",
+        "no results for",
     );
+    let empty = edited(dir.path(), "empty.json", |v| {
+        v["cases"] = serde_json::Value::Array(Vec::new());
+    });
+    assert_bad_input(&gate(&empty, &empty, &[]), "compared no case");
     assert_bad_input(
         &gate(&base, &base, &["--threshold", "-1"]),
         "must be 0 or greater",
@@ -260,4 +264,131 @@ fn bad_input_exits_2_with_a_message() {
         &gate(&base, &base, &["--threshold", "x"]),
         "is not a number",
     );
+}
+
+fn git(dir: &Path, args: &[&str]) -> String {
+    let o = Command::new("git")
+        .current_dir(dir)
+        .args(["-c", "user.name=test", "-c", "user.email=test@localhost"])
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "git {args:?}: {}", text(&o.stderr));
+    text(&o.stdout).trim().to_string()
+}
+
+/// A git repository whose HEAD's base build is this very binary, put in the gate's cache, so
+/// that an A/B run of HEAD measures the same build on both sides without compiling it again.
+fn same_tree_repo() -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().unwrap();
+    git(dir.path(), &["init", "-q"]);
+    std::fs::write(dir.path().join("gate-tiny.toml"), TINY).unwrap();
+    git(dir.path(), &["add", "-A"]);
+    git(dir.path(), &["commit", "-q", "-m", "tiny"]);
+    let head = git(dir.path(), &["rev-parse", "HEAD"]);
+    let target = dir.path().join("target");
+    let cached = target.join("gate-base").join(&head);
+    std::fs::create_dir_all(&cached).unwrap();
+    std::fs::copy(
+        env!("CARGO_BIN_EXE_nbody-bench"),
+        cached.join("nbody-bench"),
+    )
+    .unwrap();
+    (dir, target)
+}
+
+fn a_b(dir: &Path, target: &Path, rev: &str, slowdown: Option<&str>, extra: &[&str]) -> Output {
+    let mut cmd = bin();
+    cmd.current_dir(dir)
+        .env("CARGO_TARGET_DIR", target)
+        .args([
+            "gate",
+            "--against",
+            rev,
+            "--config",
+            "gate-tiny.toml",
+            "--rounds",
+            "2",
+        ])
+        .args(["--out", "gate-out", "--format", "json"])
+        .args(extra);
+    if let Some(knob) = slowdown {
+        cmd.env("NBODY_BENCH_TEST_SLOWDOWN", knob);
+    }
+    cmd.output().unwrap()
+}
+
+/// One test, so that its A/B runs never overlap.
+#[test]
+fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
+    let _serial = serial();
+    let (repo, target) = same_tree_repo();
+    let same = a_b(repo.path(), &target, "HEAD", None, &["--threshold", "0.75"]);
+    assert_eq!(same.status.code(), Some(0), "{}", text(&same.stderr));
+    assert!(verdicts(&same).iter().all(|(_, v)| v == "unchanged"));
+    assert_eq!(verdicts(&same).len(), 3);
+    for kept in ["base.json", "current.json", "gate.json"] {
+        assert!(repo.path().join("gate-out").join(kept).is_file(), "{kept}");
+    }
+    assert!(!repo.path().join("gate-out/scratch").exists());
+
+    let slow = a_b(
+        repo.path(),
+        &target,
+        "HEAD",
+        Some("symmetric:5"),
+        &["--threshold", "0.75"],
+    );
+    assert_eq!(slow.status.code(), Some(1), "{}", text(&slow.stderr));
+    for (key, verdict) in verdicts(&slow) {
+        let expected = if key.contains("/symmetric/") {
+            "regressed"
+        } else {
+            "unchanged"
+        };
+        assert_eq!(verdict, expected, "{key}");
+    }
+
+    let missing = a_b(repo.path(), &target, "0123456789abcdef0123", None, &[]);
+    assert_bad_input(&missing, "is not in this clone");
+}
+
+#[test]
+fn a_base_revision_is_built_once_and_a_broken_one_is_refused() {
+    use nbody_bench::gate::base_build::{base_binary, cache_root};
+    let dir = tempfile::tempdir().unwrap();
+    let repo = dir.path();
+    git(repo, &["init", "-q"]);
+    std::fs::create_dir(repo.join("src")).unwrap();
+    std::fs::write(
+        repo.join("Cargo.toml"),
+        "[package]\nname = \"nbody-bench\"\nversion = \"0.0.0\"\nedition = \"2021\"\n",
+    )
+    .unwrap();
+    std::fs::write(repo.join("src/main.rs"), "fn main() {}\n").unwrap();
+    git(repo, &["add", "-A"]);
+    git(repo, &["commit", "-q", "-m", "builds"]);
+    let good = git(repo, &["rev-parse", "HEAD"]);
+    std::fs::write(repo.join("src/main.rs"), "fn main() { not rust }\n").unwrap();
+    git(repo, &["commit", "-q", "-am", "broken"]);
+    let broken = git(repo, &["rev-parse", "HEAD"]);
+
+    let mut quiet = |_: &str| {};
+    let first = base_binary(repo, &good, &mut quiet).unwrap();
+    assert!(first.built && first.path.is_file());
+    assert!(first.path.starts_with(cache_root(repo)));
+    let again = base_binary(repo, &good, &mut quiet).unwrap();
+    assert!(!again.built, "taken from the cache");
+    assert_eq!(again.path, first.path);
+    let err = base_binary(repo, &broken, &mut quiet)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("does not build"), "{err}");
+    assert!(
+        err.contains("error"),
+        "the compiler's message is shown: {err}"
+    );
+    // No worktree is left behind either way.
+    let worktrees = git(repo, &["worktree", "list"]);
+    assert_eq!(worktrees.lines().count(), 1, "{worktrees}");
 }

@@ -1,0 +1,328 @@
+//! The A/B gate: two builds measured in one run on one machine, interleaved case by case.
+//!
+//! Two sweeps of the same build taken 30 s apart differ by up to a third on a shared 2-vCPU
+//! machine (its speed drifts), and no normalisation cancels all of that. So each case is
+//! measured by both builds back to back, the order alternating (A B, B A, ...) and the case
+//! order reversed every round, until each build has `rounds` rounds of the case; each sample
+//! is still paired with the reference workload timed right before it. Both builds run their
+//! own `sweep` command on a one-case, one-round config, so any revision that has `sweep`
+//! can be the base. The rounds of each build are then merged into one results file per build
+//! and judged by [`super::compare`] like any two results files.
+
+use super::base_build::BaseBinary;
+use crate::experiment::config::SweepConfig;
+use crate::experiment::plan::{Case, cases};
+use crate::experiment::results::{CaseRecord, ResultsFile};
+use crate::experiment::slowdown::SLOWDOWN_ENV;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum AbError {
+    #[error("the A/B gate cannot run config `{name}`: {why}")]
+    Unsupported { name: String, why: String },
+    #[error("--rounds must be at least 2 (got {0}): each build needs more than one round")]
+    Rounds(usize),
+    #[error(
+        "the {side} build failed to measure {key} (round {round}); its output ends with:\n{tail}"
+    )]
+    Side {
+        side: &'static str,
+        key: String,
+        round: usize,
+        tail: String,
+    },
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error(transparent)]
+    Results(#[from] crate::experiment::results::ResultsError),
+}
+
+/// The two builds, A (the base) and B (this one).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    Base,
+    Current,
+}
+
+impl Side {
+    pub fn name(self) -> &'static str {
+        match self {
+            Side::Base => "base",
+            Side::Current => "current",
+        }
+    }
+}
+
+/// What an A/B run needs.
+pub struct AbPlan<'a> {
+    pub config: &'a SweepConfig,
+    pub config_text: &'a str,
+    pub base: &'a BaseBinary,
+    /// This build's binary.
+    pub current: &'a Path,
+    /// Rounds of every case per build.
+    pub rounds: usize,
+    /// Scratch directory for the one-case sweeps.
+    pub work: &'a Path,
+}
+
+/// Both builds' merged results.
+pub struct AbResults {
+    pub base: ResultsFile,
+    pub current: ResultsFile,
+    /// Wall time of the interleaved measurement, seconds.
+    pub measure_s: f64,
+}
+
+/// The order of the two builds for one case in one round: A B, then B A, alternating over
+/// cases and rounds, so that neither build is systematically first after a case switch.
+pub fn order(round: usize, case: usize) -> [Side; 2] {
+    if (round + case).is_multiple_of(2) {
+        [Side::Base, Side::Current]
+    } else {
+        [Side::Current, Side::Base]
+    }
+}
+
+/// Samples per one-case round: the config's samples spread over the A/B rounds (at least 2).
+pub fn samples_per_round(config: &SweepConfig, rounds: usize) -> usize {
+    config.measure.samples.div_ceil(rounds).max(2)
+}
+
+/// Measures every case of the plan with both builds, interleaved.
+pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbResults, AbError> {
+    let unsupported = |why: &str| AbError::Unsupported {
+        name: plan.config.name.clone(),
+        why: why.to_string(),
+    };
+    if plan.rounds < 2 {
+        return Err(AbError::Rounds(plan.rounds));
+    }
+    if plan.config.mpi.is_some() {
+        return Err(unsupported(
+            "it runs cases under MPI; gate a config without [mpi]",
+        ));
+    }
+    let planned = cases(plan.config);
+    if planned.iter().any(|c| c.time_factor != 1) {
+        return Err(unsupported(
+            "its weak-by-time cases have no one-case config form",
+        ));
+    }
+    let table: toml::Table = toml::from_str(plan.config_text)
+        .map_err(|e| unsupported(&format!("its text does not parse ({})", e.message())))?;
+    let samples = samples_per_round(plan.config, plan.rounds);
+    let logical = crate::run::logical_cpus();
+    let mut merged: [Vec<CaseRecord>; 2] = [Vec::new(), Vec::new()];
+    for side in &mut merged {
+        *side = planned
+            .iter()
+            .map(|c| CaseRecord::new(c.clone(), plan.rounds, logical))
+            .collect();
+    }
+    let mut metadata = [None, None];
+    let started = std::time::Instant::now();
+    for round in 0..plan.rounds {
+        progress(&format!(
+            "A/B round {}/{}: {} cases, {} then {} first in turn ({:.0} s so far)",
+            round + 1,
+            plan.rounds,
+            planned.len(),
+            Side::Base.name(),
+            Side::Current.name(),
+            started.elapsed().as_secs_f64()
+        ));
+        let mut indices: Vec<usize> = (0..planned.len()).collect();
+        if round % 2 == 1 {
+            indices.reverse();
+        }
+        for i in indices {
+            let text = one_case_config(&table, &planned[i], samples);
+            for side in order(round, i) {
+                let dir = plan
+                    .work
+                    .join(side.name())
+                    .join(format!("case{i}-round{round}"));
+                let file = run_side(plan, side, &text, &dir, &planned[i], round)?;
+                let slot = side as usize;
+                metadata[slot].get_or_insert_with(|| file.metadata.clone());
+                let record = file
+                    .cases
+                    .into_iter()
+                    .find(|c| c.key == planned[i].key())
+                    .ok_or_else(|| AbError::Side {
+                        side: side.name(),
+                        key: planned[i].key(),
+                        round,
+                        tail: "its results file has no such case".to_string(),
+                    })?;
+                merged[slot][i].absorb(record, plan.config.measure.max_energy_drift);
+                // The one-case sweep's files have been merged; keep the scratch small.
+                let _ = std::fs::remove_dir_all(&dir);
+            }
+        }
+    }
+    let measure_s = started.elapsed().as_secs_f64();
+    let [base_cases, current_cases] = merged;
+    let [base_meta, current_meta] = metadata;
+    let file = |cases: Vec<CaseRecord>, meta: Option<_>| ResultsFile {
+        schema: crate::experiment::results::RESULTS_SCHEMA.to_string(),
+        metadata: meta.unwrap_or_else(crate::experiment::results::Metadata::collect),
+        config: plan.config.clone(),
+        config_text: plan.config_text.to_string(),
+        calibration: Default::default(),
+        cases,
+    };
+    let mut base = file(base_cases, base_meta);
+    // The base binary reads the commit from the checkout it runs in, which is this one.
+    base.metadata.git_commit = plan.base.commit.clone();
+    base.metadata.git_dirty = false;
+    Ok(AbResults {
+        base,
+        current: file(current_cases, current_meta),
+        measure_s,
+    })
+}
+
+/// The config text of one case for one round: the config's own text with the lists narrowed
+/// to the case, one round of `samples` samples, no budget.
+fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> String {
+    let mut t = table.clone();
+    let list = |v: toml::Value| toml::Value::Array(vec![v]);
+    t.insert("name".into(), "ab".into());
+    t.insert("study".into(), "cartesian".into());
+    t.remove("weak");
+    t.remove("out");
+    t.insert("scenarios".into(), list(case.scenario.name().into()));
+    t.insert("kernels".into(), list(case.kernel.name().into()));
+    t.insert("n".into(), list((case.n as i64).into()));
+    t.insert("threads".into(), list((case.threads as i64).into()));
+    t.insert("seeds".into(), list((case.seed as i64).into()));
+    match case.theta {
+        Some(theta) => t.insert("theta".into(), list(theta.into())),
+        None => t.remove("theta"),
+    };
+    if let Some(p) = case.precision {
+        t.insert("precision".into(), p.name().into());
+    }
+    let measure = t
+        .entry("measure")
+        .or_insert_with(|| toml::Value::Table(Default::default()));
+    if let toml::Value::Table(m) = measure {
+        m.insert("rounds".into(), 1.into());
+        m.insert("samples".into(), (samples as i64).into());
+        m.remove("budget_s");
+    }
+    toml::to_string(&t).expect("a TOML table serializes")
+}
+
+/// One build's one-case sweep; its results file.
+fn run_side(
+    plan: &AbPlan<'_>,
+    side: Side,
+    config_text: &str,
+    dir: &Path,
+    case: &Case,
+    round: usize,
+) -> Result<ResultsFile, AbError> {
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| AbError::Io { path, source }
+    };
+    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    let config = dir.join("ab.toml");
+    std::fs::write(&config, config_text).map_err(io(&config))?;
+    let binary = match side {
+        Side::Base => plan.base.path.as_path(),
+        Side::Current => plan.current,
+    };
+    let mut command = Command::new(binary);
+    command
+        .arg("sweep")
+        .arg("--config")
+        .arg(&config)
+        .arg("--out")
+        .arg(dir)
+        .arg("--no-calibration")
+        .stdin(std::process::Stdio::null());
+    if side == Side::Base {
+        // The test-only slowdown knob is meant for this build only.
+        command.env_remove(SLOWDOWN_ENV);
+    }
+    let output = command.output().map_err(|e| AbError::Side {
+        side: side.name(),
+        key: case.key(),
+        round,
+        tail: format!("{} cannot be started: {e}", binary.display()),
+    })?;
+    let results = dir.join("ab").join("results.json");
+    if !output.status.success() || !results.is_file() {
+        let text = String::from_utf8_lossy(&output.stderr).to_string()
+            + &String::from_utf8_lossy(&output.stdout);
+        let lines: Vec<&str> = text.lines().collect();
+        return Err(AbError::Side {
+            side: side.name(),
+            key: case.key(),
+            round,
+            tail: lines[lines.len().saturating_sub(12)..].join("\n"),
+        });
+    }
+    Ok(ResultsFile::load(&results)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn the_builds_take_turns() {
+        let firsts: Vec<Side> = (0..4).map(|r| order(r, 0)[0]).collect();
+        assert_eq!(
+            firsts,
+            [Side::Base, Side::Current, Side::Base, Side::Current]
+        );
+        assert_eq!(order(0, 1), [Side::Current, Side::Base]);
+        for r in 0..3 {
+            for c in 0..3 {
+                let o = order(r, c);
+                assert_ne!(o[0], o[1]);
+            }
+        }
+    }
+
+    #[test]
+    fn one_case_configs_parse_to_that_case() {
+        let text = std::fs::read_to_string("configs/ci.toml").unwrap();
+        let config = SweepConfig::parse(&text, Path::new("configs/ci.toml")).unwrap();
+        let table: toml::Table = toml::from_str(&text).unwrap();
+        let all = cases(&config);
+        assert!(all.len() > 4);
+        for case in &all {
+            let one = one_case_config(&table, case, 5);
+            let parsed = SweepConfig::parse(&one, Path::new("ab.toml")).unwrap();
+            let planned = cases(&parsed);
+            assert_eq!(planned.len(), 1, "{one}");
+            assert_eq!(planned[0].key(), case.key());
+            assert_eq!(parsed.measure.rounds, 1);
+            assert_eq!(parsed.measure.samples, 5);
+            assert_eq!(parsed.measure.reference_s, config.measure.reference_s);
+        }
+    }
+
+    #[test]
+    fn samples_are_spread_over_the_rounds() {
+        let text = std::fs::read_to_string("configs/ci.toml").unwrap();
+        let config = SweepConfig::parse(&text, Path::new("configs/ci.toml")).unwrap();
+        assert_eq!(
+            samples_per_round(&config, 3),
+            config.measure.samples.div_ceil(3)
+        );
+        assert_eq!(samples_per_round(&config, 1000), 2);
+    }
+}

@@ -1,0 +1,212 @@
+//! The base side of an A/B gate: the binary of another git revision, built once in a git
+//! worktree of its own and cached.
+//!
+//! Layout, under `<target>/gate-base/` (`<target>` is `$CARGO_TARGET_DIR` or the checkout's
+//! `target/`): `<commit>/nbody-bench` is the cached binary of a commit; `target/` is the
+//! target directory every base build shares (so a second base revision recompiles only what
+//! changed); `worktree-<commit>/` exists only while that commit builds.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use thiserror::Error;
+
+#[derive(Debug, Error)]
+pub enum BaseBuildError {
+    #[error(
+        "the A/B gate builds the base revision with git, and {0}; run it inside a git \
+         checkout of the project"
+    )]
+    NoRepository(String),
+    #[error(
+        "base revision `{rev}` is not in this clone ({detail}); a shallow clone lacks older \
+         commits: fetch them (git fetch --unshallow, or git fetch origin {rev}) or pass \
+         --against a revision that is present"
+    )]
+    MissingRevision { rev: String, detail: String },
+    #[error("cannot prepare the base revision {commit}: {detail}")]
+    Worktree { commit: String, detail: String },
+    #[error(
+        "the base revision {commit} does not build (cargo build --release; the log is {log}):\n{tail}"
+    )]
+    Build {
+        commit: String,
+        log: PathBuf,
+        tail: String,
+    },
+    #[error("cannot write the base build's files under {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// A base binary ready to run.
+#[derive(Clone, Debug)]
+pub struct BaseBinary {
+    /// The full commit hash.
+    pub commit: String,
+    pub path: PathBuf,
+    /// It was built by this call (not taken from the cache).
+    pub built: bool,
+    /// Seconds spent building (0 when cached).
+    pub build_s: f64,
+}
+
+/// Runs git with `args` in `dir`; its trimmed standard output, or its error text.
+fn git(dir: &Path, args: &[&str]) -> Result<String, String> {
+    let out = Command::new("git")
+        .arg("-C")
+        .arg(dir)
+        .args(args)
+        .output()
+        .map_err(|e| format!("git cannot be started ({e})"))?;
+    if out.status.success() {
+        Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
+    } else {
+        Err(String::from_utf8_lossy(&out.stderr).trim().to_string())
+    }
+}
+
+/// The root of the git checkout that contains `dir`.
+pub fn repository_root(dir: &Path) -> Result<PathBuf, BaseBuildError> {
+    git(dir, &["rev-parse", "--show-toplevel"])
+        .map(PathBuf::from)
+        .map_err(|e| {
+            BaseBuildError::NoRepository(format!("{} is not in a git checkout: {e}", dir.display()))
+        })
+}
+
+/// The full hash of `rev` in `repo`.
+pub fn resolve(repo: &Path, rev: &str) -> Result<String, BaseBuildError> {
+    git(
+        repo,
+        &[
+            "rev-parse",
+            "--verify",
+            "--quiet",
+            &format!("{rev}^{{commit}}"),
+        ],
+    )
+    .ok()
+    .filter(|hash| !hash.is_empty())
+    .ok_or_else(|| BaseBuildError::MissingRevision {
+        rev: rev.to_string(),
+        detail: if Path::new(&repo.join(".git/shallow")).exists() {
+            "the clone is shallow".to_string()
+        } else {
+            "git rev-parse does not know it".to_string()
+        },
+    })
+}
+
+/// Where base builds live: `$CARGO_TARGET_DIR/gate-base`, else `<repo>/target/gate-base`.
+pub fn cache_root(repo: &Path) -> PathBuf {
+    std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .map(|t| if t.is_absolute() { t } else { repo.join(t) })
+        .unwrap_or_else(|| repo.join("target"))
+        .join("gate-base")
+}
+
+/// The binary of `commit`, from the cache or built now; `progress` hears what happens.
+pub fn base_binary(
+    repo: &Path,
+    commit: &str,
+    progress: &mut dyn FnMut(&str),
+) -> Result<BaseBinary, BaseBuildError> {
+    let root = cache_root(repo);
+    let cached = root.join(commit).join("nbody-bench");
+    if cached.is_file() {
+        return Ok(BaseBinary {
+            commit: commit.to_string(),
+            path: cached,
+            built: false,
+            build_s: 0.0,
+        });
+    }
+    let io = |path: &Path| {
+        let path = path.to_path_buf();
+        move |source| BaseBuildError::Io { path, source }
+    };
+    std::fs::create_dir_all(root.join(commit)).map_err(io(&root.join(commit)))?;
+    let worktree = root.join(format!("worktree-{commit}"));
+    let worktree_error = |detail: String| BaseBuildError::Worktree {
+        commit: commit.to_string(),
+        detail,
+    };
+    // A worktree left by an interrupted build is stale: forget it and start again.
+    let _ = git(
+        repo,
+        &["worktree", "remove", "--force", &worktree.to_string_lossy()],
+    );
+    let _ = std::fs::remove_dir_all(&worktree);
+    let _ = git(repo, &["worktree", "prune"]);
+    git(
+        repo,
+        &[
+            "worktree",
+            "add",
+            "--detach",
+            "--force",
+            &worktree.to_string_lossy(),
+            commit,
+        ],
+    )
+    .map_err(worktree_error)?;
+
+    progress(&format!(
+        "building the base revision {} in {} (cached for later runs)",
+        &commit[..commit.len().min(12)],
+        worktree.display()
+    ));
+    let started = std::time::Instant::now();
+    let log = root.join(commit).join("build.log");
+    let result = build(&worktree, &root.join("target"), &log);
+    let _ = git(
+        repo,
+        &["worktree", "remove", "--force", &worktree.to_string_lossy()],
+    );
+    let _ = std::fs::remove_dir_all(&worktree);
+    let built = result.map_err(|tail| BaseBuildError::Build {
+        commit: commit.to_string(),
+        log: log.clone(),
+        tail,
+    })?;
+    // Copy, then rename: a cached binary is always whole.
+    let partial = root.join(commit).join(".nbody-bench.partial");
+    std::fs::copy(&built, &partial).map_err(io(&partial))?;
+    std::fs::rename(&partial, &cached).map_err(io(&cached))?;
+    Ok(BaseBinary {
+        commit: commit.to_string(),
+        path: cached,
+        built: true,
+        build_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// `cargo build --release` of the checkout in `dir` into `target`, output to `log`; the
+/// binary's path, or the last lines of the log.
+fn build(dir: &Path, target: &Path, log: &Path) -> Result<PathBuf, String> {
+    let file =
+        std::fs::File::create(log).map_err(|e| format!("cannot create {}: {e}", log.display()))?;
+    let err_file = file
+        .try_clone()
+        .map_err(|e| format!("cannot write {}: {e}", log.display()))?;
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let status = Command::new(cargo)
+        .args(["build", "--release", "--bin", "nbody-bench"])
+        .current_dir(dir)
+        .env("CARGO_TARGET_DIR", target)
+        .stdout(file)
+        .stderr(err_file)
+        .status()
+        .map_err(|e| format!("cargo cannot be started: {e}"))?;
+    let binary = target.join("release").join("nbody-bench");
+    if status.success() && binary.is_file() {
+        Ok(binary)
+    } else {
+        let text = std::fs::read_to_string(log).unwrap_or_default();
+        let lines: Vec<&str> = text.lines().collect();
+        Err(lines[lines.len().saturating_sub(15)..].join("\n"))
+    }
+}
