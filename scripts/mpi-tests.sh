@@ -5,8 +5,8 @@
 # particles migrating beyond the neighbouring regions and rebalancing; then the error paths,
 # the JSON outputs, `mpi-bench` and a sweep under the launcher.
 #
-# Open MPI and libclang (for the bindings) are installed with apt when missing and this runs as
-# root; otherwise it stops with the command to run. It never skips a test.
+# Open MPI and libclang (for the bindings) are installed by scripts/install-mpi.sh. The unit and
+# CLI tests built with the feature run in scripts/test.sh. It never skips a test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -15,36 +15,9 @@ fail() {
     exit 1
 }
 
-# libclang and its headers, which the bindings generator of mpi-sys needs at build time.
-have_libclang() {
-    if command -v dpkg >/dev/null 2>&1; then
-        dpkg -s libclang-dev >/dev/null 2>&1
-    else
-        ldconfig -p 2>/dev/null | grep -q libclang
-    fi
-}
-
-have_mpi() {
-    command -v mpirun >/dev/null 2>&1 &&
-        { pkg-config --exists ompi 2>/dev/null || pkg-config --exists mpich 2>/dev/null; } &&
-        have_libclang
-}
-
-if ! have_mpi; then
-    packages="libopenmpi-dev openmpi-bin libclang-dev"
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "installing $packages"
-        apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq $packages >/dev/null
-    else
-        echo "MPI is not installed. Install it, e.g.: sudo apt-get install -y $packages" >&2
-        exit 2
-    fi
-    have_mpi || fail "MPI or libclang still missing after installing $packages"
-fi
-
-cargo clippy --all-targets --release --features mpi -- -D warnings
-cargo test --release --features mpi --lib --test mpi_cli
+scripts/install-mpi.sh
+# scripts/test.sh has built the tests and this binary with the feature already (then this is
+# a no-op); run alone, this builds it.
 cargo build --release --features mpi
 BIN=target/release/nbody-bench
 MPIRUN=(mpirun --oversubscribe --bind-to none)
