@@ -8,6 +8,9 @@ use crate::experiment::runner::{SweepOptions, run_sweep};
 
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let (config, text) = SweepConfig::load(&args.config)?;
+    if let Some(code) = super::dry_run::before_sweep(&args, &config)? {
+        return Ok(code);
+    }
     let options = SweepOptions {
         resume: args.resume,
         force: args.force,
