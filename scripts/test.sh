@@ -34,9 +34,16 @@ scripts/ci-gate.sh
 step "Open MPI, lints and every test with the mpi feature"
 scripts/install-mpi.sh
 cargo clippy --all-targets --release --features mpi -- -D warnings
-# Everything but the timing tests, then those alone on one test thread (tests/suite/main.rs).
-cargo test --release --features mpi --all-targets -- --skip gate::
-cargo test --release --features mpi --test suite gate:: -- --test-threads=1
+# One build of every test target (unit tests, the integration suite, the benches in test
+# mode, the examples, the binary), then the runs: the unit tests; the suite but its timing
+# tests; those alone on one test thread (tests/suite/main.rs); each bench once (criterion's
+# test mode, so that they cannot rot).
+features=(--release --features mpi)
+cargo test "${features[@]}" --all-targets --no-run
+cargo test "${features[@]}" --lib --bins
+cargo test "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
+cargo test "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
+cargo test "${features[@]}" --benches
 
 step "the MPI drivers under mpirun"
 scripts/mpi-tests.sh

@@ -308,6 +308,14 @@ pub struct SweepArgs {
     /// Skip the machine calibration at the start and end (faster; speedups then have no ceiling).
     #[arg(long)]
     pub no_calibration: bool,
+    /// Print the planned cases and the estimated wall time (from a short probe of each kernel),
+    /// then exit without measuring or writing anything.
+    #[arg(long)]
+    pub dry_run: bool,
+    /// Start a sweep estimated at more than an hour without asking; without a terminal (CI)
+    /// such a sweep needs this flag or a `measure.budget_s`.
+    #[arg(long)]
+    pub yes: bool,
 }
 
 /// A scaling model the `fit` command fits.

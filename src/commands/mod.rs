@@ -1,6 +1,7 @@
 //! The subcommands. Each returns the process exit code or an error (reported with exit code 2).
 
 mod analyze;
+mod dry_run;
 mod fit;
 mod fit_tables;
 mod gate;

@@ -11,7 +11,29 @@ use std::path::{Path, PathBuf};
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let config_path = locate::find_config(&args.config)?;
     let (config, text) = SweepConfig::load(&config_path)?;
-    let (resume, run_dir) = where_to_write(&args, &config)?;
+    let target = where_to_write(&args, &config)?;
+    let existing = match &target {
+        Target::Out => Some(crate::experiment::runner::results_path(
+            &config,
+            args.out.as_deref(),
+        )),
+        Target::Existing(dir) => Some(dir.join("results.json")),
+        Target::New => None,
+    };
+    if let Some(code) = super::dry_run::before_sweep(&args, &config, existing.as_deref())? {
+        return Ok(code);
+    }
+    let (resume, run_dir) = match target {
+        Target::Out => (args.resume.is_some(), None),
+        Target::Existing(dir) => {
+            eprintln!("resuming {}", dir.display());
+            (true, Some(dir))
+        }
+        Target::New => {
+            let dir = locate::new_run_dir(&config.out, &config.name, &utc_now())?;
+            (false, Some(dir))
+        }
+    };
     let options = SweepOptions {
         resume,
         force: args.force,
@@ -71,15 +93,22 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     Ok(0)
 }
 
-/// Whether to resume, and the run directory to write in (`None`: `<out>/<name>/`, with --out).
+/// Where a sweep writes.
+enum Target {
+    /// `<out>/<name>/results.json`, with --out (resuming it with --resume).
+    Out,
+    /// The run directory to resume.
+    Existing(PathBuf),
+    /// A new run directory `<out>/runs/<name>/<UTC time>/`, claimed when the sweep starts.
+    New,
+}
+
+/// Where to write, without touching anything yet.
 ///
 /// Without --out every sweep gets a new run directory, so the same command can be typed again
 /// and never touches the committed reference results; `--resume` continues the latest
 /// unfinished run of the config, `--resume RUN` the one given.
-fn where_to_write(
-    args: &SweepArgs,
-    config: &SweepConfig,
-) -> anyhow::Result<(bool, Option<PathBuf>)> {
+fn where_to_write(args: &SweepArgs, config: &SweepConfig) -> anyhow::Result<Target> {
     let root = &config.out;
     match (&args.resume, &args.out) {
         (Some(Some(_)), Some(_)) => anyhow::bail!(
@@ -87,8 +116,7 @@ fn where_to_write(
              resume DIR/{}/",
             config.name
         ),
-        (Some(None), Some(_)) => Ok((true, None)),
-        (None, Some(_)) => Ok((false, None)),
+        (_, Some(_)) => Ok(Target::Out),
         (Some(Some(run)), None) => {
             let dir = if run.is_file() {
                 run.parent().unwrap_or(Path::new(".")).to_path_buf()
@@ -102,13 +130,12 @@ fn where_to_write(
                     locate::runs_dir(root, &config.name).display()
                 );
             }
-            Ok((true, Some(dir)))
+            Ok(Target::Existing(dir))
         }
-        (Some(None), None) => {
-            let dir = locate::latest_unfinished(root, &config.name)?;
-            eprintln!("resuming {}", dir.display());
-            Ok((true, Some(dir)))
-        }
+        (Some(None), None) => Ok(Target::Existing(locate::latest_unfinished(
+            root,
+            &config.name,
+        )?)),
         (None, None) => {
             if let Ok(dir) = locate::latest_unfinished(root, &config.name) {
                 eprintln!(
@@ -116,8 +143,7 @@ fn where_to_write(
                     dir.display()
                 );
             }
-            let dir = locate::new_run_dir(root, &config.name, &utc_now())?;
-            Ok((false, Some(dir)))
+            Ok(Target::New)
         }
     }
 }

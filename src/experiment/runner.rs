@@ -232,7 +232,7 @@ pub fn run_sweep<C: Clock>(
 }
 
 /// The share of `samples` taken in `round`: equal parts, the remainder in the first rounds.
-fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
+pub(super) fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
     samples / rounds + usize::from(round < samples % rounds)
 }
 

@@ -80,6 +80,24 @@ impl KernelKind {
         }
     }
 
+    /// How the kernel's work per step grows with n (the README's pair-work column), so that a
+    /// time measured at one n can be carried to another (the sweep's estimate, `sweep --dry-run`).
+    pub fn complexity(self) -> Complexity {
+        match self {
+            KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => {
+                Complexity::Quadratic
+            }
+            KernelKind::CellList => Complexity::Linear,
+            KernelKind::Octree => Complexity::NLogN,
+        }
+    }
+
+    /// Whether the force computation is split over the threads of the rayon pool it runs in
+    /// (above [`MIN_PARALLEL_PAIRS`]); the symmetric kernel runs on one thread whatever the pool.
+    pub fn uses_threads(self) -> bool {
+        !matches!(self, KernelKind::Symmetric)
+    }
+
     /// Builds the kernel for `law`, or explains which combinations exist.
     pub fn build<T: Real, L: PairLaw<T>, const D: usize>(
         self,
@@ -101,6 +119,30 @@ impl KernelKind {
             KernelKind::CellList => Box::new(CellList::new(law)?),
             KernelKind::Octree => Box::new(Octree::new(law, params.theta, params.leaf_size)),
         })
+    }
+}
+
+/// A kernel's complexity class in n: how its work per step grows with the particle count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Complexity {
+    /// O(n): the cell list at fixed density.
+    Linear,
+    /// O(n log n): the Barnes-Hut tree.
+    NLogN,
+    /// O(n²): every pair.
+    Quadratic,
+}
+
+impl Complexity {
+    /// Work at `to` particles over work at `from` (counts below 2 count as 2, so that
+    /// n log n never divides by zero).
+    pub fn ratio(self, from: usize, to: usize) -> f64 {
+        let (a, b) = (from.max(2) as f64, to.max(2) as f64);
+        match self {
+            Complexity::Linear => b / a,
+            Complexity::NLogN => (b * b.ln()) / (a * a.ln()),
+            Complexity::Quadratic => (b / a) * (b / a),
+        }
     }
 }
 

@@ -2,14 +2,15 @@
 //! library's generic kernels are compiled into one test executable instead of one per file
 //! (that made most of the test build's time).
 //!
-//! The modules that time things (`gate`) are meant to run alone: `scripts/test.sh` runs the
-//! suite without them, then them with one test thread, so no other test loads the CPUs
-//! during their sweeps.
+//! The modules that time things (`gate`, `dry_run`) are meant to run alone: `scripts/test.sh`
+//! runs the suite without them, then them with one test thread, so no other test loads the
+//! CPUs during their sweeps.
 
 mod analyze;
 mod cli;
 mod config_corpus;
 mod conservation;
+mod dry_run;
 mod fit_cli;
 mod gate;
 mod invariants;

@@ -113,11 +113,17 @@ rounds = 2
 min_sample_s = 0.0
 "#;
 
-#[test]
-fn configs_are_found_by_bare_name() {
+/// A directory holding `configs/tiny.toml`.
+fn with_tiny_config() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
     std::fs::create_dir(dir.path().join("configs")).unwrap();
     std::fs::write(dir.path().join("configs/tiny.toml"), TINY).unwrap();
+    dir
+}
+
+#[test]
+fn configs_are_found_by_bare_name() {
+    let dir = with_tiny_config();
     for name in ["tiny", "tiny.toml", "configs/tiny.toml"] {
         let o = bin(dir.path(), &["sweep", "--config", name, "--no-calibration"]);
         assert!(o.status.success(), "{name}: {}", text(&o.stderr));
@@ -129,10 +135,21 @@ fn configs_are_found_by_bare_name() {
 }
 
 #[test]
+fn a_dry_run_creates_no_run_directory() {
+    let dir = with_tiny_config();
+    let o = bin(dir.path(), &["sweep", "--config", "tiny", "--dry-run"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stdout).contains("a new run directory results/runs/tiny/"),
+        "{}",
+        text(&o.stdout)
+    );
+    assert!(!dir.path().join("results").exists(), "nothing written");
+}
+
+#[test]
 fn a_missing_config_lists_the_places_looked_and_the_configs() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::create_dir(dir.path().join("configs")).unwrap();
-    std::fs::write(dir.path().join("configs/tiny.toml"), TINY).unwrap();
+    let dir = with_tiny_config();
     let o = bin(dir.path(), &["sweep", "--config", "strong"]);
     assert_eq!(o.status.code(), Some(2));
     let err = text(&o.stderr);
@@ -173,9 +190,7 @@ fn no_error_repeats_its_cause() {
 
 #[test]
 fn resume_continues_the_latest_unfinished_run() {
-    let dir = tempfile::tempdir().unwrap();
-    std::fs::create_dir(dir.path().join("configs")).unwrap();
-    std::fs::write(dir.path().join("configs/tiny.toml"), TINY).unwrap();
+    let dir = with_tiny_config();
     let o = bin(dir.path(), &["sweep", "--config", "tiny", "--resume"]);
     assert_eq!(o.status.code(), Some(2));
     assert!(

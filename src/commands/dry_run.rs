@@ -1,0 +1,185 @@
+//! What `sweep` does before it measures anything: `--dry-run` prints the planned cases and the
+//! estimated wall time and stops, and a real sweep estimated at more than an hour without a
+//! time budget asks first (or, without a terminal, refuses unless `--yes` is given). Nothing
+//! here writes a file or creates a directory.
+
+use super::fmt_ns;
+use crate::cli::SweepArgs;
+use crate::experiment::config::SweepConfig;
+use crate::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed, fmt_duration};
+use crate::experiment::plan::cases;
+use crate::experiment::results::ResultsFile;
+use std::io::{BufRead, IsTerminal, Write};
+use std::path::Path;
+
+/// A sweep estimated above this many seconds (an hour) needs `--yes` or a `measure.budget_s`.
+pub const LONG_SWEEP_S: f64 = 3600.0;
+
+/// Runs the dry run or the guard. `path` is the results file the sweep would continue or
+/// overwrite (`None`: a new run directory). `Some(code)`: stop with this exit code; `None`: go
+/// on and measure.
+pub fn before_sweep(
+    args: &SweepArgs,
+    config: &SweepConfig,
+    path: Option<&Path>,
+) -> anyhow::Result<Option<i32>> {
+    if args.yes && !args.dry_run {
+        // Nothing to ask, so nothing to estimate.
+        return Ok(None);
+    }
+    let exists = path.is_some_and(Path::exists);
+    let refused = (exists && args.resume.is_none() && !args.fresh)
+        || (config.mpi.is_some() && !cfg!(feature = "mpi"));
+    if !args.dry_run && refused {
+        // The runner refuses this sweep with its own message; no need to estimate it.
+        return Ok(None);
+    }
+    // With --resume, only the rounds the file does not hold yet are left to run.
+    let done = match (args.resume.is_some(), path) {
+        (true, Some(path)) => ResultsFile::load(path)
+            .ok()
+            .map(done_in)
+            .unwrap_or_default(),
+        _ => Done::default(),
+    };
+    let planned = cases(config);
+    let probed = estimate::probe(config, &planned)?;
+    let calibrate = !args.no_calibration;
+    let logical = crate::run::logical_cpus();
+    let est = estimate::estimate(config, &probed.cases, &done, calibrate, logical);
+    if args.dry_run {
+        print_plan(args, config, &est, &probed, logical, path);
+        return Ok(Some(0));
+    }
+    eprintln!(
+        "estimated wall time: {} (probe took {:.2} s; `--dry-run` lists the cases)",
+        fmt_duration(est.total_s),
+        probed.seconds
+    );
+    if est.total_s <= LONG_SWEEP_S || config.measure.budget_s > 0.0 || args.yes {
+        return Ok(None);
+    }
+    let mut longest: Vec<_> = est.cases.iter().collect();
+    longest.sort_by(|a, b| b.wall_s.total_cmp(&a.wall_s));
+    for c in longest.iter().take(3) {
+        eprintln!("  {:<52} {}", c.case.key(), fmt_duration(c.wall_s));
+    }
+    if std::io::stdin().is_terminal() {
+        eprint!(
+            "sweep `{}` is estimated at {}, more than an hour; continue? [y/N] ",
+            config.name,
+            fmt_duration(est.total_s)
+        );
+        std::io::stderr().flush()?;
+        let mut answer = String::new();
+        std::io::stdin().lock().read_line(&mut answer)?;
+        if matches!(answer.trim().to_ascii_lowercase().as_str(), "y" | "yes") {
+            return Ok(None);
+        }
+        anyhow::bail!("sweep not started; pass --yes to start it without the question");
+    }
+    anyhow::bail!(
+        "sweep `{}` is estimated at {} (estimate_s: {:.0}), more than an hour, and \
+         measure.budget_s is 0; pass --yes to start it anyway, or set measure.budget_s in {} to \
+         stop starting cases after that many seconds (`--resume` continues later)",
+        config.name,
+        fmt_duration(est.total_s),
+        est.total_s,
+        args.config.display()
+    )
+}
+
+/// The rounds already measured in a results file.
+fn done_in(results: ResultsFile) -> Done {
+    Done {
+        rounds: results
+            .cases
+            .iter()
+            .map(|c| (c.key.clone(), c.rounds_done))
+            .collect(),
+        calibrated: results.calibration.start.is_some(),
+    }
+}
+
+fn print_plan(
+    args: &SweepArgs,
+    config: &SweepConfig,
+    est: &Estimate,
+    probed: &Probed,
+    logical: usize,
+    path: Option<&Path>,
+) {
+    let m = &config.measure;
+    println!(
+        "dry run of sweep `{}` ({}): {} case{}, {} rounds of {} samples in all; nothing is measured or written",
+        config.name,
+        args.config.display(),
+        est.cases.len(),
+        if est.cases.len() == 1 { "" } else { "s" },
+        m.rounds,
+        m.samples
+    );
+    println!(
+        "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
+        "case", "n", "p", "ranks", "theta", "rounds", "samples", "step (est.)", "case (est.)"
+    );
+    for c in &est.cases {
+        let theta = c.case.theta.map_or("-".to_string(), |t| t.to_string());
+        println!(
+            "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
+            c.case.key(),
+            c.case.n,
+            c.case.threads,
+            c.case.ranks,
+            theta,
+            c.rounds,
+            c.samples,
+            fmt_ns(c.step_s * 1e9),
+            fmt_duration(c.wall_s)
+        );
+    }
+    let cases_s = est.total_s - est.calibration_s;
+    println!(
+        "\nprobe took {:.2} s ({} kernel set-up{} on one thread at n <= {PROBE_MAX_N}, scaled to \
+         each case's n by the kernel's complexity class and to its threads by +{:.1} per extra \
+         thread up to {logical} logical CPUs)",
+        probed.seconds,
+        probed.setups,
+        if probed.setups == 1 { "" } else { "s" },
+        estimate::EXTRA_THREAD_GAIN
+    );
+    println!(
+        "estimated wall time: {} (cases {}, calibration {})",
+        fmt_duration(est.total_s),
+        fmt_duration(cases_s),
+        fmt_duration(est.calibration_s)
+    );
+    if let (Some(_), Some(path)) = (&args.resume, path) {
+        println!(
+            "(--resume: only the rounds {} does not hold yet)",
+            path.display()
+        );
+    }
+    if m.budget_s > 0.0 && cases_s > m.budget_s {
+        println!(
+            "measure.budget_s = {}: the sweep stops starting cases after that; --resume continues",
+            m.budget_s
+        );
+    } else if m.budget_s == 0.0 && est.total_s > LONG_SWEEP_S {
+        println!(
+            "more than an hour: a real run asks to confirm, or needs --yes without a terminal"
+        );
+    }
+    match path {
+        Some(path) if path.exists() && args.resume.is_none() && !args.fresh => println!(
+            "{} exists: a real run needs --resume or --fresh",
+            path.display()
+        ),
+        Some(path) => println!("results would go to {}", path.display()),
+        None => println!(
+            "results would go to a new run directory {}/<UTC time>/",
+            crate::experiment::locate::runs_dir(&config.out, &config.name).display()
+        ),
+    }
+    println!("estimate_s: {:.3}", est.total_s);
+}
