@@ -16,10 +16,15 @@ fail() {
 }
 
 scripts/install-mpi.sh
-# scripts/test.sh has built the tests and this binary with the feature already (then this is
-# a no-op); run alone, this builds it.
-cargo build --release --features mpi
-BIN=target/release/nbody-bench
+# scripts/test.sh passes the binary its `cargo test --features mpi` built (NBODY_BENCH_BIN): a
+# `cargo build` would compile the crate again, since the tests' dev-dependencies change the
+# features of shared dependencies. Run alone, this builds it.
+if [ -n "${NBODY_BENCH_BIN:-}" ]; then
+    BIN=$NBODY_BENCH_BIN
+else
+    cargo build --release --features mpi
+    BIN=target/release/nbody-bench
+fi
 MPIRUN=(mpirun --oversubscribe --bind-to none)
 if [ "$(id -u)" = 0 ]; then
     MPIRUN+=(--allow-run-as-root)

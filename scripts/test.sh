@@ -46,5 +46,5 @@ cargo test "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
 cargo test "${features[@]}" --benches
 
 step "the MPI drivers under mpirun"
-scripts/mpi-tests.sh
+NBODY_BENCH_BIN=target/release/nbody-bench scripts/mpi-tests.sh
 step "all checks passed"

@@ -100,12 +100,13 @@ pub struct SystemArgs {
 /// Kernel tuning options.
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
-    /// Barnes-Hut opening angle (octree): a node of side s at distance d is used whole when s/d < theta.
-    #[arg(long, default_value_t = 0.5, value_parser = parse_non_negative, allow_hyphen_values = true)]
-    pub theta: f64,
-    /// Most particles in a tree leaf (octree).
-    #[arg(long, default_value_t = 8, value_parser = parse_count)]
-    pub leaf_size: usize,
+    /// Barnes-Hut opening angle (octree only): a node of side s at distance d is used whole
+    /// when s/d < theta [default: 0.5].
+    #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
+    pub theta: Option<f64>,
+    /// Most particles in a tree leaf (octree only) [default: 8].
+    #[arg(long, value_parser = parse_count)]
+    pub leaf_size: Option<usize>,
     /// Threads in the rayon pool for this run (the environment's RAYON_NUM_THREADS is not used).
     #[arg(long, default_value_t = 1, value_parser = parse_count)]
     pub threads: usize,

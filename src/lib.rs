@@ -6,6 +6,10 @@
 //! [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
 //! [`run`] and [`validate`] (measured runs and force checks), [`output`], and the CLI.
 
+// First, so that its `outln!` and `out!` macros are in scope in every module below.
+#[macro_use]
+pub mod console;
+
 pub mod analysis;
 pub mod boundary;
 pub mod calibrate;

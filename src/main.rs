@@ -5,11 +5,26 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     // clap exits with code 2 on usage errors and 0 for --help/--version.
     let cli = Cli::parse();
-    match nbody_bench::commands::dispatch(cli) {
-        Ok(code) => ExitCode::from(code as u8),
+    // An interrupted command (SIGINT, SIGTERM) leaves no temporary file behind: files are
+    // written under a temporary name and renamed into place, and whatever is half-written when
+    // the signal comes is removed here. Results saved before the signal are whole.
+    let _ = ctrlc::set_handler(|| {
+        nbody_bench::output::remove_temporaries();
+        std::process::exit(130);
+    });
+    let code = match nbody_bench::commands::dispatch(cli) {
+        Ok(code) => code,
         Err(err) => {
             eprintln!("error: {}", nbody_bench::commands::error_chain(&err));
+            2
+        }
+    };
+    // A closed pipe on stdout ends the output quietly; any other failed write is an error.
+    match nbody_bench::console::finish() {
+        Err(why) => {
+            eprintln!("error: {why}");
             ExitCode::from(2)
         }
+        Ok(()) => ExitCode::from(code as u8),
     }
 }

@@ -171,12 +171,13 @@ fn measure<T: Real, const D: usize>(
         Some(t) => Some(Trajectory::start(t, &sim, info.box_side)?),
         None => None,
     };
-    let mut step_ns = Vec::with_capacity(spec.steps as usize);
+    // A histogram, not a vector: memory must not grow with --steps.
+    let mut step_ns = crate::stats::StepHistogram::new();
     let start = Instant::now();
     for _ in 0..spec.steps {
         let t = Instant::now();
         sim.step()?;
-        step_ns.push(t.elapsed().as_nanos() as u64);
+        step_ns.record(t.elapsed().as_nanos() as u64);
         if let Some(tr) = trajectory
             .as_mut()
             .filter(|tr| sim.step.is_multiple_of(tr.every))
@@ -194,7 +195,12 @@ fn measure<T: Real, const D: usize>(
             energy: e1.total(),
         });
     }
-    if let Some(tr) = trajectory {
+    if let Some(mut tr) = trajectory {
+        // The final state is always in the trajectory, also when --steps is not a multiple of
+        // --every.
+        if !sim.step.is_multiple_of(tr.every) {
+            tr.frame(&sim)?;
+        }
         tr.file.commit()?;
     }
     if let Some(path) = &spec.dump_state {
@@ -211,8 +217,8 @@ fn measure<T: Real, const D: usize>(
             dump::state_dump(&header, &sim.state, &sim.forces).as_bytes(),
         )?;
     }
-    let step_sum_s = step_ns.iter().sum::<u64>() as f64 * 1e-9;
-    let per_step_ns = StepPercentiles::of(&step_ns).unwrap_or_default();
+    let step_sum_s = step_ns.sum_s();
+    let per_step_ns = step_ns.percentiles().unwrap_or_default();
     let steps = sim.step.max(1) as f64;
     Ok(RunOutcome {
         schema: RUN_SCHEMA,

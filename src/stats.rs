@@ -33,6 +33,58 @@ impl StepPercentiles {
     }
 }
 
+impl StepPercentiles {
+    /// Percentiles of an HDR histogram (3 significant digits); `None` when it is empty. The
+    /// one definition `run` and `sweep` share, so both give the same p99 for the same steps.
+    pub fn of_histogram(h: &hdrhistogram::Histogram<u64>) -> Option<Self> {
+        (!h.is_empty()).then(|| StepPercentiles {
+            min: h.min(),
+            p50: h.value_at_quantile(0.5),
+            p90: h.value_at_quantile(0.9),
+            p99: h.value_at_quantile(0.99),
+            max: h.max(),
+            mean: h.mean(),
+        })
+    }
+}
+
+/// Step times as a histogram: memory that does not grow with the number of steps.
+pub struct StepHistogram {
+    hist: hdrhistogram::Histogram<u64>,
+    sum_ns: u128,
+}
+
+impl Default for StepHistogram {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl StepHistogram {
+    /// From 1 ns to an hour, 3 significant digits (values beyond are clamped, not dropped).
+    pub fn new() -> Self {
+        StepHistogram {
+            hist: hdrhistogram::Histogram::new_with_bounds(1, 3_600_000_000_000, 3)
+                .expect("valid histogram bounds"),
+            sum_ns: 0,
+        }
+    }
+
+    pub fn record(&mut self, ns: u64) {
+        self.hist.saturating_record(ns.max(1));
+        self.sum_ns += u128::from(ns);
+    }
+
+    /// Sum of the recorded step times, seconds.
+    pub fn sum_s(&self) -> f64 {
+        self.sum_ns as f64 * 1e-9
+    }
+
+    pub fn percentiles(&self) -> Option<StepPercentiles> {
+        StepPercentiles::of_histogram(&self.hist)
+    }
+}
+
 /// Median of a slice of floats (NaN-free); `None` when empty.
 pub fn median(values: &[f64]) -> Option<f64> {
     if values.is_empty() {

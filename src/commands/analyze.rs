@@ -30,7 +30,7 @@ pub fn run(results: &ResultsFile, source: &Path, dir: &Path) -> anyhow::Result<W
 }
 
 pub fn print_written(w: &Written) {
-    println!(
+    outln!(
         "analysis: {} and {} with {} figure(s) in {}",
         w.fits.display(),
         w.summary.display(),

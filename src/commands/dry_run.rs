@@ -110,7 +110,7 @@ fn print_plan(
     path: Option<&Path>,
 ) {
     let m = &config.measure;
-    println!(
+    outln!(
         "dry run of sweep `{}` ({}): {} case{}, {} rounds of {} samples in all; nothing is measured or written",
         config.name,
         args.config.display(),
@@ -119,13 +119,21 @@ fn print_plan(
         m.rounds,
         m.samples
     );
-    println!(
+    outln!(
         "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
-        "case", "n", "p", "ranks", "theta", "rounds", "samples", "step (est.)", "case (est.)"
+        "case",
+        "n",
+        "p",
+        "ranks",
+        "theta",
+        "rounds",
+        "samples",
+        "step (est.)",
+        "case (est.)"
     );
     for c in &est.cases {
         let theta = c.case.theta.map_or("-".to_string(), |t| t.to_string());
-        println!(
+        outln!(
             "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
             c.case.key(),
             c.case.n,
@@ -139,7 +147,7 @@ fn print_plan(
         );
     }
     let cases_s = est.total_s - est.calibration_s;
-    println!(
+    outln!(
         "\nprobe took {:.2} s ({} kernel set-up{} on one thread at n <= {PROBE_MAX_N}, scaled to \
          each case's n by the kernel's complexity class and to its threads by +{:.1} per extra \
          thread up to {logical} logical CPUs)",
@@ -148,38 +156,36 @@ fn print_plan(
         if probed.setups == 1 { "" } else { "s" },
         estimate::EXTRA_THREAD_GAIN
     );
-    println!(
+    outln!(
         "estimated wall time: {} (cases {}, calibration {})",
         fmt_duration(est.total_s),
         fmt_duration(cases_s),
         fmt_duration(est.calibration_s)
     );
     if let (Some(_), Some(path)) = (&args.resume, path) {
-        println!(
+        outln!(
             "(--resume: only the rounds {} does not hold yet)",
             path.display()
         );
     }
     if m.budget_s > 0.0 && cases_s > m.budget_s {
-        println!(
+        outln!(
             "measure.budget_s = {}: the sweep stops starting cases after that; --resume continues",
             m.budget_s
         );
     } else if m.budget_s == 0.0 && est.total_s > LONG_SWEEP_S {
-        println!(
-            "more than an hour: a real run asks to confirm, or needs --yes without a terminal"
-        );
+        outln!("more than an hour: a real run asks to confirm, or needs --yes without a terminal");
     }
     match path {
-        Some(path) if path.exists() && args.resume.is_none() && !args.fresh => println!(
+        Some(path) if path.exists() && args.resume.is_none() && !args.fresh => outln!(
             "{} exists: a real run needs --resume or --fresh",
             path.display()
         ),
-        Some(path) => println!("results would go to {}", path.display()),
-        None => println!(
+        Some(path) => outln!("results would go to {}", path.display()),
+        None => outln!(
             "results would go to a new run directory {}/<UTC time>/",
             crate::experiment::locate::runs_dir(&config.out, &config.name).display()
         ),
     }
-    println!("estimate_s: {:.3}", est.total_s);
+    outln!("estimate_s: {:.3}", est.total_s);
 }

@@ -20,6 +20,9 @@ struct FitDocument<'a, T: Serialize> {
 }
 
 pub fn fit(args: FitArgs) -> anyhow::Result<i32> {
+    if let Some(json) = &args.json {
+        crate::output::check_outputs(&[("--json", json)], &[("--csv", &args.csv)])?;
+    }
     let text = std::fs::read_to_string(&args.csv)
         .with_context(|| format!("cannot read {}", args.csv.display()))?;
     let in_csv = |e: csv::CsvError| anyhow::anyhow!("{}: {e}", args.csv.display());
@@ -87,6 +90,6 @@ fn write_json<T: Serialize>(args: &FitArgs, model: &'static str, fit: &T) -> any
     let mut text = serde_json::to_string_pretty(&doc)?;
     text.push('\n');
     crate::output::write_atomic(Path::new(path), text.as_bytes())?;
-    println!("\nfit written to {}", path.display());
+    outln!("\nfit written to {}", path.display());
     Ok(())
 }

@@ -34,7 +34,7 @@ fn r2(r2: Option<f64>) -> String {
 
 fn header(title: &str, file: &str, inputs: &[Input], what: &str, method: CiMethod, n: usize) {
     let samples: usize = inputs.iter().map(|i| i.samples).sum();
-    println!(
+    outln!(
         "{title} fit of {file}: {} {what}, {samples} samples; 95% intervals from {n} bootstrap \
          replicates, {}",
         inputs.len(),
@@ -44,7 +44,7 @@ fn header(title: &str, file: &str, inputs: &[Input], what: &str, method: CiMetho
 
 fn print_notes(notes: &[String]) {
     for n in notes {
-        println!("note: {n}");
+        outln!("note: {n}");
     }
 }
 
@@ -57,9 +57,12 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         fit.ci_method,
         fit.resamples,
     );
-    println!(
+    outln!(
         "\n{:>6} {:>11}  {:<28} {:<28} Karp-Flatt e(p)",
-        "p", "median", "speedup [95% CI]", "efficiency"
+        "p",
+        "median",
+        "speedup [95% CI]",
+        "efficiency"
     );
     for pt in &fit.points {
         let e = fit
@@ -79,10 +82,10 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
             est(&pt.efficiency),
             e
         );
-        println!("{}", line.trim_end());
+        outln!("{}", line.trim_end());
     }
-    println!();
-    println!(
+    outln!();
+    outln!(
         "serial fraction f   {}{}",
         est(&fit.serial_fraction),
         if fit.clamped {
@@ -91,9 +94,9 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
             ""
         }
     );
-    println!("T1                  {}", est_s(&fit.t1));
-    println!("max speedup 1/f     {}", est(&fit.max_speedup));
-    println!(
+    outln!("T1                  {}", est_s(&fit.t1));
+    outln!("max speedup 1/f     {}", est(&fit.max_speedup));
+    outln!(
         "fit of T(p)         r2 {}, SMAPE {:.2}%",
         r2(fit.goodness.r2),
         fit.goodness.smape_percent
@@ -105,7 +108,7 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         .map_or(String::new(), |s| {
             format!(" (slope per doubling of p {})", est(s))
         });
-    println!(
+    outln!(
         "Karp-Flatt trend    {}{slope}: {}",
         trend.verdict.name(),
         trend.meaning
@@ -123,14 +126,14 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         })
         .collect();
     match &fit.overhead.kept {
-        Some(k) => println!(
+        Some(k) => outln!(
             "overhead term       {} kept: c = {} s, f with it {} (leave-one-out SMAPE: {})",
             k.term.name(),
             est(&k.coefficient),
             est(&k.serial_fraction),
             loo.join(", ")
         ),
-        None => println!(
+        None => outln!(
             "overhead terms      none kept (leave-one-out SMAPE: {})",
             loo.join(", ")
         ),
@@ -147,9 +150,12 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
         fit.ci_method,
         fit.resamples,
     );
-    println!(
+    outln!(
         "\n{:>6} {:>11}  {:<28} {:<28} n (work per worker ratio)",
-        "p", "median", "efficiency T1/T(p)", "scaled speedup"
+        "p",
+        "median",
+        "efficiency T1/T(p)",
+        "scaled speedup"
     );
     for (i, input) in fit.inputs.iter().enumerate() {
         let work = fit
@@ -163,10 +169,10 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
             est(&fit.efficiency[i].e),
             est(&fit.scaled_speedup[i].s),
         );
-        println!("{}", line.trim_end());
+        outln!("{}", line.trim_end());
     }
-    println!();
-    println!(
+    outln!();
+    outln!(
         "serial fraction     alpha = {}{}  (S = p - alpha (p - 1))",
         est(&fit.serial_fraction),
         if fit.clamped {
@@ -176,9 +182,9 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
         }
     );
     if let Some(cost) = fit.cost_model {
-        println!("cost model          g(n) = {}", cost.name());
+        outln!("cost model          g(n) = {}", cost.name());
     }
-    println!(
+    outln!(
         "fit of S(p)         r2 {}, SMAPE {:.2}%",
         r2(fit.goodness.r2),
         fit.goodness.smape_percent
@@ -195,18 +201,18 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         fit.ci_method,
         fit.resamples,
     );
-    println!("\n{:>12} {:>11} {:>8}", "n", "median", "samples");
+    outln!("\n{:>12} {:>11} {:>8}", "n", "median", "samples");
     for input in &fit.inputs {
-        println!(
+        outln!(
             "{:>12} {:>11} {:>8}",
             input.x,
             fmt_ns(input.median * 1e9),
             input.samples
         );
     }
-    println!();
-    println!("exponent k          {}  (T = c*n^k)", est(&fit.exponent));
-    println!(
+    outln!();
+    outln!("exponent k          {}  (T = c*n^k)", est(&fit.exponent));
+    outln!(
         "c                   {} s; log-log r2 {}",
         est(&fit.coefficient),
         r2(fit.power_law_goodness.r2)
@@ -217,7 +223,7 @@ pub fn print_power(file: &str, fit: &PowerFit) {
     } else {
         format!("c*{}", sel.class.name())
     };
-    println!(
+    outln!(
         "complexity class    {} ({model}, c = {}); leave-one-out SMAPE {:.2}%, chosen by {:.0}% \
          of bootstrap replicates",
         sel.class.name(),
@@ -225,9 +231,11 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         sel.loo_smape_percent,
         100.0 * sel.support
     );
-    println!(
+    outln!(
         "\n{:<12} {:>16} {:>16}   (leave-one-out SMAPE)",
-        "class", "c*g(n)", "a + c*g(n)"
+        "class",
+        "c*g(n)",
+        "a + c*g(n)"
     );
     for class in ComplexityClass::ALL {
         let cell = |with_constant: bool| {
@@ -244,13 +252,13 @@ pub fn print_power(file: &str, fit: &PowerFit) {
                 })
                 .unwrap_or_else(|| "-".to_string())
         };
-        println!(
+        outln!(
             "{:<12} {:>16} {:>16}",
             class.name(),
             cell(false),
             cell(true)
         );
     }
-    println!("(in parentheses: a negative constant or coefficient; not selectable)");
+    outln!("(in parentheses: a negative constant or coefficient; not selectable)");
     print_notes(&fit.notes);
 }

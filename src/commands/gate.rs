@@ -38,7 +38,7 @@ fn options(args: &GateArgs, default_threshold: f64) -> GateOptions {
 
 /// Prints the report (and keeps it as `gate.json` in `dir`); the exit code.
 fn finish(report: &GateReport, args: &GateArgs, dir: Option<&Path>) -> anyhow::Result<i32> {
-    print!("{}", render(report, args.format));
+    out!("{}", render(report, args.format));
     if let Some(dir) = dir {
         let json = render(report, crate::gate::Format::Json);
         crate::output::write_atomic(&dir.join("gate.json"), json.as_bytes())?;

@@ -2,7 +2,7 @@ use crate::kernels::KernelKind;
 use crate::scenario::ScenarioKind;
 
 pub fn list() -> anyhow::Result<i32> {
-    println!("Kernels:");
+    outln!("Kernels:");
     for k in KernelKind::ALL {
         let what = match k {
             KernelKind::Naive => {
@@ -19,16 +19,20 @@ pub fn list() -> anyhow::Result<i32> {
                 "Barnes-Hut tree (quadtree in 2-D), opening angle --theta; O(n log n)"
             }
         };
-        println!("  {:<11} {what}", k.name());
+        outln!("  {:<11} {what}", k.name());
     }
-    println!("\nScenarios:");
-    println!(
+    outln!("\nScenarios:");
+    outln!(
         "  {:<10} {:>3} {:>9} {:>6} {:>8}  description",
-        "name", "dim", "precision", "n", "dt"
+        "name",
+        "dim",
+        "precision",
+        "n",
+        "dt"
     );
     for s in ScenarioKind::ALL {
         let d = s.defaults();
-        println!(
+        outln!(
             "  {:<10} {:>3} {:>9} {:>6} {:>8}  {}",
             s.name(),
             s.dim(),
@@ -38,9 +42,9 @@ pub fn list() -> anyhow::Result<i32> {
             s.summary()
         );
     }
-    println!("\nSupported combinations (law: kernels):");
+    outln!("\nSupported combinations (law: kernels):");
     for s in ScenarioKind::ALL {
-        println!(
+        outln!(
             "  {:<10} ({}): {}",
             s.name(),
             s.law().name(),

@@ -15,7 +15,7 @@ mod validate;
 pub use run::fmt_ns;
 
 use crate::cli::{Cli, Command, KernelArgs, SystemArgs};
-use crate::kernels::KernelParams;
+use crate::kernels::{KernelKind, KernelParams};
 use crate::scenario::{ScenarioKind, Setup};
 
 /// Runs the parsed command line.
@@ -64,11 +64,29 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
     }
 }
 
-fn kernel_params(args: &KernelArgs) -> KernelParams {
-    KernelParams {
-        theta: args.theta,
-        leaf_size: args.leaf_size,
+/// The kernel parameters given, over the defaults; `--theta` and `--leaf-size` are refused
+/// for a kernel that ignores them (as `--density` is for a scenario without a box), so that
+/// nobody believes a setting that changed nothing.
+fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Result<KernelParams> {
+    if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Octree) {
+        for (flag, given) in [
+            ("--theta", args.theta.is_some()),
+            ("--leaf-size", args.leaf_size.is_some()),
+        ] {
+            if given {
+                anyhow::bail!(
+                    "{flag} applies to the octree kernel only; `{}` does not use it: drop it, or \
+                     pass --kernel octree",
+                    kernel.name()
+                );
+            }
+        }
     }
+    let defaults = KernelParams::default();
+    Ok(KernelParams {
+        theta: args.theta.unwrap_or(defaults.theta),
+        leaf_size: args.leaf_size.unwrap_or(defaults.leaf_size),
+    })
 }
 
 #[cfg(test)]

@@ -58,10 +58,12 @@ mod with_mpi {
         mpi: &MpiOptions,
         dump_state: Option<PathBuf>,
         check: bool,
-    ) -> MpiSpec {
-        MpiSpec {
+    ) -> Result<MpiSpec, MpiError> {
+        let params =
+            kernel_params(kernel_args, Some(kernel)).map_err(|e| MpiError::Usage(e.to_string()))?;
+        Ok(MpiSpec {
             kernel,
-            params: kernel_params(kernel_args),
+            params,
             decomp,
             steps: steps as u64,
             warmup: mpi.warmup_steps as u64,
@@ -72,7 +74,7 @@ mod with_mpi {
             },
             dump_state,
             check,
-        }
+        })
     }
 
     pub fn run(args: RunArgs, decomp: Decomposition) -> anyhow::Result<i32> {
@@ -95,6 +97,10 @@ mod with_mpi {
             args.dump_state.clone(),
             false,
         );
+        let spec = match spec {
+            Ok(spec) => spec,
+            Err(err) => return Ok(fail(rank, err)),
+        };
         let root = match mpi.run(&setup, &spec) {
             Ok(Some(root)) => root,
             Ok(None) => return Ok(0),
@@ -116,7 +122,7 @@ mod with_mpi {
         if let Some(path) = &args.json {
             let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
             crate::output::write_atomic(path, text.as_bytes())?;
-            println!("result written to {}", path.display());
+            outln!("result written to {}", path.display());
         }
         Ok(0)
     }
@@ -132,7 +138,7 @@ mod with_mpi {
                 format!(" on a {} grid", g.join("x"))
             })
             .unwrap_or_default();
-        println!(
+        outln!(
             "mpi               {} ranks, {}{grid}, {} rebalance(s); {}",
             r.ranks,
             r.decomposition.name(),
@@ -142,7 +148,7 @@ mod with_mpi {
         let span = |m: &crate::decomp::stats::MinMeanMax| {
             format!("{:.4}/{:.4}/{:.4}", m.min, m.mean, m.max)
         };
-        println!(
+        outln!(
             "per rank (s)      compute {}  comm {}  wait {}  (min/mean/max); comm {:.1}% of the time, compute imbalance {:.3}",
             span(&red.compute_s),
             span(&red.comm_s),
@@ -150,7 +156,7 @@ mod with_mpi {
             100.0 * red.comm_fraction,
             red.compute_imbalance
         );
-        println!(
+        outln!(
             "traffic per rank  {:.3e} bytes, {:.0} messages sent (mean); particles {:.0}..{:.0}; ghosts received {:.0}, migrated {:.0} (mean)",
             red.bytes_sent.mean,
             red.messages_sent.mean,
@@ -160,9 +166,9 @@ mod with_mpi {
             red.migrated_out.mean
         );
         let s = &r.source_004;
-        println!("Communication time {:8.5} seconds", s.communication_s);
-        println!("Computation time   {:8.5} seconds", s.computation_s);
-        println!("\tEvaluated {} interactions", s.interactions);
+        outln!("Communication time {:8.5} seconds", s.communication_s);
+        outln!("Computation time   {:8.5} seconds", s.computation_s);
+        outln!("\tEvaluated {} interactions", s.interactions);
     }
 
     pub fn check(args: MpiCheckArgs) -> anyhow::Result<i32> {
@@ -178,6 +184,10 @@ mod with_mpi {
             None,
             true,
         );
+        let spec = match spec {
+            Ok(spec) => spec,
+            Err(err) => return Ok(fail(rank, err)),
+        };
         let root = match mpi.run(&setup, &spec) {
             Ok(Some(root)) => root,
             Ok(None) => return Ok(0),
@@ -193,7 +203,7 @@ mod with_mpi {
             Precision::F32 => 1e-4,
         });
         let o = &root.outcome;
-        println!(
+        outln!(
             "{} / {} / {}: n = {}, {} steps, {} ranks",
             o.scenario,
             o.kernel,
@@ -202,7 +212,7 @@ mod with_mpi {
             args.steps + args.mpi.warmup_steps,
             mpi.size()
         );
-        println!(
+        outln!(
             "particles         {} distributed, {} serial, ids complete: {}, id sum {} (expected {})",
             report.n_distributed,
             report.n_serial,
@@ -210,13 +220,15 @@ mod with_mpi {
             report.id_sum,
             report.id_sum_expected
         );
-        println!(
+        outln!(
             "difference        positions {:.3e} of the box, velocities {:.3e} of the top speed (tolerance {tolerance:.1e})",
-            report.position_error, report.velocity_error
+            report.position_error,
+            report.velocity_error
         );
-        println!(
+        outln!(
             "migration         {} particles changed rank, {} beyond the neighbours",
-            report.migrated, report.far_migrated
+            report.migrated,
+            report.far_migrated
         );
         let (owned, rebalances): (Vec<u64>, u64) = o
             .mpi
@@ -228,31 +240,32 @@ mod with_mpi {
                 )
             })
             .unwrap_or_default();
-        println!("owned at the end  {owned:?}, {rebalances} rebalance(s)");
+        outln!("owned at the end  {owned:?}, {rebalances} rebalance(s)");
         let mut ok = report.passes(tolerance);
         if args.expect_empty_rank && !owned.contains(&0) {
-            println!("FAIL: every rank owns particles (--expect-empty-rank)");
+            outln!("FAIL: every rank owns particles (--expect-empty-rank)");
             ok = false;
         }
         if args.expect_rebalance && rebalances == 0 {
-            println!("FAIL: the boundaries never moved (--expect-rebalance)");
+            outln!("FAIL: the boundaries never moved (--expect-rebalance)");
             ok = false;
         }
         if args.expect_migration && report.migrated == 0 {
-            println!("FAIL: no particle changed rank (--expect-migration)");
+            outln!("FAIL: no particle changed rank (--expect-migration)");
             ok = false;
         }
         if args.expect_far_migration && report.far_migrated == 0 {
-            println!(
+            outln!(
                 "FAIL: no particle moved beyond the neighbouring regions (--expect-far-migration)"
             );
             ok = false;
         }
-        println!("{}", if ok { "MATCH" } else { "MISMATCH" });
+        outln!("{}", if ok { "MATCH" } else { "MISMATCH" });
         Ok(if ok { 0 } else { 1 })
     }
 
     pub fn bench(args: MpiBenchArgs) -> anyhow::Result<i32> {
+        crate::output::check_outputs(&[("--out", &args.out)], &[])?;
         let mut mpi = Mpi::init()?;
         let rank = mpi.rank();
         let options = BenchOptions {
@@ -265,7 +278,7 @@ mod with_mpi {
             Ok(None) => return Ok(0),
             Err(err) => return Ok(fail(rank, err)),
         };
-        println!(
+        outln!(
             "{} ranks on {} ({}), MPI {}{}",
             file.ranks,
             file.host,
@@ -277,14 +290,17 @@ mod with_mpi {
                 ""
             }
         );
-        println!(
+        outln!(
             "{:>10} {:>14} {:>14} {:>18}",
-            "bytes", "ping-pong p50", "one-way GB/s", "allgatherv p50"
+            "bytes",
+            "ping-pong p50",
+            "one-way GB/s",
+            "allgatherv p50"
         );
         for (p, a) in file.ping_pong.points.iter().zip(&file.allgatherv.points) {
             let pp = crate::stats::median(&p.seconds).unwrap_or(0.0);
             let ag = crate::stats::median(&a.seconds).unwrap_or(0.0);
-            println!(
+            outln!(
                 "{:>10} {:>14} {:>14.3} {:>18}",
                 p.bytes,
                 crate::commands::fmt_ns(pp * 1e9),
@@ -298,7 +314,7 @@ mod with_mpi {
         }
         let text = serde_json::to_string_pretty(&file).context("serializing the timings")?;
         crate::output::write_atomic(&args.out, text.as_bytes())?;
-        println!("timings written to {}", args.out.display());
+        outln!("timings written to {}", args.out.display());
         Ok(0)
     }
 }

@@ -4,7 +4,7 @@ use crate::cli::ReportArgs;
 
 pub fn report(args: ReportArgs) -> anyhow::Result<i32> {
     let generated = crate::report::generate(&args.results, &args.out)?;
-    println!(
+    outln!(
         "{}: {} sweeps, {} figures",
         generated.path.display(),
         generated.sweeps,

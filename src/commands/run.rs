@@ -4,13 +4,23 @@ use crate::run::{RunJob, RunOutcome, RunSpec, TrajectorySpec, logical_cpus};
 use anyhow::Context;
 
 pub fn run(args: RunArgs) -> anyhow::Result<i32> {
+    // Every output is checked before the run starts: a result is never lost at the end.
+    let outputs: Vec<(&str, &std::path::Path)> = [
+        ("--json", args.json.as_deref()),
+        ("--trajectory", args.trajectory.as_deref()),
+        ("--dump-state", args.dump_state.as_deref()),
+    ]
+    .into_iter()
+    .filter_map(|(flag, path)| Some((flag, path?)))
+    .collect();
+    crate::output::check_outputs(&outputs, &[])?;
     if let Some(decomp) = args.decomp {
         return super::mpi::run(args, decomp);
     }
     let setup = setup(args.scenario, &args.system);
     let spec = RunSpec {
         kernel: args.kernel,
-        params: kernel_params(&args.kernel_args),
+        params: kernel_params(&args.kernel_args, Some(args.kernel))?,
         steps: args.steps as u64,
         threads: args.kernel_args.threads,
         trajectory: args.trajectory.map(|path| TrajectorySpec {
@@ -32,14 +42,14 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
         crate::output::write_atomic(path, text.as_bytes())?;
-        println!("result written to {}", path.display());
+        outln!("result written to {}", path.display());
     }
     Ok(0)
 }
 
 pub(super) fn print_summary(r: &RunOutcome) {
     let t = &r.timing;
-    println!(
+    outln!(
         "{} / {}: n = {}, {} steps, {} thread{}{}, {}-D {}, seed {}, simd {}",
         r.scenario,
         r.kernel,
@@ -58,28 +68,30 @@ pub(super) fn print_summary(r: &RunOutcome) {
         r.simd
     );
     if r.n < r.n_requested {
-        println!(
+        outln!(
             "note: placed {} of the {} particles requested (--allow-fewer)",
-            r.n, r.n_requested
+            r.n,
+            r.n_requested
         );
     }
     let p = &t.per_step_ns;
-    println!(
+    outln!(
         "time per step     p50 {}  p90 {}  p99 {}  max {}",
         fmt_ns(p.p50 as f64),
         fmt_ns(p.p90 as f64),
         fmt_ns(p.p99 as f64),
         fmt_ns(p.max as f64)
     );
-    println!("per particle-step {}", fmt_ns(t.ns_per_particle_step));
-    println!(
+    outln!("per particle-step {}", fmt_ns(t.ns_per_particle_step));
+    outln!(
         "throughput        {:.3e} particle-steps/s, {:.3e} pair-evaluations/s",
-        r.throughput.particle_steps_per_s, r.throughput.pair_evals_per_s
+        r.throughput.particle_steps_per_s,
+        r.throughput.pair_evals_per_s
     );
     let ph = &t.phases;
     let total = ph.total().max(f64::MIN_POSITIVE);
     let pct = |x: f64| 100.0 * x / total;
-    println!(
+    outln!(
         "phases            force build {:.1}%  interact {:.1}%  integrate {:.1}%  boundary {:.1}%  output {:.1}%",
         pct(ph.force_build),
         pct(ph.force_interact),
@@ -88,29 +100,29 @@ pub(super) fn print_summary(r: &RunOutcome) {
         pct(ph.output)
     );
     let c = &r.counters;
-    print!(
+    out!(
         "work per step     {:.4e} pair checks",
         c.pair_checks_per_step
     );
     let steps = r.steps.max(1) as f64;
     if c.total.nodes_opened > 0 {
-        print!(
+        out!(
             ", {:.4e} nodes opened, {:.4e} accepted",
             c.total.nodes_opened as f64 / steps,
             c.total.nodes_accepted as f64 / steps
         );
     }
     if c.total.cells_visited > 0 {
-        print!(
+        out!(
             ", {:.4e} cells visited",
             c.total.cells_visited as f64 / steps
         );
     }
-    println!(
+    outln!(
         "; {} interacting pairs at the end",
         c.pairs_interacting_final
     );
-    println!(
+    outln!(
         "energy            {:.6e} -> {:.6e}, relative drift {:+.3e}",
         r.energy.initial.total(),
         r.energy.last.total(),

@@ -62,7 +62,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let results = ResultsFile::load(&report.path)?;
     print_table(&results);
     print_speedups(&results);
-    println!(
+    outln!(
         "\n{} cases, {} rounds measured in this run; results in {}",
         report.cases,
         report.rounds_measured,
@@ -80,7 +80,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         ),
     }
     if report.incomplete > 0 {
-        println!(
+        outln!(
             "{} cases are not complete; run `nbody-bench sweep --config {} --resume{}` to finish them",
             report.incomplete,
             args.config.display(),
@@ -149,16 +149,21 @@ fn where_to_write(args: &SweepArgs, config: &SweepConfig) -> anyhow::Result<Targ
 }
 
 fn print_table(results: &ResultsFile) {
-    println!(
+    outln!(
         "{:<52} {:>11} {:>23} {:>11} {:>10} {:>6}",
-        "case", "per step", "95% CI", "ns/p-step", "pairs/s", "sanity"
+        "case",
+        "per step",
+        "95% CI",
+        "ns/p-step",
+        "pairs/s",
+        "sanity"
     );
     for c in &results.cases {
         let Some(s) = &c.summary else {
-            println!("{:<52} {:>11}", c.key, "not measured");
+            outln!("{:<52} {:>11}", c.key, "not measured");
             continue;
         };
-        println!(
+        outln!(
             "{:<52} {:>11} {:>23} {:>11.1} {:>10.2e} {:>6}{}",
             c.key,
             fmt_ns(s.median_s * 1e9),
@@ -223,12 +228,15 @@ fn print_speedups(results: &ResultsFile) {
         ));
     }
     if !lines.is_empty() {
-        println!(
+        outln!(
             "\n{:<52} {:>8} {:>6} {:>6}",
-            "speedup over the same case on 1 thread", "raw", "eff.", "/ceiling"
+            "speedup over the same case on 1 thread",
+            "raw",
+            "eff.",
+            "/ceiling"
         );
         for l in lines {
-            println!("{l}");
+            outln!("{l}");
         }
     }
 }

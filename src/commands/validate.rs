@@ -9,7 +9,16 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         Some(s) => vec![s],
         None => ScenarioKind::ALL.to_vec(),
     };
-    let params = kernel_params(&args.kernel_args);
+    if let Some(dump) = &args.dump {
+        let paths: Vec<PathBuf> = scenarios
+            .iter()
+            .map(|&s| dump_file(dump, scenarios.len(), s))
+            .collect();
+        let outputs: Vec<(&str, &std::path::Path)> =
+            paths.iter().map(|p| ("--dump", p.as_path())).collect();
+        crate::output::check_outputs(&outputs, &[])?;
+    }
+    let params = kernel_params(&args.kernel_args, None)?;
     let mut results: Vec<ScenarioCheck> = Vec::new();
     for &scenario in &scenarios {
         let mut s = setup(scenario, &args.system);
@@ -27,14 +36,10 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         };
         let check = s.dispatch(job)??;
         if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
-            let path = if scenarios.len() > 1 {
-                dump_path(path, scenario)
-            } else {
-                path.clone()
-            };
+            let path = dump_file(path, scenarios.len(), scenario);
             crate::output::write_atomic(&path, text.as_bytes())?;
             if !args.json {
-                println!("forces written to {}", path.display());
+                outln!("forces written to {}", path.display());
             }
         }
         if !args.json {
@@ -52,13 +57,21 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         })
         .collect();
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&results)?);
+        outln!("{}", serde_json::to_string_pretty(&results)?);
     } else if failed.is_empty() {
-        println!("all kernels agree with the reference");
+        outln!("all kernels agree with the reference");
     } else {
-        println!("FAILED: {}", failed.join(", "));
+        outln!("FAILED: {}", failed.join(", "));
     }
     Ok(if failed.is_empty() { 0 } else { 1 })
+}
+
+/// The dump of one scenario: `path` itself, or `path.<scenario>` when several are checked.
+fn dump_file(path: &std::path::Path, scenarios: usize, scenario: ScenarioKind) -> PathBuf {
+    if scenarios == 1 {
+        return path.to_path_buf();
+    }
+    dump_path(path, scenario)
 }
 
 fn dump_path(path: &std::path::Path, scenario: ScenarioKind) -> PathBuf {
@@ -68,16 +81,22 @@ fn dump_path(path: &std::path::Path, scenario: ScenarioKind) -> PathBuf {
 }
 
 fn print_check(c: &ScenarioCheck) {
-    println!(
+    outln!(
         "{}: n = {}, {}, reference = naive in f64, theta = {}",
-        c.scenario, c.n, c.precision, c.theta
+        c.scenario,
+        c.n,
+        c.precision,
+        c.theta
     );
-    println!(
+    outln!(
         "  {:<11} {:>12} {:>12}  {:<6} criterion",
-        "kernel", "max rel err", "median", "result"
+        "kernel",
+        "max rel err",
+        "median",
+        "result"
     );
     for k in &c.kernels {
-        println!(
+        outln!(
             "  {:<11} {:>12.3e} {:>12.3e}  {:<6} {}",
             k.kernel,
             k.max_rel_error,

@@ -38,11 +38,33 @@ pub enum WeakRule {
 }
 
 /// The particle counts: an explicit list or a geometric range.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Counts {
     List(Vec<usize>),
     Range(CountRange),
+}
+
+/// The forms `n` takes, for the message when it has none of them.
+const COUNTS_FORMS: &str = "`n` must be a list of whole numbers, such as n = [1000, 2000], or a \
+    geometric range, such as n = { from = 1000, to = 32000, factor = 2 }";
+
+impl<'de> Deserialize<'de> for Counts {
+    /// As the two forms, with a message that names the key and both forms (serde's own for an
+    /// untagged enum, "data did not match any variant", names neither).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Form {
+            List(Vec<usize>),
+            Range(CountRange),
+        }
+        match Form::deserialize(d) {
+            Ok(Form::List(v)) => Ok(Counts::List(v)),
+            Ok(Form::Range(r)) => Ok(Counts::Range(r)),
+            Err(_) => Err(serde::de::Error::custom(COUNTS_FORMS)),
+        }
+    }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -261,7 +283,10 @@ impl SweepConfig {
             key: key.into(),
             problem,
         };
+        // The name becomes a directory name under the output directory: a plain file name,
+        // never `.`, `..` or a hidden name that would escape or hide from `--out`.
         if self.name.is_empty()
+            || self.name.starts_with('.')
             || !self
                 .name
                 .chars()
@@ -269,7 +294,11 @@ impl SweepConfig {
         {
             return Err(bad(
                 "name",
-                "must be a non-empty name of letters, digits, '-', '_' or '.'".into(),
+                format!(
+                    "is `{}`: it must be a plain file name of letters, digits, '-', '_' and '.', \
+                     not starting with '.'",
+                    self.name
+                ),
             ));
         }
         if self.scenarios.is_empty() {

@@ -100,8 +100,10 @@ pub(crate) fn time(term: Option<OverheadTerm>, abc: [f64; 3], p: f64) -> f64 {
 }
 
 /// Compares plain Amdahl with each overhead model. A term is kept when its leave-one-out SMAPE
-/// is below [`MIN_IMPROVEMENT`] times Amdahl's and its fitted coefficient and parallel part
-/// are positive (an overhead that makes the run faster is not an overhead).
+/// is below [`MIN_IMPROVEMENT`] times Amdahl's, its fitted coefficient and parallel part are
+/// positive (an overhead that makes the run faster is not an overhead) and its serial part is
+/// not negative: the serial fraction `a / (a + b)` must lie in [0, 1], or the term is dropped
+/// (the candidates table still shows its fit).
 pub(crate) fn select(ps: &[f64], times: &[f64]) -> (Vec<OverheadCandidate>, Option<OverheadTerm>) {
     let mut candidates = Vec::new();
     for term in [None, Some(OverheadTerm::Log2P), Some(OverheadTerm::P)] {
@@ -118,7 +120,8 @@ pub(crate) fn select(ps: &[f64], times: &[f64]) -> (Vec<OverheadCandidate>, Opti
         let (Some(term), Some(loo), Some(base)) = (c.term, c.loo_smape_percent, base) else {
             continue;
         };
-        let positive = fit(Some(term), ps, times).is_some_and(|abc| abc[1] > 0.0 && abc[2] > 0.0);
+        let positive = fit(Some(term), ps, times)
+            .is_some_and(|abc| abc[0] >= 0.0 && abc[1] > 0.0 && abc[2] > 0.0);
         if positive
             && loo < MIN_IMPROVEMENT * base - NEGLIGIBLE
             && kept.is_none_or(|(_, best)| loo < best)
@@ -146,6 +149,23 @@ mod tests {
 
         let pure: Vec<f64> = ps.iter().map(|p| 0.1 + 0.9 / p).collect();
         assert_eq!(select(&ps, &pure).1, None);
+    }
+
+    #[test]
+    fn a_term_that_needs_a_negative_serial_part_is_dropped() {
+        // Exactly T = -0.05 + 1/p + 0.02 p: the P term fits perfectly, but with a serial part
+        // below zero, so f = a / (a + b) < 0: not a physical answer, the term is not kept.
+        let ps = [1.0, 2.0, 4.0, 8.0, 16.0, 32.0];
+        let t: Vec<f64> = ps.iter().map(|p| -0.05 + 1.0 / p + 0.02 * p).collect();
+        let abc = fit(Some(OverheadTerm::P), &ps, &t).unwrap();
+        assert!(abc[0] < 0.0, "{abc:?}");
+        let (_, kept) = select(&ps, &t);
+        if let Some(term) = kept {
+            let abc = fit(Some(term), &ps, &t).unwrap();
+            let f = abc[0] / (abc[0] + abc[1]);
+            assert!((0.0..=1.0).contains(&f), "kept {term:?} with f = {f}");
+        }
+        assert_ne!(kept, Some(OverheadTerm::P));
     }
 
     #[test]

@@ -148,7 +148,8 @@ pub fn fit_strong(
         let overhead = match kept {
             Some(term) => {
                 let [a, b, c] = overhead::fit(Some(term), ps, t)?;
-                Some((c, a / (a + b)))
+                // A replicate's serial fraction is a fraction: clamped like Amdahl's.
+                Some((c, clamp_unit(a / (a + b)).0))
             }
             None => None,
         };

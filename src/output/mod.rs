@@ -17,8 +17,116 @@ pub struct WriteError {
     pub source: io::Error,
 }
 
+/// Why an output path cannot be written; found before any work starts.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    #[error("{flag} {path}: is a directory; name a file")]
+    Directory { flag: String, path: PathBuf },
+    #[error(
+        "{flag} {path}: is not a regular file (a device, pipe or socket); results are written \
+         under a temporary name and renamed into place, which would replace it: name a file"
+    )]
+    Special { flag: String, path: PathBuf },
+    #[error("{flag} {path}: its directory {dir} does not exist; create it first")]
+    NoDirectory {
+        flag: String,
+        path: PathBuf,
+        dir: PathBuf,
+    },
+    #[error("{flag} {path}: is also an input of this command ({input}); it would be overwritten")]
+    IsInput {
+        flag: String,
+        path: PathBuf,
+        input: String,
+    },
+    #[error(
+        "{flag} and {other} both name {path}; one output would be lost: give each its own file"
+    )]
+    Twice {
+        flag: String,
+        other: String,
+        path: PathBuf,
+    },
+}
+
+/// The real location of a path: a symbolic link is written through, to the file it points at
+/// (so a link stays a link); a path that does not exist yet is its absolute form.
+fn real(path: &Path) -> PathBuf {
+    if let Ok(p) = fs::canonicalize(path) {
+        return p;
+    }
+    let parent = path.parent().filter(|p| !p.as_os_str().is_empty());
+    let dir = parent.map_or_else(|| fs::canonicalize("."), fs::canonicalize);
+    match (dir, path.file_name()) {
+        (Ok(dir), Some(name)) => dir.join(name),
+        _ => path.to_path_buf(),
+    }
+}
+
+/// Checks every output of a command before it starts working: each names a regular file (or
+/// one to create) in an existing directory, none is one of the command's inputs, no two are the
+/// same. `outputs` and `inputs` are (flag, path) pairs, the flag as the user typed it.
+pub fn check_outputs(
+    outputs: &[(&str, &Path)],
+    inputs: &[(&str, &Path)],
+) -> Result<(), OutputError> {
+    for (i, &(flag, path)) in outputs.iter().enumerate() {
+        let bad = |path: &Path| (flag.to_string(), path.to_path_buf());
+        let target = real(path);
+        if let Ok(meta) = fs::metadata(&target) {
+            let (flag, path) = bad(path);
+            if meta.is_dir() {
+                return Err(OutputError::Directory { flag, path });
+            }
+            if !meta.is_file() {
+                return Err(OutputError::Special { flag, path });
+            }
+        } else if let Some(dir) = target.parent().filter(|d| !d.is_dir()) {
+            let (flag, path) = bad(path);
+            return Err(OutputError::NoDirectory {
+                flag,
+                path,
+                dir: dir.to_path_buf(),
+            });
+        }
+        if let Some(&(input, _)) = inputs.iter().find(|(_, p)| real(p) == target) {
+            let (flag, path) = bad(path);
+            return Err(OutputError::IsInput {
+                flag,
+                path,
+                input: input.to_string(),
+            });
+        }
+        if let Some(&(other, _)) = outputs[..i].iter().find(|(_, p)| real(p) == target) {
+            let (flag, path) = bad(path);
+            return Err(OutputError::Twice {
+                flag,
+                other: other.to_string(),
+                path,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Temporary files being written now, removed by [`remove_temporaries`] when the process is
+/// interrupted (SIGINT, SIGTERM), so that an interrupted run leaves nothing behind.
+static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Removes every temporary file still open; for the interrupt handler.
+pub fn remove_temporaries() {
+    for tmp in temporaries().drain(..) {
+        let _ = fs::remove_file(tmp);
+    }
+}
+
 /// A file written under a temporary name and renamed into place by [`AtomicFile::commit`];
-/// dropped without commit, the temporary file is removed and `path` is untouched.
+/// dropped without commit, or if the commit fails, the temporary file is removed and `path`
+/// is untouched. A symbolic link is written through: the file it points at is replaced.
 pub struct AtomicFile {
     path: PathBuf,
     tmp: PathBuf,
@@ -31,16 +139,27 @@ impl AtomicFile {
             path: path.to_path_buf(),
             source,
         };
-        let name = path
+        if let Err(e) = check_outputs(&[("output", path)], &[]) {
+            return Err(err(io::Error::other(e.to_string())));
+        }
+        let target = real(path);
+        let name = target
             .file_name()
             .ok_or_else(|| err(io::Error::other("not a file name")))?;
         let mut tmp_name = std::ffi::OsString::from(".");
         tmp_name.push(name);
         tmp_name.push(format!(".{}.tmp", std::process::id()));
-        let tmp = path.with_file_name(tmp_name);
-        let file = File::create(&tmp).map_err(err)?;
+        let tmp = target.with_file_name(tmp_name);
+        temporaries().push(tmp.clone());
+        let file = match File::create(&tmp) {
+            Ok(file) => file,
+            Err(e) => {
+                temporaries().retain(|t| *t != tmp);
+                return Err(err(e));
+            }
+        };
         Ok(AtomicFile {
-            path: path.to_path_buf(),
+            path: target,
             tmp,
             out: Some(BufWriter::new(file)),
         })
@@ -61,9 +180,16 @@ impl AtomicFile {
             source,
         };
         let out = self.out.take().expect("writer present until commit");
-        let file = out.into_inner().map_err(|e| err(e.into_error()))?;
-        file.sync_all().map_err(err)?;
-        fs::rename(&self.tmp, &self.path).map_err(err)
+        let result = out
+            .into_inner()
+            .map_err(|e| e.into_error())
+            .and_then(|file| file.sync_all())
+            .and_then(|()| fs::rename(&self.tmp, &self.path));
+        if result.is_err() {
+            let _ = fs::remove_file(&self.tmp);
+        }
+        temporaries().retain(|t| *t != self.tmp);
+        result.map_err(err)
     }
 
     /// Maps an I/O error from writing to this file into a [`WriteError`] naming it.
@@ -79,6 +205,7 @@ impl Drop for AtomicFile {
     fn drop(&mut self) {
         if self.out.is_some() {
             let _ = fs::remove_file(&self.tmp);
+            temporaries().retain(|t| *t != self.tmp);
         }
     }
 }
@@ -110,6 +237,63 @@ mod tests {
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
         write_atomic(&path, b"new").unwrap();
         assert_eq!(fs::read_to_string(&path).unwrap(), "new");
+    }
+
+    #[test]
+    fn outputs_are_checked_before_the_work() {
+        let dir = tempfile::tempdir().unwrap();
+        let input = dir.path().join("in.csv");
+        fs::write(&input, "x").unwrap();
+        let out = dir.path().join("out.json");
+        assert!(check_outputs(&[("--json", &out)], &[("--csv", &input)]).is_ok());
+        let e = check_outputs(&[("--json", dir.path())], &[]).unwrap_err();
+        assert!(e.to_string().contains("is a directory"), "{e}");
+        let e = check_outputs(&[("--json", Path::new("/dev/full"))], &[]).unwrap_err();
+        assert!(e.to_string().contains("not a regular file"), "{e}");
+        let e = check_outputs(&[("--json", &input)], &[("--csv", &input)]).unwrap_err();
+        assert!(e.to_string().contains("also an input"), "{e}");
+        let e = check_outputs(&[("--json", &out), ("--trajectory", &out)], &[]).unwrap_err();
+        assert!(
+            e.to_string().contains("--trajectory and --json both name"),
+            "{e}"
+        );
+        let e = check_outputs(&[("--json", &dir.path().join("no/such.json"))], &[]).unwrap_err();
+        assert!(e.to_string().contains("does not exist"), "{e}");
+    }
+
+    #[test]
+    fn a_failed_commit_leaves_no_temporary_and_links_are_written_through() {
+        let dir = tempfile::tempdir().unwrap();
+        // The rename fails: the target became a non-empty directory after the check.
+        let path = dir.path().join("x.json");
+        let mut f = AtomicFile::create(&path).unwrap();
+        f.writer().write_all(b"partial").unwrap();
+        fs::create_dir(&path).unwrap();
+        fs::write(path.join("inside"), "x").unwrap();
+        assert!(f.commit().is_err());
+        let names: Vec<_> = fs::read_dir(dir.path())
+            .unwrap()
+            .flatten()
+            .map(|e| e.file_name())
+            .collect();
+        assert_eq!(
+            names,
+            vec![std::ffi::OsString::from("x.json")],
+            "no temporary left"
+        );
+        // A symbolic link stays a link; the file it points at gets the contents.
+        let real_file = dir.path().join("real.json");
+        let link = dir.path().join("link.json");
+        fs::write(&real_file, "old").unwrap();
+        std::os::unix::fs::symlink(&real_file, &link).unwrap();
+        write_atomic(&link, b"new").unwrap();
+        assert!(
+            fs::symlink_metadata(&link)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        assert_eq!(fs::read_to_string(&real_file).unwrap(), "new");
     }
 
     #[test]

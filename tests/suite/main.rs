@@ -7,6 +7,7 @@
 //! CPUs during their sweeps.
 
 mod analyze;
+mod bad_input;
 mod cli;
 mod config_corpus;
 mod conservation;
