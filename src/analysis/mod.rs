@@ -141,11 +141,7 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
             path: source.into(),
         });
     }
-    let calibration = results
-        .calibration
-        .start
-        .clone()
-        .or(results.calibration.end.clone());
+    let calibration = results.calibration.for_analysis();
     let complexity: Vec<ComplexityAnalysis> = groups.complexity.iter().map(complexity).collect();
     let crossovers = crossovers(&complexity);
     let strong = groups

@@ -35,6 +35,25 @@ pub struct Calibrations {
     pub end: Option<Calibration>,
 }
 
+impl Calibrations {
+    /// The calibration an analysis reads: the start one (else the end one), with each parallel
+    /// ceiling the larger of the start and end measurements. The ceiling is what the hardware
+    /// can do; another process or the hypervisor taking a core during one measurement only
+    /// lowers it (a start calibration once read 1.01x at two threads between two readings of
+    /// 1.98x), so the larger reading is the better estimate.
+    pub fn for_analysis(&self) -> Option<Calibration> {
+        let mut c = self.start.clone().or_else(|| self.end.clone())?;
+        if let (Some(_), Some(end)) = (&self.start, &self.end) {
+            for r in &mut c.parallel_ceiling {
+                if let Some(e) = end.parallel_ceiling.iter().find(|e| e.threads == r.threads) {
+                    r.ratio = r.ratio.max(e.ratio);
+                }
+            }
+        }
+        Some(c)
+    }
+}
+
 /// Where and how the results were produced (SPEC §3).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metadata {
@@ -380,6 +399,40 @@ pub fn utc_now() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn calibration(two_threads: f64) -> Calibration {
+        serde_json::from_value(serde_json::json!({
+            "cpu_model": "x", "logical_cpus": 2, "simd": "avx512", "fma_gflops_1t": 100.0,
+            "parallel_ceiling": [
+                {"threads": 1, "ratio": 1.0, "oversubscribed": false},
+                {"threads": 2, "ratio": two_threads, "oversubscribed": false}
+            ],
+            "fork_join_us": 30.0, "fork_join_hot_us": 1.0, "fork_join_threads": 2,
+            "memory_bandwidth_gbs": 30.0, "duration_s": 1.0, "background_cpus": 0.0,
+            "warnings": []
+        }))
+        .unwrap()
+    }
+
+    #[test]
+    fn the_analysis_reads_the_larger_ceiling() {
+        let both = Calibrations {
+            start: Some(calibration(1.01)),
+            end: Some(calibration(1.98)),
+        };
+        assert_eq!(both.for_analysis().unwrap().ceiling(2), Some(1.98));
+        let start_only = Calibrations {
+            start: Some(calibration(1.9)),
+            end: None,
+        };
+        assert_eq!(start_only.for_analysis().unwrap().ceiling(2), Some(1.9));
+        let end_only = Calibrations {
+            start: None,
+            end: Some(calibration(1.7)),
+        };
+        assert_eq!(end_only.for_analysis().unwrap().ceiling(2), Some(1.7));
+        assert!(Calibrations::default().for_analysis().is_none());
+    }
 
     #[test]
     fn utc_format() {

@@ -70,7 +70,10 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
              | single-thread FMA throughput | {:.0} GFLOP/s (f32) |\n| hardware parallel ceiling at p = 2 | {} |\n\
              | rayon fork/join (idle / hot workers) | {:.1} µs / {:.1} µs |\n| streaming read bandwidth, one thread | {:.1} GB/s |\n\
              | build | {} profile, {}, target features {} |\n",
-            c.cpu_model,
+            match &c.cpu_signature {
+                Some(sig) => format!("{} ({sig})", c.cpu_model),
+                None => c.cpu_model.clone(),
+            },
             c.logical_cpus,
             c.simd,
             c.fma_gflops_1t,

@@ -18,6 +18,7 @@ mod invariants;
 mod kernel_parts;
 mod kernels_agree;
 mod mpi_cli;
+mod parsers;
 mod report;
 mod runs;
 mod sweep;
