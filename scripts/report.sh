@@ -7,7 +7,7 @@
 #   scripts/report.sh --fresh    measure everything again (old results kept as .bak copies)
 #   scripts/report.sh --report   only regenerate REPORT.md from the committed results
 #
-# About 30 minutes on the reference machine (2 vCPUs). Run it on a quiet machine: the sweeps
+# About 10 minutes on a 2-vCPU AMD EPYC (2026-12-01). Run it on a quiet machine: the sweeps
 # record the background load they saw, and the report shows it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
