@@ -109,6 +109,18 @@ pub fn run_sweep<C: Clock>(
             config: config.name.clone(),
         });
     }
+    // Everything that can be known before the first case is checked before it: a case whose
+    // system cannot be built (a box its precision cannot resolve, too many particles) would
+    // otherwise fail only when its turn comes, after the cases before it ran, and again at
+    // every --resume.
+    for case in cases(config) {
+        case_setup(&case)
+            .validate()
+            .map_err(|source| SweepError::Case {
+                key: case.key(),
+                source: Box::new(source),
+            })?;
+    }
     let path = match &options.run_dir {
         Some(dir) => dir.join("results.json"),
         None => results_path(config, options.out.as_deref()),
@@ -245,11 +257,16 @@ fn measure_case<C: Clock>(
     if let Some(launch) = &config.mpi {
         return Ok(super::launcher::measure_round(launch, case, spec)?);
     }
+    Ok(case_setup(case).dispatch(MeasureJob { case, spec, clock })??)
+}
+
+/// The system a case measures.
+fn case_setup(case: &Case) -> Setup {
     let mut setup = Setup::new(case.scenario);
     setup.n = Some(case.n);
     setup.seed = case.seed;
     setup.precision = case.precision;
-    Ok(setup.dispatch(MeasureJob { case, spec, clock })??)
+    setup
 }
 
 /// Opens the results file for this sweep: a new one, or an existing one to resume.

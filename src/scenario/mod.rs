@@ -184,6 +184,18 @@ pub enum SetupError {
     BadDensity(f64),
     #[error("scenario `{0}` has no density parameter; drop --density")]
     NoDensity(&'static str),
+    #[error(
+        "a box of side {side:.3e} ({n} particles at density {density:e}) is too large for {precision} \
+         positions to resolve the particle size σ = {sigma}: raise --density, lower -n, or use \
+         --precision f64"
+    )]
+    BoxTooLarge {
+        side: f64,
+        n: usize,
+        density: f64,
+        precision: &'static str,
+        sigma: f64,
+    },
     #[error(transparent)]
     Placement(#[from] PlacementError),
 }
@@ -235,6 +247,24 @@ impl Setup {
             }
             if !(rho.is_finite() && rho > 0.0) {
                 return Err(SetupError::BadDensity(rho));
+            }
+        }
+        if let Some(density) = self.density() {
+            // A finite geometry the precision can resolve: positions near the far wall must
+            // still tell apart points σ apart (and the side itself must be finite).
+            let side = (self.n() as f64 / density).sqrt();
+            let epsilon = match self.precision() {
+                Precision::F32 => f32::EPSILON as f64,
+                Precision::F64 => f64::EPSILON,
+            };
+            if !side.is_finite() || side * epsilon * 16.0 > LJ_SIGMA {
+                return Err(SetupError::BoxTooLarge {
+                    side,
+                    n: self.n(),
+                    density,
+                    precision: self.precision().name(),
+                    sigma: LJ_SIGMA,
+                });
             }
         }
         Ok(())

@@ -31,9 +31,12 @@ pub fn spaced_uniform(
 ) -> Result<Vec<[f64; 2]>, PlacementError> {
     let cells = ((side / min_dist).floor() as usize).clamp(1, 1 << 15);
     let cell = side / cells as f64;
-    // Each cell of side ≥ min_dist holds at most a few particles; keep up to 4 per cell.
+    // Each cell of side ≥ min_dist holds at most a few particles; keep up to 4 per cell. Only
+    // the cells that hold a particle are stored: a dilute gas in a huge box has far more cells
+    // than particles (a dense array of them once took gigabytes for 500 particles).
     const SLOTS: usize = 4;
-    let mut grid = vec![u32::MAX; cells * cells * SLOTS];
+    let mut grid: std::collections::HashMap<(usize, usize), [u32; SLOTS]> =
+        std::collections::HashMap::with_capacity(n.min(cells.saturating_mul(cells)));
     let mut pts: Vec<[f64; 2]> = Vec::with_capacity(n);
     let cell_of = |x: f64| ((x / cell) as usize).min(cells - 1);
     let min2 = min_dist * min_dist;
@@ -44,7 +47,10 @@ pub fn spaced_uniform(
             let mut ok = true;
             'check: for gy in cy.saturating_sub(1)..=(cy + 1).min(cells - 1) {
                 for gx in cx.saturating_sub(1)..=(cx + 1).min(cells - 1) {
-                    for &k in &grid[(gy * cells + gx) * SLOTS..][..SLOTS] {
+                    let Some(slots) = grid.get(&(gx, gy)) else {
+                        continue;
+                    };
+                    for &k in slots {
                         if k == u32::MAX {
                             break;
                         }
@@ -59,7 +65,7 @@ pub fn spaced_uniform(
             if !ok {
                 continue;
             }
-            let slots = &mut grid[(cy * cells + cx) * SLOTS..][..SLOTS];
+            let slots = grid.entry((cx, cy)).or_insert([u32::MAX; SLOTS]);
             if let Some(slot) = slots.iter_mut().find(|s| **s == u32::MAX) {
                 *slot = pts.len() as u32;
                 pts.push(p);

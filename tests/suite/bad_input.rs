@@ -325,3 +325,62 @@ fn an_interrupt_leaves_no_temporary_file() {
     let parsed: serde_json::Value = serde_json::from_str(&file).expect("whole JSON");
     assert_eq!(parsed["schema"], "nbody-bench/results/v1");
 }
+
+#[test]
+fn a_box_the_precision_cannot_resolve_is_refused_before_any_work() {
+    let o = bin()
+        .args([
+            "run",
+            "--scenario",
+            "lj-box",
+            "--kernel",
+            "cell-list",
+            "-n",
+            "500",
+        ])
+        .args(["--density", "1e-300"])
+        .output()
+        .unwrap();
+    refused(&o, "too large for f32 positions");
+    // A huge but resolvable box in f64 runs, in little memory: placement keeps only the
+    // occupied cells.
+    let o = bin()
+        .args([
+            "run",
+            "--scenario",
+            "lj-box",
+            "--kernel",
+            "naive",
+            "-n",
+            "500",
+        ])
+        .args(["--density", "1e-6", "--precision", "f64", "--steps", "2"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+}
+
+#[test]
+fn a_sweep_checks_every_case_before_the_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("big.toml");
+    std::fs::write(
+        &config,
+        "name = \"big\"\nstudy = \"cartesian\"\nscenarios = [\"lj-box\"]\nkernels = [\"naive\"]\n\
+         n = [100, 1000000000]\n",
+    )
+    .unwrap();
+    let o = bin()
+        .args(["sweep", "--no-calibration", "--yes", "--config"])
+        .arg(&config)
+        .arg("--out")
+        .arg(dir.path().join("out"))
+        .output()
+        .unwrap();
+    refused(&o, "case lj-box/naive/n=1000000000");
+    assert!(text(&o.stderr).contains("more than this tool handles"));
+    assert!(
+        !dir.path().join("out").exists(),
+        "nothing measured, nothing written"
+    );
+}
