@@ -107,8 +107,9 @@ pub struct KernelArgs {
     /// Most particles in a tree leaf (octree only) [default: 8].
     #[arg(long, value_parser = parse_count)]
     pub leaf_size: Option<usize>,
-    /// Threads in the rayon pool for this run (the environment's RAYON_NUM_THREADS is not used).
-    #[arg(long, default_value_t = 1, value_parser = parse_count)]
+    /// Threads in the rayon pool for this run, at most 1024 (the environment's
+    /// RAYON_NUM_THREADS is not used).
+    #[arg(long, default_value_t = 1, value_parser = parse_threads)]
     pub threads: usize,
 }
 
@@ -254,6 +255,16 @@ fn parse_count(s: &str) -> Result<usize, String> {
         Ok(0) => Err("must be at least 1".into()),
         Ok(v) => Ok(v),
         Err(_) => Err(format!("`{s}` is not a whole number")),
+    }
+}
+
+fn parse_threads(s: &str) -> Result<usize, String> {
+    match parse_count(s)? {
+        t if t > crate::run::MAX_THREADS => Err(format!(
+            "{t} threads is more than {} (each is an OS thread with its own stack)",
+            crate::run::MAX_THREADS
+        )),
+        t => Ok(t),
     }
 }
 

@@ -335,10 +335,18 @@ impl SweepConfig {
                 ));
             }
         }
-        if self.threads.is_empty() || self.threads.contains(&0) {
+        if self.threads.is_empty()
+            || self
+                .threads
+                .iter()
+                .any(|&t| t == 0 || t > crate::run::MAX_THREADS)
+        {
             return Err(bad(
                 "threads",
-                "must be a non-empty list of thread counts >= 1".into(),
+                format!(
+                    "must be a non-empty list of thread counts from 1 to {}",
+                    crate::run::MAX_THREADS
+                ),
             ));
         }
         if self.seeds.is_empty() {

@@ -384,3 +384,35 @@ fn a_sweep_checks_every_case_before_the_first() {
         "nothing measured, nothing written"
     );
 }
+
+#[test]
+fn thread_counts_are_bounded() {
+    let o = bin()
+        .args([
+            "run",
+            "--scenario",
+            "lj-box",
+            "--kernel",
+            "naive",
+            "-n",
+            "50",
+        ])
+        .args(["--threads", "100000"])
+        .output()
+        .unwrap();
+    refused(&o, "more than 1024");
+    let dir = tempfile::tempdir().unwrap();
+    let config = dir.path().join("t.toml");
+    std::fs::write(
+        &config,
+        "name = \"t\"\nstudy = \"cartesian\"\nscenarios = [\"lj-box\"]\nkernels = [\"naive\"]\n\
+         n = [100]\nthreads = [1, 5000]\n",
+    )
+    .unwrap();
+    let o = bin()
+        .args(["sweep", "--config"])
+        .arg(&config)
+        .output()
+        .unwrap();
+    refused(&o, "thread counts from 1 to 1024");
+}
