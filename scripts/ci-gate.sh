@@ -32,8 +32,8 @@ if command -v flock >/dev/null 2>&1; then
 fi
 if [ -n "${GITHUB_STEP_SUMMARY:-}" ]; then
     status=0
-    "${lock[@]}" target/release/nbody-bench gate "${args[@]}" --format markdown \
+    ${lock[@]+"${lock[@]}"} target/release/nbody-bench gate "${args[@]}" --format markdown \
         | tee -a "$GITHUB_STEP_SUMMARY" || status=$?
     exit "$status"
 fi
-exec "${lock[@]}" target/release/nbody-bench gate "${args[@]}"
+exec ${lock[@]+"${lock[@]}"} target/release/nbody-bench gate "${args[@]}"

@@ -8,7 +8,8 @@ have_libclang() {
     if command -v dpkg >/dev/null 2>&1; then
         dpkg -s libclang-dev >/dev/null 2>&1
     else
-        ldconfig -p 2>/dev/null | grep -q libclang
+        # Not grep -q: under pipefail an early exit of grep can fail the pipe (SIGPIPE).
+        ldconfig -p 2>/dev/null | grep libclang >/dev/null
     fi
 }
 

@@ -65,7 +65,7 @@ for ranks in 1 2 3 4; do
     check "$ranks" --scenario lj-box --kernel naive --decomp allgather -n 2001 --steps 20
     check "$ranks" --scenario lj-box --kernel symmetric --decomp allgather -n 2001 --steps 20
     # Spatial decomposition: particles cross rank borders during the run.
-    check "$ranks" --scenario lj-box --kernel cell-list --decomp domain -n 3001 --steps 60 "${migration[@]}"
+    check "$ranks" --scenario lj-box --kernel cell-list --decomp domain -n 3001 --steps 60 ${migration[@]+"${migration[@]}"}
 done
 
 # More kernels and shapes.

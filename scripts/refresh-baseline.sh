@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # Re-measures the CI gate's baseline, results/baseline/ci.json: one configs/ci.toml sweep on
 # this machine, from the committed code. Run it on a quiet machine of the CI machine class
-# (2 vCPU AMD EPYC), after a change that is meant to alter the timings (or ci.toml), then
-# commit the file. Takes about 20 s plus the build.
+# (the CPU model and signature CI reports), after a change that is meant to alter the timings
+# (or ci.toml), then commit the file. Takes about 20 s plus the build.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,7 +17,7 @@ lock=()
 if command -v flock >/dev/null 2>&1; then
     lock=(flock /tmp/nbody-bench.lock)
 fi
-"${lock[@]}" cargo run --release --quiet -- sweep --config configs/ci.toml --out "$out"
+${lock[@]+"${lock[@]}"} cargo run --release --quiet -- sweep --config configs/ci.toml --out "$out"
 mkdir -p results/baseline
 cp "$out/ci/results.json" results/baseline/.ci.json.tmp
 mv results/baseline/.ci.json.tmp results/baseline/ci.json

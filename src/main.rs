@@ -8,10 +8,7 @@ fn main() -> ExitCode {
     // An interrupted command (SIGINT, SIGTERM) leaves no temporary file behind: files are
     // written under a temporary name and renamed into place, and whatever is half-written when
     // the signal comes is removed here. Results saved before the signal are whole.
-    let _ = ctrlc::set_handler(|| {
-        nbody_bench::output::remove_temporaries();
-        std::process::exit(130);
-    });
+    let _ = ctrlc::set_handler(|| nbody_bench::output::remove_temporaries_and_exit(130));
     let code = match nbody_bench::commands::dispatch(cli) {
         Ok(code) => code,
         Err(err) => {

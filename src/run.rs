@@ -276,11 +276,11 @@ fn measure<T: Real, const D: usize>(
     })
 }
 
-/// Logical CPUs available to this process.
 /// Most threads a run's pool may have: far beyond any oversubscription study on the machines
 /// this runs on, and far below what would exhaust memory with thread stacks.
 pub const MAX_THREADS: usize = 1024;
 
+/// Logical CPUs available to this process.
 pub fn logical_cpus() -> usize {
     std::thread::available_parallelism()
         .map(|n| n.get())

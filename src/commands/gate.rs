@@ -13,6 +13,10 @@ use crate::gate::{
 };
 use std::path::{Path, PathBuf};
 
+/// How far the two builds' reference workload may differ (median over all samples) before the
+/// A/B gate stops normalising by it. A/A runs here kept it within 1-2 %.
+const REFERENCE_TOLERANCE: f64 = 0.05;
+
 pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     match &args.current {
         Some(current) => {
@@ -97,16 +101,44 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
     let config = SweepConfig::parse(&config_text, &config_path)?;
     let out = match &args.out {
         Some(dir) => {
+            // What a gate keeps is never overwritten: each run needs its own directory.
+            if let Some(kept) = ["gate.json", "base.json", "current.json", "results.json"]
+                .iter()
+                .map(|f| dir.join(f))
+                .find(|f| f.exists())
+            {
+                anyhow::bail!(
+                    "--out {}: {} is there from an earlier gate run; name a new directory",
+                    dir.display(),
+                    kept.display()
+                );
+            }
             std::fs::create_dir_all(dir)
                 .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
             dir.clone()
         }
         None => locate::new_run_dir(Path::new("results"), "gate", &utc_now())?,
     };
-    let against = match (&args.against, &baseline) {
+    let judged = judge(args, baseline.as_ref(), &config, &config_text, &out);
+    if judged.is_err() {
+        // A gate that failed before measuring leaves no empty run directory behind.
+        let _ = std::fs::remove_dir(&out);
+    }
+    judged
+}
+
+/// Chooses the fast path or A/B, and runs it.
+fn judge(
+    args: &GateArgs,
+    baseline: Option<&ResultsFile>,
+    config: &SweepConfig,
+    config_text: &str,
+    out: &Path,
+) -> anyhow::Result<i32> {
+    let against = match (&args.against, baseline) {
         (Some(rev), _) => rev.clone(),
         (None, Some(b)) => match RunInfo::of(b).machine_class_differs(&this_machine()) {
-            None => return fast_path(args, b, &config, &config_text, &out),
+            None => return fast_path(args, b, config, config_text, out),
             Some(why) => {
                 eprintln!(
                     "gate: the baseline {} comes from another machine class ({why}); measuring \
@@ -119,7 +151,7 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
         },
         (None, None) => unreachable!("a baseline is loaded unless --against is given"),
     };
-    a_b(args, &against, &config, &config_text, &out)
+    a_b(args, &against, config, config_text, out)
 }
 
 /// The baseline file comes from this machine class: sweep this build and compare.
@@ -168,7 +200,8 @@ fn a_b(
         .map_err(|e| anyhow::anyhow!("cannot find this program's binary: {e}"))?;
     say("calibrating the machine...");
     let calibration = crate::calibrate::calibrate(&[1]);
-    let work = out.join("scratch");
+    // Scratch of this process only: nothing else in `out` is removed.
+    let work = out.join(format!(".scratch-{}", std::process::id()));
     let plan = AbPlan {
         config,
         config_text: text,
@@ -184,11 +217,38 @@ fn a_b(
     }
     results.base.save(&out.join("base.json"))?;
     results.current.save(&out.join("current.json"))?;
-    let mut report = compare(
-        &results.base,
-        &results.current,
-        &options(args, AB_THRESHOLD),
-    )?;
+    let mut opts = options(args, AB_THRESHOLD);
+    // Each build times its own copy of the reference workload. If that copy itself got faster
+    // or slower (another compiler, profile or SIMD dispatch), dividing by it would hide or
+    // invent a change of the kernels: then judge raw times, which interleaving keeps fair.
+    let (rb, rc) = (
+        ab::median_reference(&results.base),
+        ab::median_reference(&results.current),
+    );
+    let reference_moved = match (rb, rc) {
+        (Some(b), Some(c)) if b > 0.0 => ((c / b) - 1.0).abs() > REFERENCE_TOLERANCE,
+        _ => false,
+    };
+    if reference_moved && opts.normalization == crate::gate::NormalizationChoice::Auto {
+        opts.normalization = crate::gate::NormalizationChoice::None;
+    }
+    let mut report = compare(&results.base, &results.current, &opts)?;
+    if reference_moved {
+        report.warnings.push(format!(
+            "the reference workload itself takes {:.3}x as long in this build as in the base, \
+             so the builds differ in more than their kernels; the cases are judged on raw \
+             times (both builds measured interleaved)",
+            rc.unwrap_or(0.0) / rb.unwrap_or(1.0)
+        ));
+    }
+    for (file, which) in [(&results.base, "base"), (&results.current, "current")] {
+        if file.metadata.rustc_version != results.current.metadata.rustc_version {
+            report.warnings.push(format!(
+                "the {which} build was compiled by `{}`, this one by `{}`",
+                file.metadata.rustc_version, results.current.metadata.rustc_version
+            ));
+        }
+    }
     // Both builds share the one calibration, so the warning about a baseline measured under
     // more load than the current run does not apply; the load itself is still worth a word.
     report
@@ -214,5 +274,5 @@ fn a_b(
 }
 
 fn short(commit: &str) -> &str {
-    &commit[..commit.len().min(12)]
+    crate::gate::prefix(commit, 12)
 }

@@ -22,7 +22,10 @@ use thiserror::Error;
 pub enum AbError {
     #[error("the A/B gate cannot run config `{name}`: {why}")]
     Unsupported { name: String, why: String },
-    #[error("--rounds must be at least 2 (got {0}): each build needs more than one round")]
+    #[error(
+        "--rounds must be an even number of at least 2 (got {0}): each build must go first as \
+         often as the other"
+    )]
     Rounds(usize),
     #[error(
         "the {side} build failed to measure {key} (round {round}); its output ends with:\n{tail}"
@@ -100,9 +103,12 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
         name: plan.config.name.clone(),
         why: why.to_string(),
     };
-    if plan.rounds < 2 {
+    if plan.rounds < 2 || !plan.rounds.is_multiple_of(2) {
         return Err(AbError::Rounds(plan.rounds));
     }
+    // A base that estimates a sweep's length before starting it (as this build does) is told
+    // not to, like this build, so that neither side does extra work before its samples.
+    let base_takes_yes = takes_yes(&plan.base.path);
     if plan.config.mpi.is_some() {
         return Err(unsupported(
             "it runs cases under MPI; gate a config without [mpi]",
@@ -148,7 +154,7 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
                     .work
                     .join(side.name())
                     .join(format!("case{i}-round{round}"));
-                let file = run_side(plan, side, &text, &dir, &planned[i], round)?;
+                let file = run_side(plan, side, &text, &dir, &planned[i], round, base_takes_yes)?;
                 let slot = side as usize;
                 metadata[slot].get_or_insert_with(|| file.metadata.clone());
                 let record = file
@@ -187,6 +193,24 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
         current: file(current_cases, current_meta),
         measure_s,
     })
+}
+
+/// Whether a binary's `sweep` has the `--yes` flag.
+fn takes_yes(binary: &Path) -> bool {
+    Command::new(binary)
+        .args(["sweep", "--help"])
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains("--yes"))
+}
+
+/// The median of every reference-workload time of a results file, seconds.
+pub fn median_reference(file: &ResultsFile) -> Option<f64> {
+    let all: Vec<f64> = file
+        .cases
+        .iter()
+        .flat_map(|c| c.rounds.iter().flat_map(|r| r.reference_s.iter().copied()))
+        .collect();
+    crate::stats::median(&all)
 }
 
 /// The config text of one case for one round: the config's own text with the lists narrowed
@@ -229,6 +253,7 @@ fn run_side(
     dir: &Path,
     case: &Case,
     round: usize,
+    base_takes_yes: bool,
 ) -> Result<ResultsFile, AbError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -250,16 +275,13 @@ fn run_side(
         .arg(dir)
         .arg("--no-calibration")
         .stdin(std::process::Stdio::null());
-    match side {
+    // A one-case round needs no length estimate (older bases have no such step, nor the flag).
+    if side == Side::Current || base_takes_yes {
+        command.arg("--yes");
+    }
+    if side == Side::Base {
         // The test-only slowdown knob is meant for this build only.
-        Side::Base => {
-            command.env_remove(SLOWDOWN_ENV);
-        }
-        // This build estimates a sweep's length before starting it; a one-case round needs no
-        // estimate (older bases have no such step, nor the flag).
-        Side::Current => {
-            command.arg("--yes");
-        }
+        command.env_remove(SLOWDOWN_ENV);
     }
     let output = command.output().map_err(|e| AbError::Side {
         side: side.name(),

@@ -2,7 +2,8 @@
 //! worktree of its own and cached.
 //!
 //! Layout, under `<target>/gate-base/` (`<target>` is `$CARGO_TARGET_DIR` or the checkout's
-//! `target/`): `<commit>/nbody-bench` is the cached binary of a commit; `target/` is the
+//! `target/`): `<commit>-<toolchain>/nbody-bench` is the cached binary of a commit built by one
+//! toolchain (`rustc -vV` and `RUSTFLAGS`, hashed); `target/` is the
 //! target directory every base build shares (so a second base revision recompiles only what
 //! changed); `worktree-<commit>/` exists only while that commit builds.
 
@@ -115,7 +116,10 @@ pub fn base_binary(
     progress: &mut dyn FnMut(&str),
 ) -> Result<BaseBinary, BaseBuildError> {
     let root = cache_root(repo);
-    let cached = root.join(commit).join("nbody-bench");
+    // One cached binary per commit and toolchain: a compiler upgrade between two gate runs
+    // must not have the old compiler's base measured against the new one's build.
+    let key = cache_key(commit);
+    let cached = root.join(&key).join("nbody-bench");
     if cached.is_file() {
         return Ok(BaseBinary {
             commit: commit.to_string(),
@@ -128,7 +132,7 @@ pub fn base_binary(
         let path = path.to_path_buf();
         move |source| BaseBuildError::Io { path, source }
     };
-    std::fs::create_dir_all(root.join(commit)).map_err(io(&root.join(commit)))?;
+    std::fs::create_dir_all(root.join(&key)).map_err(io(&root.join(&key)))?;
     let worktree = root.join(format!("worktree-{commit}"));
     let worktree_error = |detail: String| BaseBuildError::Worktree {
         commit: commit.to_string(),
@@ -156,11 +160,11 @@ pub fn base_binary(
 
     progress(&format!(
         "building the base revision {} in {} (cached for later runs)",
-        &commit[..commit.len().min(12)],
+        super::prefix(commit, 12),
         worktree.display()
     ));
     let started = std::time::Instant::now();
-    let log = root.join(commit).join("build.log");
+    let log = root.join(&key).join("build.log");
     let result = build(&worktree, &root.join("target"), &log);
     let _ = git(
         repo,
@@ -173,7 +177,7 @@ pub fn base_binary(
         tail,
     })?;
     // Copy, then rename: a cached binary is always whole.
-    let partial = root.join(commit).join(".nbody-bench.partial");
+    let partial = root.join(&key).join(".nbody-bench.partial");
     std::fs::copy(&built, &partial).map_err(io(&partial))?;
     std::fs::rename(&partial, &cached).map_err(io(&cached))?;
     Ok(BaseBinary {
@@ -182,6 +186,28 @@ pub fn base_binary(
         built: true,
         build_s: started.elapsed().as_secs_f64(),
     })
+}
+
+/// The cache directory name of `commit` built by the toolchain at hand.
+pub fn cache_key(commit: &str) -> String {
+    format!("{commit}-{}", toolchain_key())
+}
+
+/// A short hash of what else decides the base binary: `rustc -vV` and `RUSTFLAGS`.
+fn toolchain_key() -> String {
+    let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
+    let version = Command::new(rustc)
+        .arg("-vV")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
+        .unwrap_or_default();
+    let flags = std::env::var("RUSTFLAGS").unwrap_or_default();
+    // FNV-1a: stable across runs and platforms, unlike the standard hasher.
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for b in version.bytes().chain([0]).chain(flags.bytes()) {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+    }
+    format!("{:08x}", h >> 32)
 }
 
 /// `cargo build --release` of the checkout in `dir` into `target`, output to `log`; the

@@ -37,14 +37,21 @@ pub(super) fn check_comparable(
         };
         refuse(error, &mut warnings)?;
     }
-    if b.cpu_signature != c.cpu_signature {
-        let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "not recorded".into());
-        let error = GateError::OtherMachine {
-            what: "CPU signature",
-            baseline: show(&b.cpu_signature),
-            current: show(&c.cpu_signature),
-        };
-        refuse(error, &mut warnings)?;
+    match (&b.cpu_signature, &c.cpu_signature) {
+        (Some(bs), Some(cs)) if bs != cs => {
+            let error = GateError::OtherMachine {
+                what: "CPU signature",
+                baseline: bs.clone(),
+                current: cs.clone(),
+            };
+            refuse(error, &mut warnings)?;
+        }
+        (None, Some(_)) | (Some(_), None) => warnings.push(
+            "one file records no CPU signature (written before it was recorded): the CPU model \
+             matches, but the processor generation cannot be checked"
+                .to_string(),
+        ),
+        _ => {}
     }
     if let (Some(bn), Some(cn)) = (b.logical_cpus, c.logical_cpus)
         && bn != cn
@@ -148,5 +155,12 @@ fn diff_keys(prefix: &str, a: &serde_json::Value, b: &serde_json::Value, out: &m
 
 /// The first 10 characters of a commit hash.
 pub(super) fn short(commit: &str) -> &str {
-    &commit[..commit.len().min(10)]
+    prefix(commit, 10)
+}
+
+/// The first `chars` characters of `text` (a commit read from a file may hold anything).
+pub(crate) fn prefix(text: &str, chars: usize) -> &str {
+    text.char_indices()
+        .nth(chars)
+        .map_or(text, |(i, _)| &text[..i])
 }

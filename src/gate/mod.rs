@@ -24,6 +24,7 @@ mod render;
 #[cfg(test)]
 mod tests;
 
+pub(crate) use checks::prefix;
 pub use compare::compare;
 pub use render::{Format, render};
 
@@ -36,7 +37,7 @@ use thiserror::Error;
 pub const AB_THRESHOLD: f64 = 0.10;
 /// Default threshold against a baseline file measured at another time.
 pub const FILE_THRESHOLD: f64 = 0.25;
-/// Default rounds of every case per build in an A/B run.
+/// Default rounds of every case per build in an A/B run (even: each build goes first as often).
 pub const AB_ROUNDS: usize = 4;
 
 /// Schema of the JSON rendering of a [`GateReport`].

@@ -117,11 +117,15 @@ fn temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     TEMPORARIES.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Removes every temporary file still open; for the interrupt handler.
-pub fn remove_temporaries() {
-    for tmp in temporaries().drain(..) {
+/// Removes every temporary file still open and ends the process with `code`; for the
+/// interrupt handler. The registry stays locked until the end, so that no new temporary can
+/// be created between the clean-up and the exit.
+pub fn remove_temporaries_and_exit(code: i32) -> ! {
+    let mut open = temporaries();
+    for tmp in open.drain(..) {
         let _ = fs::remove_file(tmp);
     }
+    std::process::exit(code)
 }
 
 /// A file written under a temporary name and renamed into place by [`AtomicFile::commit`];

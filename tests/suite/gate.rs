@@ -287,7 +287,9 @@ fn same_tree_repo() -> (tempfile::TempDir, PathBuf) {
     git(dir.path(), &["commit", "-q", "-m", "tiny"]);
     let head = git(dir.path(), &["rev-parse", "HEAD"]);
     let target = dir.path().join("target");
-    let cached = target.join("gate-base").join(&head);
+    let cached = target
+        .join("gate-base")
+        .join(nbody_bench::gate::base_build::cache_key(&head));
     std::fs::create_dir_all(&cached).unwrap();
     std::fs::copy(
         env!("CARGO_BIN_EXE_nbody-bench"),
@@ -297,7 +299,14 @@ fn same_tree_repo() -> (tempfile::TempDir, PathBuf) {
     (dir, target)
 }
 
-fn a_b(dir: &Path, target: &Path, rev: &str, slowdown: Option<&str>, extra: &[&str]) -> Output {
+fn a_b(
+    dir: &Path,
+    target: &Path,
+    rev: &str,
+    out: &str,
+    slowdown: Option<&str>,
+    extra: &[&str],
+) -> Output {
     let mut cmd = bin();
     cmd.current_dir(dir)
         .env("CARGO_TARGET_DIR", target)
@@ -310,7 +319,7 @@ fn a_b(dir: &Path, target: &Path, rev: &str, slowdown: Option<&str>, extra: &[&s
             "--rounds",
             "2",
         ])
-        .args(["--out", "gate-out", "--format", "json"])
+        .args(["--out", out, "--format", "json"])
         .args(extra);
     if let Some(knob) = slowdown {
         cmd.env("NBODY_BENCH_TEST_SLOWDOWN", knob);
@@ -323,19 +332,35 @@ fn a_b(dir: &Path, target: &Path, rev: &str, slowdown: Option<&str>, extra: &[&s
 fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
     let _serial = serial();
     let (repo, target) = same_tree_repo();
-    let same = a_b(repo.path(), &target, "HEAD", None, &["--threshold", "0.75"]);
+    let same = a_b(
+        repo.path(),
+        &target,
+        "HEAD",
+        "same",
+        None,
+        &["--threshold", "0.75"],
+    );
     assert_eq!(same.status.code(), Some(0), "{}", text(&same.stderr));
     assert!(verdicts(&same).iter().all(|(_, v)| v == "unchanged"));
     assert_eq!(verdicts(&same).len(), 3);
     for kept in ["base.json", "current.json", "gate.json"] {
-        assert!(repo.path().join("gate-out").join(kept).is_file(), "{kept}");
+        assert!(repo.path().join("same").join(kept).is_file(), "{kept}");
     }
-    assert!(!repo.path().join("gate-out/scratch").exists());
+    let left: Vec<_> = std::fs::read_dir(repo.path().join("same"))
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_name().to_string_lossy().starts_with(".scratch"))
+        .collect();
+    assert!(left.is_empty(), "scratch removed");
+    // What a gate kept is never overwritten.
+    let again = a_b(repo.path(), &target, "HEAD", "same", None, &[]);
+    assert_bad_input(&again, "is there from an earlier gate run");
 
     let slow = a_b(
         repo.path(),
         &target,
         "HEAD",
+        "slow",
         Some("symmetric:5"),
         &["--threshold", "0.75"],
     );
@@ -349,7 +374,14 @@ fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
         assert_eq!(verdict, expected, "{key}");
     }
 
-    let missing = a_b(repo.path(), &target, "0123456789abcdef0123", None, &[]);
+    let missing = a_b(
+        repo.path(),
+        &target,
+        "0123456789abcdef0123",
+        "missing",
+        None,
+        &[],
+    );
     assert_bad_input(&missing, "is not in this clone");
 }
 
