@@ -43,20 +43,50 @@ fn a_closed_pipe_ends_the_output_quietly() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("s.csv");
     std::fs::write(&csv, CSV).unwrap();
+    let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/ci.json");
+    let quick = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/quick/results.json");
+    let config = dir.path().join("tiny.toml");
+    std::fs::write(
+        &config,
+        "name = \"tiny\"\nstudy = \"cartesian\"\nscenarios = [\"lj-box\"]\n\
+         kernels = [\"naive\", \"symmetric\"]\nn = [50]\n[measure]\nsamples = 2\nrounds = 2\n\
+         warmup_s = 0.0\nmin_sample_s = 0.0\n",
+    )
+    .unwrap();
+    let analysis = dir.path().join("analysis");
+    let (b, q, c, d, a) = (
+        baseline.to_str().unwrap(),
+        quick.to_str().unwrap(),
+        config.to_str().unwrap(),
+        dir.path().to_str().unwrap(),
+        analysis.to_str().unwrap(),
+    );
+    let run = [
+        "run",
+        "--scenario",
+        "lj-box",
+        "--kernel",
+        "naive",
+        "-n",
+        "50",
+        "--steps",
+        "5",
+    ];
     let commands: Vec<Vec<String>> = vec![
         vec!["fit", "--model", "amdahl", "--csv", csv.to_str().unwrap()],
         vec!["list"],
         vec!["validate", "--scenario", "lj-box", "-n", "200"],
+        run.to_vec(),
+        vec!["gate", "--baseline", b, "--current", b],
+        vec!["analyze", q, "--out", a],
         vec![
-            "run",
-            "--scenario",
-            "lj-box",
-            "--kernel",
-            "naive",
-            "-n",
-            "50",
-            "--steps",
-            "5",
+            "sweep",
+            "--config",
+            c,
+            "--out",
+            d,
+            "--no-calibration",
+            "--fresh",
         ],
     ]
     .into_iter()
@@ -79,16 +109,41 @@ fn a_closed_pipe_ends_the_output_quietly() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
         assert_eq!(o.status.code(), Some(0), "{args:?}: {err}");
     }
+    // The sweep behind a closed pipe still saved and analysed its results.
+    let results = dir.path().join("tiny/results.json");
+    let parsed: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&results).unwrap()).unwrap();
+    assert_eq!(parsed["cases"].as_array().unwrap().len(), 2);
+    assert!(dir.path().join("tiny/analysis/summary.md").is_file());
 }
 
 #[test]
 fn a_full_stdout_is_an_error_with_exit_2() {
-    let full = std::fs::OpenOptions::new()
-        .write(true)
-        .open("/dev/full")
-        .unwrap();
-    let o = bin().arg("list").stdout(full).output().unwrap();
-    refused(&o, "cannot write to standard output");
+    let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/ci.json");
+    let b = baseline.to_str().unwrap();
+    let commands: [&[&str]; 3] = [
+        &["list"],
+        &["gate", "--baseline", b, "--current", b],
+        &[
+            "run",
+            "--scenario",
+            "lj-box",
+            "--kernel",
+            "naive",
+            "-n",
+            "50",
+            "--steps",
+            "2",
+        ],
+    ];
+    for args in commands {
+        let full = std::fs::OpenOptions::new()
+            .write(true)
+            .open("/dev/full")
+            .unwrap();
+        let o = bin().args(args).stdout(full).output().unwrap();
+        refused(&o, "cannot write to standard output");
+    }
 }
 
 #[test]
