@@ -113,7 +113,8 @@ pub fn new_run_dir(root: &Path, name: &str, utc: &str) -> Result<PathBuf, Locate
         source,
     })?;
     let stamp: String = utc.chars().filter(|c| !matches!(c, ':' | '-')).collect();
-    for attempt in 1.. {
+    let mut attempt = 1u64;
+    loop {
         let dir = if attempt == 1 {
             parent.join(&stamp)
         } else {
@@ -121,11 +122,10 @@ pub fn new_run_dir(root: &Path, name: &str, utc: &str) -> Result<PathBuf, Locate
         };
         match std::fs::create_dir(&dir) {
             Ok(()) => return Ok(dir),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => attempt += 1,
             Err(source) => return Err(LocateError::CreateRun { path: dir, source }),
         }
     }
-    unreachable!("the attempts are unbounded")
 }
 
 /// The run directories of a config that hold a results file, oldest first (the directory

@@ -210,15 +210,7 @@ impl CaseRecord {
             // Values beyond the histogram's range (an hour) are clamped, not dropped.
             hist.saturating_record(ns.max(1));
         }
-        self.step_histogram = hist
-            .iter_recorded()
-            .map(|v| [v.value_iterated_to(), v.count_at_value()])
-            .collect();
-        self.n = round.n;
-        self.steps_per_sample = round.steps_per_sample;
-        self.rounds.push(round);
-        self.rounds_done += 1;
-        self.summary = Some(self.summarize(&hist, max_drift));
+        self.push_rounds(hist, [round], max_drift);
     }
 
     /// Adds every round of `other`, the same case measured by another sweep (an A/B gate's
@@ -228,11 +220,22 @@ impl CaseRecord {
         for &[value, count] in &other.step_histogram {
             hist.saturating_record_n(value, count);
         }
+        self.push_rounds(hist, other.rounds, max_drift);
+    }
+
+    /// Stores `hist` (this record's histogram with the new steps in it), appends `rounds` and
+    /// recomputes the summary from all raw values.
+    fn push_rounds(
+        &mut self,
+        hist: Histogram<u64>,
+        rounds: impl IntoIterator<Item = RoundOutcome>,
+        max_drift: f64,
+    ) {
         self.step_histogram = hist
             .iter_recorded()
             .map(|v| [v.value_iterated_to(), v.count_at_value()])
             .collect();
-        for round in other.rounds {
+        for round in rounds {
             self.n = round.n;
             self.steps_per_sample = round.steps_per_sample;
             self.rounds.push(round);
