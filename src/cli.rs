@@ -148,6 +148,10 @@ pub struct RunArgs {
     /// Write the final positions, velocities and forces (text, id order, nothing run-dependent).
     #[arg(long, value_name = "FILE")]
     pub dump_state: Option<PathBuf>,
+    /// Start a run estimated at more than an hour (a probe at small n carried to -n, --steps
+    /// and --threads) instead of refusing it.
+    #[arg(long)]
+    pub yes: bool,
     /// Split the run over MPI ranks (start it under `mpirun -n P`): allgather (replicated data,
     /// any kernel) or domain (spatial regions, cell list). Needs the `mpi` feature.
     #[arg(long, value_enum, help_heading = MPI_HEADING)]
@@ -163,7 +167,7 @@ const MPI_HEADING: &str = "MPI (build with --features mpi, start under mpirun)";
 #[command(next_help_heading = MPI_HEADING)]
 pub struct MpiOptions {
     /// Untimed steps before the timed ones.
-    #[arg(long, default_value_t = 0, requires = "decomp")]
+    #[arg(long, default_value_t = 0, value_parser = parse_warmup, requires = "decomp")]
     pub warmup_steps: usize,
     /// Regions per axis of the domain decomposition, e.g. 4x1 (slabs) or 2x2 (blocks)
     /// [default: the factorization with the least cut area].
@@ -189,8 +193,8 @@ pub struct MpiCheckArgs {
     /// Decomposition to check.
     #[arg(long, value_enum)]
     pub decomp: Decomposition,
-    /// Time steps to integrate.
-    #[arg(long, default_value_t = 20, value_parser = parse_count)]
+    /// Time steps to integrate (a check: at most 1000000).
+    #[arg(long, default_value_t = 20, value_parser = parse_count_at_most::<1_000_000>)]
     pub steps: usize,
     #[command(flatten)]
     pub system: SystemArgs,
@@ -221,14 +225,16 @@ pub struct MpiBenchArgs {
     /// Where to write the timings (JSON, schema nbody-bench/mpi-bench/v1).
     #[arg(long, value_name = "FILE", default_value = "mpi-bench.json")]
     pub out: PathBuf,
-    /// Largest message in bytes (per rank for Allgatherv); sizes are 1, 4, 16, ... up to it.
-    #[arg(long, default_value_t = 4 << 20, value_parser = parse_count)]
+    /// Largest message in bytes (per rank for Allgatherv), at most 1 GiB; sizes are 1, 4,
+    /// 16, ... up to it.
+    #[arg(long, default_value_t = 4 << 20, value_parser = parse_count_at_most::<{ 1 << 30 }>)]
     pub max_bytes: usize,
-    /// Timed repetitions per size up to 64 KiB (fewer above, in proportion, at least 10).
-    #[arg(long, default_value_t = 100, value_parser = parse_count)]
+    /// Timed repetitions per size up to 64 KiB (fewer above, in proportion, at least 10), at
+    /// most 1000000.
+    #[arg(long, default_value_t = 100, value_parser = parse_count_at_most::<1_000_000>)]
     pub reps: usize,
-    /// Untimed repetitions before each size.
-    #[arg(long, default_value_t = 5)]
+    /// Untimed repetitions before each size, at most 1000000.
+    #[arg(long, default_value_t = 5, value_parser = parse_warmup)]
     pub warmup: usize,
 }
 
@@ -248,6 +254,10 @@ pub struct ValidateArgs {
     /// Print the result as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Check a system estimated at more than an hour (the direct sums grow as n²) instead of
+    /// refusing it.
+    #[arg(long)]
+    pub yes: bool,
 }
 
 fn parse_count(s: &str) -> Result<usize, String> {
@@ -255,6 +265,26 @@ fn parse_count(s: &str) -> Result<usize, String> {
         Ok(0) => Err("must be at least 1".into()),
         Ok(v) => Ok(v),
         Err(_) => Err(format!("`{s}` is not a whole number")),
+    }
+}
+
+fn parse_warmup(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(v) if v > 1_000_000 => Err(format!(
+            "{v} is more than 1000000, the most this option takes"
+        )),
+        Ok(v) => Ok(v),
+        Err(_) => Err(format!("`{s}` is not a whole number")),
+    }
+}
+
+/// A count of at least 1 and at most `MAX`, for sizes that allocate or run in proportion.
+fn parse_count_at_most<const MAX: usize>(s: &str) -> Result<usize, String> {
+    match parse_count(s)? {
+        v if v > MAX => Err(format!(
+            "{v} is more than {MAX}, the most this option takes"
+        )),
+        v => Ok(v),
     }
 }
 

@@ -2,12 +2,12 @@
 //! step and per phase, with work counters and an energy check. Used by `run` and by sweeps.
 
 use crate::engine::{Energy, PhaseTimes, Simulation};
-use crate::kernels::{KernelKind, KernelParams, WorkCounters};
+use crate::kernels::{KernelKind, KernelParams, WorkCounters, footprint};
 use crate::output::nbview::{self, NbviewFormat};
 use crate::output::{AtomicFile, WriteError, dump};
 use crate::physics::PairLaw;
 use crate::real::Real;
-use crate::scenario::{System, SystemInfo, SystemJob};
+use crate::scenario::{Setup, System, SystemInfo, SystemJob};
 use crate::simd;
 use crate::stats::StepPercentiles;
 use serde::Serialize;
@@ -279,6 +279,24 @@ fn measure<T: Real, const D: usize>(
 /// Most threads a run's pool may have: far beyond any oversubscription study on the machines
 /// this runs on, and far below what would exhaust memory with thread stacks.
 pub const MAX_THREADS: usize = 1024;
+
+/// Refuses a run the machine cannot hold (see `kernels::footprint`), before anything is
+/// built; `processes` is the number of copies on this machine (MPI ranks each holding all n).
+pub fn check_memory(
+    setup: &Setup,
+    kernel: KernelKind,
+    threads: usize,
+    processes: usize,
+) -> Result<(), footprint::TooLarge> {
+    footprint::check(
+        kernel,
+        setup.n(),
+        setup.scenario.dim(),
+        setup.precision().bytes(),
+        threads,
+        processes,
+    )
+}
 
 /// Logical CPUs available to this process.
 pub fn logical_cpus() -> usize {

@@ -77,7 +77,56 @@ mod with_mpi {
         })
     }
 
+    /// This process's rank as the launcher tells it before MPI starts (Open MPI, MPICH,
+    /// Slurm).
+    fn launcher_rank() -> Option<usize> {
+        ["OMPI_COMM_WORLD_RANK", "PMI_RANK", "SLURM_PROCID"]
+            .iter()
+            .find_map(|v| std::env::var(v).ok()?.parse().ok())
+    }
+
+    /// Refuses a job whose ranks on this machine would not fit in its memory: with allgather
+    /// every rank holds all n particles, with domain about n / ranks.
+    fn fits(
+        setup: &crate::scenario::Setup,
+        kernel: KernelKind,
+        decomp: Decomposition,
+        kernel_args: &KernelArgs,
+        ranks: usize,
+    ) -> Result<(), MpiError> {
+        let local_ranks = std::env::var("OMPI_COMM_WORLD_LOCAL_SIZE")
+            .ok()
+            .and_then(|v| v.parse::<usize>().ok())
+            .unwrap_or(ranks)
+            .max(1);
+        let copies = match decomp {
+            Decomposition::Allgather => local_ranks,
+            // Ghost layers aside, the ranks together hold the system once.
+            Decomposition::Domain => 1,
+        };
+        if let Err(e) = setup.validate() {
+            return Err(MpiError::Usage(e.to_string()));
+        }
+        crate::run::check_memory(setup, kernel, kernel_args.threads, copies)
+            .map_err(|e| MpiError::Usage(e.to_string()))
+    }
+
     pub fn run(args: RunArgs, decomp: Decomposition) -> anyhow::Result<i32> {
+        // Rank 0 alone estimates the run, before MPI starts (a probe's timing differs between
+        // ranks, and a refusal must not leave ranks waiting in a collective): its exit with
+        // code 2 ends the job under the launcher.
+        if !args.yes && launcher_rank().unwrap_or(0) == 0 {
+            let setup = setup(args.scenario, &args.system);
+            if setup.validate().is_ok() {
+                let steps = (args.steps + args.mpi.warmup_steps) as u64;
+                crate::commands::run::refuse_long_run(
+                    &setup,
+                    args.kernel,
+                    &args.kernel_args,
+                    steps,
+                )?;
+            }
+        }
         let mut mpi = Mpi::init()?;
         let rank = mpi.rank();
         if args.trajectory.is_some() {
@@ -88,6 +137,9 @@ mod with_mpi {
             return Ok(fail(rank, err));
         }
         let setup = setup(args.scenario, &args.system);
+        if let Err(err) = fits(&setup, args.kernel, decomp, &args.kernel_args, mpi.size()) {
+            return Ok(fail(rank, err));
+        }
         let spec = spec(
             args.kernel,
             decomp,
@@ -175,6 +227,15 @@ mod with_mpi {
         let mut mpi = Mpi::init()?;
         let rank = mpi.rank();
         let setup = setup(args.scenario, &args.system);
+        if let Err(err) = fits(
+            &setup,
+            args.kernel,
+            args.decomp,
+            &args.kernel_args,
+            mpi.size(),
+        ) {
+            return Ok(fail(rank, err));
+        }
         let spec = spec(
             args.kernel,
             args.decomp,

@@ -18,6 +18,11 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
         return super::mpi::run(args, decomp);
     }
     let setup = setup(args.scenario, &args.system);
+    setup.validate()?;
+    crate::run::check_memory(&setup, args.kernel, args.kernel_args.threads, 1)?;
+    if !args.yes {
+        refuse_long_run(&setup, args.kernel, &args.kernel_args, args.steps as u64)?;
+    }
     let spec = RunSpec {
         kernel: args.kernel,
         params: kernel_params(&args.kernel_args, Some(args.kernel))?,
@@ -45,6 +50,47 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
         outln!("result written to {}", path.display());
     }
     Ok(0)
+}
+
+/// Runs this small need no estimate: even the naive kernel in f64 finishes them in minutes.
+const SMALL_RUN_N: usize = crate::experiment::estimate::PROBE_MAX_N;
+const SMALL_RUN_STEPS: u64 = 100_000;
+
+/// Refuses a run estimated at more than an hour (the sweep's limit) unless `--yes` is given.
+pub(crate) fn refuse_long_run(
+    setup: &crate::scenario::Setup,
+    kernel: crate::kernels::KernelKind,
+    kernel_args: &crate::cli::KernelArgs,
+    steps: u64,
+) -> anyhow::Result<()> {
+    let n = setup.n();
+    if n <= SMALL_RUN_N && steps <= SMALL_RUN_STEPS {
+        return Ok(());
+    }
+    let case = crate::experiment::plan::Case {
+        scenario: setup.scenario,
+        kernel,
+        n,
+        threads: kernel_args.threads,
+        ranks: 1,
+        theta: kernel_args.theta,
+        seed: setup.seed,
+        precision: setup.precision,
+        time_factor: 1,
+        decomp: None,
+    };
+    let wall_s = crate::experiment::estimate::run_seconds(&case, steps, logical_cpus())?;
+    let limit = super::dry_run::LONG_SWEEP_S;
+    if wall_s > limit {
+        anyhow::bail!(
+            "this run is estimated at {} ({steps} step{} of {n} particles, from a probe at small n); \
+             it is refused above {}: lower --steps or -n, or pass --yes to run it anyway",
+            crate::experiment::estimate::fmt_duration(wall_s),
+            if steps == 1 { "" } else { "s" },
+            crate::experiment::estimate::fmt_duration(limit),
+        );
+    }
+    Ok(())
 }
 
 pub(super) fn print_summary(r: &RunOutcome) {

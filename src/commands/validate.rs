@@ -1,5 +1,6 @@
 use super::{kernel_params, setup};
 use crate::cli::ValidateArgs;
+use crate::kernels::KernelKind;
 use crate::scenario::ScenarioKind;
 use crate::validate::{ScenarioCheck, ValidateJob};
 use std::path::PathBuf;
@@ -28,6 +29,15 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         {
             // --density applies to the scenarios that have one.
             s.density = None;
+        }
+        s.validate()?;
+        // The tree holds the most memory of the kernels checked, the O(n²) direct sums take
+        // the time: the f64 reference and the three quadratic kernels, one force computation
+        // each.
+        crate::run::check_memory(&s, KernelKind::Octree, args.kernel_args.threads, 1)?;
+        crate::run::check_memory(&s, KernelKind::PerThread, args.kernel_args.threads, 1)?;
+        if !args.yes {
+            refuse_long_check(&s, params, args.kernel_args.threads)?;
         }
         let job = ValidateJob {
             params,
@@ -64,6 +74,44 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         outln!("FAILED: {}", failed.join(", "));
     }
     Ok(if failed.is_empty() { 0 } else { 1 })
+}
+
+/// Checks up to this many particles need no estimate (well under a second).
+const PROBE_N: usize = 1000;
+
+/// Refuses a check estimated at more than an hour unless `--yes` is given: the same check at
+/// [`PROBE_N`] particles, timed, carried to n as n² (its direct sums dominate).
+fn refuse_long_check(
+    setup: &crate::scenario::Setup,
+    params: crate::kernels::KernelParams,
+    threads: usize,
+) -> anyhow::Result<()> {
+    let n = setup.n();
+    if n <= PROBE_N {
+        return Ok(());
+    }
+    let mut probe = setup.clone();
+    probe.n = Some(PROBE_N);
+    let job = ValidateJob {
+        params,
+        threads,
+        want_dump: false,
+    };
+    let started = std::time::Instant::now();
+    probe.dispatch(job)??;
+    let ratio = n as f64 / PROBE_N as f64;
+    let wall_s = started.elapsed().as_secs_f64() * ratio * ratio;
+    let limit = super::dry_run::LONG_SWEEP_S;
+    if wall_s > limit {
+        anyhow::bail!(
+            "checking {} at n = {n} is estimated at {} (the check at n = {PROBE_N}, carried as n²); \
+             it is refused above {}: lower -n, or pass --yes to run it anyway",
+            setup.scenario.name(),
+            crate::experiment::estimate::fmt_duration(wall_s),
+            crate::experiment::estimate::fmt_duration(limit),
+        );
+    }
+    Ok(())
 }
 
 /// The dump of one scenario: `path` itself, or `path.<scenario>` when several are checked.

@@ -45,10 +45,6 @@ pub enum Counts {
     Range(CountRange),
 }
 
-/// The forms `n` takes, for the message when it has none of them.
-const COUNTS_FORMS: &str = "`n` must be a list of whole numbers, such as n = [1000, 2000], or a \
-    geometric range, such as n = { from = 1000, to = 32000, factor = 2 }";
-
 impl<'de> Deserialize<'de> for Counts {
     /// As the two forms, with a message that names the key and both forms (serde's own for an
     /// untagged enum, "data did not match any variant", names neither).
@@ -62,7 +58,10 @@ impl<'de> Deserialize<'de> for Counts {
         match Form::deserialize(d) {
             Ok(Form::List(v)) => Ok(Counts::List(v)),
             Ok(Form::Range(r)) => Ok(Counts::Range(r)),
-            Err(_) => Err(serde::de::Error::custom(COUNTS_FORMS)),
+            Err(_) => Err(serde::de::Error::custom(format!(
+                "must be {}",
+                super::config_keys::COUNTS_FORMS
+            ))),
         }
     }
 }
@@ -271,7 +270,7 @@ impl SweepConfig {
     pub fn parse(text: &str, path: &Path) -> Result<SweepConfig, ConfigError> {
         let config: SweepConfig = toml::from_str(text).map_err(|e| ConfigError::Parse {
             path: path.into(),
-            message: e.message().to_string() + &location(text, e.span()),
+            message: super::config_keys::describe(text, e.message(), e.span()),
         })?;
         config.validate(path)?;
         Ok(config)
@@ -485,17 +484,6 @@ impl SweepConfig {
         }
         Ok(())
     }
-}
-
-/// " at line L, column C" for a parse error span.
-fn location(text: &str, span: Option<std::ops::Range<usize>>) -> String {
-    let Some(span) = span else {
-        return String::new();
-    };
-    let before = &text[..span.start.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let col = before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1;
-    format!(" (line {line}, column {col})")
 }
 
 #[cfg(test)]

@@ -292,6 +292,23 @@ pub enum ProbeError {
 /// Probes each distinct set-up of `cases` once, on one thread, at the largest of its cases' n
 /// up to [`PROBE_MAX_N`].
 pub fn probe(config: &SweepConfig, cases: &[Case]) -> Result<Probed, ProbeError> {
+    probe_with_error_sample(config.measure.force_error_sample, cases)
+}
+
+/// Expected wall time of a single `run` of `steps` steps of `case` (no sweep around it): the
+/// system's build and energy probes, then the steps, threads counted as in [`speedup`].
+pub fn run_seconds(case: &Case, steps: u64, logical_cpus: usize) -> Result<f64, ProbeError> {
+    let probed = probe_with_error_sample(0, std::slice::from_ref(case))?;
+    let Some((_, probe)) = probed.cases.first() else {
+        return Ok(0.0);
+    };
+    let at_n = probe.at(case.kernel, case.n);
+    let sp = speedup(case.kernel, case.threads, 1, at_n.pair_checks, logical_cpus);
+    let step_s = at_n.force_s / sp + at_n.other_s;
+    Ok(probed.seconds + at_n.build_s + 2.0 * at_n.energy_s / sp + steps as f64 * step_s)
+}
+
+fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed, ProbeError> {
     type Key = (ScenarioKind, KernelKind, Option<Precision>, Option<u64>);
     let key = |c: &Case| (c.scenario, c.kernel, c.precision, c.theta.map(f64::to_bits));
     let started = Instant::now();
@@ -314,7 +331,7 @@ pub fn probe(config: &SweepConfig, cases: &[Case]) -> Result<Probed, ProbeError>
         let job = ProbeJob {
             kernel: case.kernel,
             theta: case.theta,
-            error_sample: config.measure.force_error_sample,
+            error_sample,
             started: Instant::now(),
         };
         let probe = pool

@@ -80,6 +80,8 @@ pub fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> 
         ("--steps", Some(launch.steps.to_string())),
         ("--warmup-steps", Some(launch.warmup_steps.to_string())),
         ("--json", Some(json.display().to_string())),
+        // The sweep estimated its cases before it started; a long one is not asked again.
+        ("--yes", None),
     ] {
         a.push(flag.to_string());
         a.extend(value);

@@ -1,6 +1,7 @@
 //! The experiment runner: sweep configs → planned cases → measured rounds → results file.
 
 pub mod config;
+pub mod config_keys;
 pub mod estimate;
 pub mod launcher;
 pub mod locate;

@@ -114,12 +114,23 @@ pub fn run_sweep<C: Clock>(
     // otherwise fail only when its turn comes, after the cases before it ran, and again at
     // every --resume.
     for case in cases(config) {
-        case_setup(&case)
+        let setup = case_setup(&case);
+        let copies = match case.decomp {
+            // Every rank holds all the particles.
+            Some(crate::decomp::Decomposition::Allgather) => case.ranks,
+            _ => 1,
+        };
+        let checked = setup
             .validate()
-            .map_err(|source| SweepError::Case {
-                key: case.key(),
-                source: Box::new(source),
-            })?;
+            .map_err(|e| Box::new(e) as Box<dyn std::error::Error + Send + Sync>)
+            .and_then(|()| {
+                crate::run::check_memory(&setup, case.kernel, case.threads, copies)
+                    .map_err(|e| Box::new(e) as _)
+            });
+        checked.map_err(|source| SweepError::Case {
+            key: case.key(),
+            source,
+        })?;
     }
     let path = match &options.run_dir {
         Some(dir) => dir.join("results.json"),

@@ -7,6 +7,7 @@
 //! monomorphized for the law, precision and dimension.
 
 mod cell_list;
+pub mod footprint;
 mod naive;
 mod octree;
 mod par;

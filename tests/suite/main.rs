@@ -8,6 +8,7 @@
 
 mod analyze;
 mod bad_input;
+mod bad_sizes;
 mod cli;
 mod config_corpus;
 mod conservation;

@@ -42,7 +42,7 @@ fn a_launch_runs_this_program_under_the_launcher() {
     assert_eq!(
         args.join(" "),
         "--oversubscribe -n 4 /bin/nb run --scenario lj-box --kernel cell-list -n 2000 --seed 3 \
-         --threads 1 --decomp domain --steps 40 --warmup-steps 5 --json /tmp/r.json --precision f64"
+         --threads 1 --decomp domain --steps 40 --warmup-steps 5 --json /tmp/r.json --yes --precision f64"
     );
     assert!(
         case().key().ends_with("/r=4/seed=3/f64/domain"),
