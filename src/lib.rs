@@ -20,6 +20,7 @@ pub mod engine;
 pub mod experiment;
 pub mod fit;
 pub mod gate;
+pub mod input;
 pub mod integrator;
 pub mod kernels;
 #[cfg(feature = "mpi")]

@@ -23,7 +23,7 @@ pub fn fit(args: FitArgs) -> anyhow::Result<i32> {
     if let Some(json) = &args.json {
         crate::output::check_outputs(&[("--json", json)], &[("--csv", &args.csv)])?;
     }
-    let text = std::fs::read_to_string(&args.csv)
+    let text = crate::input::read_text(&args.csv)
         .with_context(|| format!("cannot read {}", args.csv.display()))?;
     let in_csv = |e: csv::CsvError| anyhow::anyhow!("{}: {e}", args.csv.display());
     let name = args.csv.display().to_string();

@@ -87,14 +87,14 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
     let (config_path, config_text) = match (&args.config, &baseline) {
         (Some(name), _) => {
             let path = locate::find_config(name)?;
-            let text = std::fs::read_to_string(&path)
+            let text = crate::input::read_text(&path)
                 .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
             (path, text)
         }
         (None, Some(b)) => (args.baseline.clone(), b.config_text.clone()),
         (None, None) => {
             let path = locate::find_config(Path::new("ci"))?;
-            let text = std::fs::read_to_string(&path)
+            let text = crate::input::read_text(&path)
                 .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
             (path, text)
         }

@@ -71,7 +71,7 @@ pub enum BenchFileError {
 
 impl MpiBenchFile {
     pub fn load(path: &Path) -> Result<MpiBenchFile, BenchFileError> {
-        let text = std::fs::read_to_string(path).map_err(|source| BenchFileError::Read {
+        let text = crate::input::read_text(path).map_err(|source| BenchFileError::Read {
             path: path.into(),
             source,
         })?;

@@ -258,7 +258,7 @@ pub enum ConfigError {
 impl SweepConfig {
     /// Reads, parses and validates a config file.
     pub fn load(path: &Path) -> Result<(SweepConfig, String), ConfigError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ConfigError::Read {
+        let text = crate::input::read_text(path).map_err(|source| ConfigError::Read {
             path: path.into(),
             source,
         })?;

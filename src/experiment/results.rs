@@ -146,7 +146,7 @@ pub enum ResultsError {
 
 impl ResultsFile {
     pub fn load(path: &Path) -> Result<ResultsFile, ResultsError> {
-        let text = std::fs::read_to_string(path).map_err(|source| ResultsError::Read {
+        let text = crate::input::read_text(path).map_err(|source| ResultsError::Read {
             path: path.into(),
             source,
         })?;

@@ -116,7 +116,7 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
     }
     let comm = comm_model(results_dir, &sweeps, report_dir, &mut figure_errors)?;
     let generated = sections::document(&sweeps, comm.as_ref(), results_dir);
-    let old = match std::fs::read_to_string(out) {
+    let old = match crate::input::read_text(out) {
         Ok(text) => text,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
         Err(source) => {

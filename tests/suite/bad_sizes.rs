@@ -220,3 +220,30 @@ fn thread_counts_are_bounded() {
         .unwrap();
     refused(&o, "thread counts from 1 to 1024");
 }
+
+#[test]
+fn endless_inputs_and_report_outputs_are_refused() {
+    refused(
+        &run(&["fit", "--model", "amdahl", "--csv", "/dev/zero"]),
+        "is a device or socket, not a file",
+    );
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let results = root.join("results");
+    let quick = results.join("quick/results.json");
+    let before = std::fs::read(&quick).unwrap();
+    let r = results.to_str().unwrap();
+    // Reading the old report from a device would never end; replacing an input loses it.
+    refused(
+        &run(&["report", "--results", r, "--out", "/dev/full"]),
+        "not a regular file",
+    );
+    refused(
+        &run(&["report", "--results", r, "--out", quick.to_str().unwrap()]),
+        "is also an input of this command (--results)",
+    );
+    refused(
+        &run(&["report", "--results", r, "--out", "/tmp"]),
+        "is a directory",
+    );
+    assert_eq!(std::fs::read(&quick).unwrap(), before, "input untouched");
+}
