@@ -13,9 +13,9 @@ use std::path::PathBuf;
     version,
     about = "Characterize the performance of particle (N-body) simulation codes",
     long_about = "Characterize the performance of particle (N-body) simulation codes.\n\n\
-        An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, octree) \
-        over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, work counters \
-        and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
+        An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, \
+        octree, verlet) over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, \
+        work counters and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
     after_help = "Examples:\n  nbody-bench list\n  nbody-bench sweep --config configs/quick.toml\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
 )]
 pub struct Cli {
@@ -107,6 +107,11 @@ pub struct KernelArgs {
     /// Most particles in a tree leaf (octree only) [default: 8].
     #[arg(long, value_parser = parse_count)]
     pub leaf_size: Option<usize>,
+    /// Verlet list skin, in the scenario's length unit (verlet only): pairs within the cutoff
+    /// plus the skin are listed, and the list is rebuilt once a particle has moved half the
+    /// skin [default: 0.003, 0.3 sigma].
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
+    pub skin: Option<f64>,
     /// Threads in the rayon pool for this run, at most 1024 (the environment's
     /// RAYON_NUM_THREADS is not used).
     #[arg(long, default_value_t = 1, value_parser = parse_threads)]

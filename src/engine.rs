@@ -9,7 +9,8 @@ use crate::state::{Field, State, zero_field};
 use serde::Serialize;
 use std::time::Instant;
 
-/// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order).
+/// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order), unless
+/// the kernel asks more often ([`ForceKernel::sort_every`]: the Verlet list, at its rebuilds).
 pub const SORT_EVERY: u64 = 20;
 
 /// Seconds spent in each phase of the step, summed over steps.
@@ -136,7 +137,7 @@ impl<T: Real, const D: usize> Simulation<T, D> {
         self.bounds = self.boundary.apply(&mut self.state, self.step + 1)?;
         let t2 = Instant::now();
         let mut reorder_s = 0.0;
-        if (self.step + 1).is_multiple_of(SORT_EVERY) {
+        if (self.step + 1).is_multiple_of(self.kernel.sort_every()) {
             if let Some(order) = self.kernel.spatial_order(&self.state) {
                 self.state.permute(&order, &mut [&mut self.forces]);
             }

@@ -352,7 +352,7 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
 fn cost_class(kernel: KernelKind) -> ComplexityClass {
     match kernel {
         KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => ComplexityClass::N2,
-        KernelKind::CellList => ComplexityClass::N,
+        KernelKind::CellList | KernelKind::Verlet => ComplexityClass::N,
         KernelKind::Octree => ComplexityClass::NLogN,
     }
 }

@@ -18,6 +18,9 @@ pub fn list() -> anyhow::Result<i32> {
             KernelKind::Octree => {
                 "Barnes-Hut tree (quadtree in 2-D), opening angle --theta; O(n log n)"
             }
+            KernelKind::Verlet => {
+                "half neighbour list, cutoff + --skin, rebuilt when a particle moved skin/2; O(n)"
+            }
         };
         outln!("  {:<11} {what}", k.name());
     }

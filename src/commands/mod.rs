@@ -64,10 +64,19 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
     }
 }
 
-/// The kernel parameters given, over the defaults; `--theta` and `--leaf-size` are refused
-/// for a kernel that ignores them (as `--density` is for a scenario without a box), so that
-/// nobody believes a setting that changed nothing.
+/// The kernel parameters given, over the defaults; `--theta`, `--leaf-size` and `--skin` are
+/// refused for a kernel that ignores them (as `--density` is for a scenario without a box), so
+/// that nobody believes a setting that changed nothing.
 fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Result<KernelParams> {
+    if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Verlet)
+        && args.skin.is_some()
+    {
+        anyhow::bail!(
+            "--skin applies to the verlet kernel only; `{}` does not use it: drop it, or pass \
+             --kernel verlet",
+            kernel.name()
+        );
+    }
     if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Octree) {
         for (flag, given) in [
             ("--theta", args.theta.is_some()),
@@ -86,6 +95,7 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
     Ok(KernelParams {
         theta: args.theta.unwrap_or(defaults.theta),
         leaf_size: args.leaf_size.unwrap_or(defaults.leaf_size),
+        skin: args.skin.unwrap_or(defaults.skin),
     })
 }
 

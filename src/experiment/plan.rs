@@ -143,7 +143,7 @@ pub fn weak_size(kernel: KernelKind, rule: WeakRule, base_n: usize, p: usize) ->
         WeakRule::Linear => b * pf,
         WeakRule::Sqrt => b * pf.sqrt(),
         WeakRule::CostModel => match kernel {
-            KernelKind::CellList => b * pf,
+            KernelKind::CellList | KernelKind::Verlet => b * pf,
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => b * pf.sqrt(),
             KernelKind::Octree => solve_n_log_n(pf * b * b.max(2.0).ln()),
         },

@@ -5,7 +5,10 @@
 //! Bytes per particle, from peak resident sizes measured with `/usr/bin/time -f %M` over
 //! `run --steps 1 --threads 2` at two n (the difference, so the executable and the pools do not
 //! count): naive 60 B (2-D f32) and 97 B (3-D f64); cell list 110 B and 129 B; octree 88 B and
-//! 186 B; per-thread buffers 2 × D f64 more per thread. The model below is at or above each.
+//! 186 B; per-thread buffers 2 × D f64 more per thread; the Verlet list (2-D only, n = 1e5 and
+//! 4e5, default skin) 202 B on the liquid in f32 and 251 B in f64, 130 B and 210 B on the gas.
+//! The model below is at or above each. The Verlet list's entries grow with the density and
+//! with (cutoff + skin)^D: a denser system or a wider `--skin` needs more than the model says.
 
 use super::KernelKind;
 
@@ -15,13 +18,15 @@ fn state_bytes(dim: usize, real_bytes: usize) -> usize {
 }
 
 /// What the kernel keeps beside the state: bins and the sorted order of the cell list, the
-/// nodes of the tree, one f64 force buffer per thread.
+/// nodes of the tree, one f64 force buffer per thread, the Verlet list's entries (about ten
+/// per particle in the liquid), bins and positions at the build.
 fn kernel_bytes(kernel: KernelKind, dim: usize, threads: usize) -> usize {
     match kernel {
         KernelKind::Naive | KernelKind::Symmetric => 0,
         KernelKind::PerThread => threads * dim * size_of::<f64>(),
         KernelKind::CellList => 48,
         KernelKind::Octree => 112,
+        KernelKind::Verlet => 170,
     }
 }
 
@@ -129,6 +134,10 @@ mod tests {
             (KernelKind::Octree, 2, 4, 2, 88),
             (KernelKind::Octree, 3, 8, 2, 186),
             (KernelKind::PerThread, 3, 8, 2, 135),
+            (KernelKind::Verlet, 2, 4, 2, 202),
+            (KernelKind::Verlet, 2, 8, 2, 251),
+            (KernelKind::Verlet, 2, 4, 2, 130),
+            (KernelKind::Verlet, 2, 8, 2, 210),
         ];
         for (kernel, dim, real, threads, bytes) in measured {
             let model = run_bytes(kernel, 1_000_000, dim, real, threads) as f64 / 1e6;

@@ -15,6 +15,7 @@ mod per_thread;
 pub mod rows;
 mod share;
 mod symmetric;
+pub mod verlet;
 
 pub use cell_list::CellList;
 pub use naive::Naive;
@@ -22,7 +23,9 @@ pub use octree::Octree;
 pub use per_thread::PerThread;
 pub use share::Share;
 pub use symmetric::Symmetric;
+pub use verlet::Verlet;
 
+use crate::engine::SORT_EVERY;
 use crate::physics::{LawKind, PairLaw};
 use crate::real::Real;
 use crate::state::{Field, State, zero_field};
@@ -30,7 +33,7 @@ use serde::Serialize;
 use std::ops::Range;
 use thiserror::Error;
 
-/// The five kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
+/// The six kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
 #[derive(
     Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
 )]
@@ -46,15 +49,19 @@ pub enum KernelKind {
     CellList,
     /// Barnes-Hut tree (octree in 3-D, quadtree in 2-D) with opening angle θ (O(n log n)).
     Octree,
+    /// Half neighbour list within the cutoff plus a skin, rebuilt from cell-list bins only when
+    /// some particle has moved more than half the skin (O(n)).
+    Verlet,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 5] = [
+    pub const ALL: [KernelKind; 6] = [
         KernelKind::Naive,
         KernelKind::Symmetric,
         KernelKind::PerThread,
         KernelKind::CellList,
         KernelKind::Octree,
+        KernelKind::Verlet,
     ];
 
     pub fn name(self) -> &'static str {
@@ -64,6 +71,7 @@ impl KernelKind {
             KernelKind::PerThread => "per-thread",
             KernelKind::CellList => "cell-list",
             KernelKind::Octree => "octree",
+            KernelKind::Verlet => "verlet",
         }
     }
 
@@ -76,7 +84,7 @@ impl KernelKind {
     pub fn supports(self, law: LawKind) -> bool {
         match self {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => true,
-            KernelKind::CellList => law.has_cutoff(),
+            KernelKind::CellList | KernelKind::Verlet => law.has_cutoff(),
             KernelKind::Octree => law.is_inverse_square(),
         }
     }
@@ -88,7 +96,7 @@ impl KernelKind {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => {
                 Complexity::Quadratic
             }
-            KernelKind::CellList => Complexity::Linear,
+            KernelKind::CellList | KernelKind::Verlet => Complexity::Linear,
             KernelKind::Octree => Complexity::NLogN,
         }
     }
@@ -119,6 +127,7 @@ impl KernelKind {
             KernelKind::PerThread => Box::new(PerThread::new(law)),
             KernelKind::CellList => Box::new(CellList::new(law)?),
             KernelKind::Octree => Box::new(Octree::new(law, params.theta, params.leaf_size)),
+            KernelKind::Verlet => Box::new(Verlet::new(law, params.skin)?),
         })
     }
 }
@@ -164,6 +173,15 @@ pub struct KernelParams {
     pub theta: f64,
     /// Most particles in a tree leaf.
     pub leaf_size: usize,
+    /// Verlet list skin, in the scenario's length unit: pairs within the cutoff plus the skin
+    /// enter the list, which stays exact until some particle has moved half the skin.
+    #[serde(default = "default_skin")]
+    pub skin: f64,
+}
+
+/// The Verlet skin by default: 0.3σ of the LJ scenarios.
+fn default_skin() -> f64 {
+    0.3 * crate::scenario::LJ_SIGMA
 }
 
 impl Default for KernelParams {
@@ -171,6 +189,7 @@ impl Default for KernelParams {
         KernelParams {
             theta: 0.5,
             leaf_size: 8,
+            skin: default_skin(),
         }
     }
 }
@@ -187,6 +206,13 @@ impl KernelParams {
             return Err(KernelError::BadParam(format!(
                 "leaf size must be between 1 and 4096 (got {})",
                 self.leaf_size
+            )));
+        }
+        if !(self.skin.is_finite() && self.skin > 0.0) {
+            return Err(KernelError::BadParam(format!(
+                "skin must be a finite number > 0 (got {}); {} (0.3σ) is the default",
+                self.skin,
+                default_skin()
             )));
         }
         Ok(())
@@ -218,6 +244,12 @@ pub struct WorkCounters {
     pub nodes_opened: u64,
     /// Tree nodes accepted as a monopole.
     pub nodes_accepted: u64,
+    /// Neighbour lists built (Verlet list).
+    #[serde(default)]
+    pub rebuilds: u64,
+    /// Neighbour-list entries evaluated (Verlet list; also counted in `pair_checks`).
+    #[serde(default)]
+    pub list_entries: u64,
 }
 
 impl WorkCounters {
@@ -227,6 +259,23 @@ impl WorkCounters {
         self.cells_visited += o.cells_visited;
         self.nodes_opened += o.nodes_opened;
         self.nodes_accepted += o.nodes_accepted;
+        self.rebuilds += o.rebuilds;
+        self.list_entries += o.list_entries;
+    }
+
+    /// The work done since `earlier` (a snapshot of the same running sum).
+    pub fn since(&self, earlier: &WorkCounters) -> WorkCounters {
+        WorkCounters {
+            pair_checks: self.pair_checks.saturating_sub(earlier.pair_checks),
+            pairs_interacting: self
+                .pairs_interacting
+                .saturating_sub(earlier.pairs_interacting),
+            cells_visited: self.cells_visited.saturating_sub(earlier.cells_visited),
+            nodes_opened: self.nodes_opened.saturating_sub(earlier.nodes_opened),
+            nodes_accepted: self.nodes_accepted.saturating_sub(earlier.nodes_accepted),
+            rebuilds: self.rebuilds.saturating_sub(earlier.rebuilds),
+            list_entries: self.list_entries.saturating_sub(earlier.list_entries),
+        }
     }
 }
 
@@ -257,6 +306,13 @@ pub trait ForceKernel<T: Real, const D: usize>: Send {
     /// curve order), as `order[new_slot] = old_slot`, if the kernel benefits from one.
     fn spatial_order(&mut self, _state: &State<T, D>) -> Option<Vec<u32>> {
         None
+    }
+
+    /// Steps between the calls of [`ForceKernel::spatial_order`] by drivers that re-order
+    /// periodically. A kernel that re-sorts only when it rebuilds its own structure asks every
+    /// step and answers `None` in between.
+    fn sort_every(&self) -> u64 {
+        SORT_EVERY
     }
 
     /// The forces on the particles in slots `targets` only, from every particle of `state`:

@@ -18,6 +18,7 @@ fn forces<L: PairLaw<f64>, const D: usize>(
             &KernelParams {
                 theta: 0.0,
                 leaf_size: 4,
+                ..KernelParams::default()
             },
         )
         .unwrap();

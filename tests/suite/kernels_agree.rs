@@ -104,6 +104,7 @@ fn exact_kernels_agree_with_the_reference() {
         KernelKind::Symmetric,
         KernelKind::PerThread,
         KernelKind::CellList,
+        KernelKind::Verlet,
     ];
     for scenario in ScenarioKind::ALL {
         for precision in [Precision::F32, Precision::F64] {

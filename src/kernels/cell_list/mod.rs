@@ -17,8 +17,8 @@
 //! padding), 16 bytes per particle and 8 bytes per bin (at most 4 bins per particle).
 
 mod forces;
-mod grid;
-mod strips;
+pub(super) mod grid;
+pub(super) mod strips;
 #[cfg(test)]
 mod tests;
 

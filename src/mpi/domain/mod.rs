@@ -18,7 +18,6 @@ use super::driver::{Driver, Tally};
 use super::error::MpiError;
 use crate::boundary::Boundary;
 use crate::decomp::regions::{Regions, grid_dims, parse_grid};
-use crate::engine::SORT_EVERY;
 use crate::integrator::{drift, kick};
 use crate::kernels::ForceKernel;
 use crate::physics::PairLaw;
@@ -185,7 +184,7 @@ impl<T: Real, const D: usize> Driver<T, D> for Domain<T, D> {
             self.rebalance(comm)?;
             self.last_rebalance = step;
         }
-        if step.is_multiple_of(SORT_EVERY) {
+        if step.is_multiple_of(self.interior.sort_every()) {
             self.sort();
         }
         self.compute_forces(comm)?;
