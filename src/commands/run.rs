@@ -168,6 +168,18 @@ pub(super) fn print_summary(r: &RunOutcome) {
         "; {} interacting pairs at the end",
         c.pairs_interacting_final
     );
+    if c.total.list_entries > 0 || c.total.rebuilds > 0 {
+        let entries = c.total.list_entries as f64 / steps;
+        let every = match c.total.rebuilds {
+            0 => "no rebuild".to_string(),
+            k => format!("{k} rebuilds, one per {:.1} steps", steps / k as f64),
+        };
+        outln!(
+            "neighbour list    {entries:.4e} entries per step, {every}; pairs inside the cutoff \
+             at the end: {:.1}% of the entries",
+            100.0 * c.pairs_interacting_final as f64 / entries.max(1.0)
+        );
+    }
     outln!(
         "energy            {:.6e} -> {:.6e}, relative drift {:+.3e}",
         r.energy.initial.total(),

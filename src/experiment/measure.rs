@@ -207,11 +207,7 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         boundary: per(sim.phases.boundary, phases0.boundary),
         output: 0.0,
     };
-    let mut work = sim.work;
-    work.pair_checks -= work0.pair_checks;
-    work.cells_visited -= work0.cells_visited;
-    work.nodes_opened -= work0.nodes_opened;
-    work.nodes_accepted -= work0.nodes_accepted;
+    let work = sim.work.since(&work0);
     let force_error = (spec.force_error_sample > 0).then(|| {
         let (median, max) = crate::validate::sampled_force_error(
             law,

@@ -118,6 +118,11 @@ pub struct Summary {
     pub cells_visited_per_step: f64,
     pub nodes_opened_per_step: f64,
     pub nodes_accepted_per_step: f64,
+    /// Verlet list: rebuilds and list entries per step.
+    #[serde(default)]
+    pub rebuilds_per_step: f64,
+    #[serde(default)]
+    pub list_entries_per_step: f64,
     pub pairs_interacting: u64,
     /// Largest |energy drift| of any round, and whether it exceeded the config's limit.
     pub max_energy_drift: f64,
@@ -297,6 +302,8 @@ impl CaseRecord {
             cells_visited_per_step: per_step(&|w| w.cells_visited),
             nodes_opened_per_step: per_step(&|w| w.nodes_opened),
             nodes_accepted_per_step: per_step(&|w| w.nodes_accepted),
+            rebuilds_per_step: per_step(&|w| w.rebuilds),
+            list_entries_per_step: per_step(&|w| w.list_entries),
             pairs_interacting: self.rounds.last().map(|r| r.pairs_interacting).unwrap_or(0),
             max_energy_drift: drift,
             sanity_ok: drift <= max_drift,

@@ -259,6 +259,8 @@ fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, Vec<St
             check("cells_visited", b.cells_visited, c.cells_visited);
             check("nodes_opened", b.nodes_opened, c.nodes_opened);
             check("nodes_accepted", b.nodes_accepted, c.nodes_accepted);
+            check("rebuilds", b.rebuilds, c.rebuilds);
+            check("list_entries", b.list_entries, c.list_entries);
         }
         _ => notes.push(
             "work counters not compared (a file has no initial_work: swept by an older version)"
