@@ -41,6 +41,22 @@ fn energy_drift_is_bounded_for_every_scenario() {
         ),
         (ScenarioKind::LjBox, KernelKind::Naive, 500, 300, None, 2e-3),
         (
+            ScenarioKind::LjBox,
+            KernelKind::Verlet,
+            500,
+            300,
+            None,
+            2e-3,
+        ),
+        (
+            ScenarioKind::LjLiquid,
+            KernelKind::Verlet,
+            2000,
+            300,
+            None,
+            1e-2,
+        ),
+        (
             ScenarioKind::LjLiquid,
             KernelKind::CellList,
             2000,

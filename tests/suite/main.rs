@@ -23,3 +23,4 @@ mod parsers;
 mod report;
 mod runs;
 mod sweep;
+mod verlet;
