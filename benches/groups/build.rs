@@ -1,19 +1,22 @@
-//! The build phase alone: cell-list binning and strip layout, and the octree (Morton keys,
-//! sort, nodes, groups), over a few n.
+//! The build phase alone: cell-list binning and strip layout, the octree (Morton keys, sort,
+//! nodes, groups) and the Verlet list (binning and the half list), over a few n.
 
 use super::{SCENARIOS, criterion, kernels_for, setup, sizes};
 use criterion::measurement::WallTime;
 use criterion::{BenchmarkGroup, BenchmarkId, Criterion, Throughput};
-use nbody_bench::kernels::{CellList, KernelKind, KernelParams, Octree};
+use nbody_bench::kernels::{CellList, KernelKind, KernelParams, Octree, Verlet};
 use nbody_bench::physics::PairLaw;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{System, SystemJob};
 
 fn build(c: &mut Criterion) {
     for scenario in SCENARIOS {
-        for kernel in
-            kernels_for(scenario).filter(|k| matches!(k, KernelKind::CellList | KernelKind::Octree))
-        {
+        for kernel in kernels_for(scenario).filter(|k| {
+            matches!(
+                k,
+                KernelKind::CellList | KernelKind::Octree | KernelKind::Verlet
+            )
+        }) {
             let mut group =
                 c.benchmark_group(format!("build/{}/{}", scenario.name(), kernel.name()));
             for &n in sizes(kernel) {
@@ -52,6 +55,12 @@ impl SystemJob for BuildBench<'_, '_> {
                 let mut tree = Octree::new(system.law, params.theta, params.leaf_size);
                 self.group
                     .bench_function(id, |b| b.iter(|| tree.build(&state)));
+            }
+            KernelKind::Verlet => {
+                let mut list = Verlet::new(system.law, KernelParams::default().skin)
+                    .expect("the law has a cutoff");
+                self.group
+                    .bench_function(id, |b| b.iter(|| list.build(&state)));
             }
             other => unreachable!("{} has no build phase", other.name()),
         }

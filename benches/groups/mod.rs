@@ -25,16 +25,16 @@ pub const SCENARIOS: [ScenarioKind; 2] = [ScenarioKind::LjBox, ScenarioKind::Gal
 /// about a millisecond; the O(n) and O(n log n) ones go further.
 pub fn sizes(kernel: KernelKind) -> &'static [usize] {
     match kernel {
-        KernelKind::CellList | KernelKind::Octree => &[1000, 4000, 16000],
+        KernelKind::CellList | KernelKind::Octree | KernelKind::Verlet => &[1000, 4000, 16000],
         KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => &[500, 1000, 2000],
     }
 }
 
 /// Thread counts for a kernel: one, and every logical CPU for the per-thread kernel, which
-/// exists to use them.
+/// exists to use them, and for the Verlet list, which chooses between one and several parts.
 pub fn thread_counts(kernel: KernelKind) -> Vec<usize> {
     let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-    if kernel == KernelKind::PerThread && cpus > 1 {
+    if matches!(kernel, KernelKind::PerThread | KernelKind::Verlet) && cpus > 1 {
         vec![1, cpus]
     } else {
         vec![1]
