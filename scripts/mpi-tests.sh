@@ -1,9 +1,10 @@
 #!/usr/bin/env bash
 # The MPI tests, run for real: builds with `--features mpi` and checks under `mpirun -n 1..4`
 # that distributed runs end in the state of the serial run (to rounding) with every particle
-# present once, for both decompositions, uneven particle counts, ranks left without particles,
-# particles migrating beyond the neighbouring regions and rebalancing; then the error paths,
-# the JSON outputs, `mpi-bench` and a sweep under the launcher.
+# present once, for both decompositions (the cell list and the Verlet list on the spatial one),
+# uneven particle counts, ranks left without particles, particles migrating beyond the
+# neighbouring regions and rebalancing; then the error paths, the JSON outputs, `mpi-bench` and
+# a sweep under the launcher.
 #
 # Open MPI and libclang (for the bindings) are installed by scripts/install-mpi.sh. The unit and
 # CLI tests built with the feature run in scripts/test.sh. It never skips a test.
@@ -66,6 +67,11 @@ for ranks in 1 2 3 4; do
     check "$ranks" --scenario lj-box --kernel symmetric --decomp allgather -n 2001 --steps 20
     # Spatial decomposition: particles cross rank borders during the run.
     check "$ranks" --scenario lj-box --kernel cell-list --decomp domain -n 3001 --steps 60 ${migration[@]+"${migration[@]}"}
+    # The Verlet list: full lists of the block's targets kept between steps (allgather), and
+    # the owned particles' half list rebuilt as particles migrate (domain); 60 steps cross
+    # many rebuilds.
+    check "$ranks" --scenario lj-box --kernel verlet --decomp allgather -n 2001 --steps 60
+    check "$ranks" --scenario lj-box --kernel verlet --decomp domain -n 3001 --steps 60 ${migration[@]+"${migration[@]}"}
 done
 
 # More kernels and shapes.
@@ -74,6 +80,11 @@ check 2 --scenario coulomb --kernel per-thread --decomp allgather -n 1500 --step
 check 3 --scenario lj-box --kernel cell-list --decomp allgather -n 2001 --steps 20
 check 4 --scenario lj-box --kernel cell-list --decomp domain -n 3001 --steps 60 --rank-grid 2x2 --precision f64 --expect-migration
 check 4 --scenario lj-liquid --kernel cell-list --decomp domain -n 4000 --steps 30 --precision f64 --expect-migration
+check 4 --scenario lj-liquid --kernel verlet --decomp domain -n 4000 --steps 30 --precision f64 --expect-migration
+# The liquid in f64: in f32 its rounding differences grow to near the tolerance in 30 steps.
+check 3 --scenario lj-liquid --kernel verlet --decomp allgather -n 3000 --steps 30 --skin 0.005 --precision f64
+# A list long enough to be split over the threads of each rank.
+check 2 --scenario lj-liquid --kernel verlet --decomp domain -n 8000 --steps 30 --threads 2 --precision f64 --expect-migration
 # Ranks with no particle at all.
 check 4 --scenario lj-box --kernel cell-list --decomp domain -n 3 --steps 20 --no-rebalance --expect-empty-rank
 check 4 --scenario lj-box --kernel symmetric --decomp allgather -n 3 --steps 20 --expect-empty-rank
@@ -84,7 +95,8 @@ check 4 --scenario lj-box --kernel cell-list --decomp domain -n 40 --density 1 -
 check 4 --scenario lj-box --kernel cell-list --decomp domain -n 400 --steps 100 --rank-grid 4x1 --rebalance-above 1.01 --expect-rebalance
 
 # Errors: clear message, exit 2, every rank stops.
-refuses 2 "needs --kernel cell-list" run --decomp domain --scenario lj-box --kernel naive -n 100
+refuses 2 "needs --kernel cell-list or verlet" run --decomp domain --scenario lj-box --kernel naive -n 100
+refuses 2 "--skin applies to the verlet kernel only" run --decomp allgather --scenario lj-box --kernel cell-list -n 100 --skin 0.003
 refuses 1 "needs at least 2 ranks" mpi-bench --out "$TMP/bench.json"
 refuses 3 "still outside the box after one reflection" \
     run --decomp domain --scenario lj-box --kernel cell-list -n 60 --density 20 --dt 0.1 --steps 20

@@ -158,7 +158,7 @@ pub struct RunArgs {
     #[arg(long)]
     pub yes: bool,
     /// Split the run over MPI ranks (start it under `mpirun -n P`): allgather (replicated data,
-    /// any kernel) or domain (spatial regions, cell list). Needs the `mpi` feature.
+    /// any kernel) or domain (spatial regions; cell-list or verlet). Needs the `mpi` feature.
     #[arg(long, value_enum, help_heading = MPI_HEADING)]
     pub decomp: Option<Decomposition>,
     #[command(flatten)]

@@ -23,15 +23,15 @@ pub enum Decomposition {
     /// Replicated data (sources 000 and 004): each rank owns a block of particles, computes
     /// their forces against all particles, and every step an Allgatherv shares the positions.
     Allgather,
-    /// Spatial decomposition (cell list only): each rank owns a region, exchanges ghosts within
-    /// the cutoff with its neighbours and migrates particles that cross its border.
+    /// Spatial decomposition (cell list and Verlet list): each rank owns a region, exchanges
+    /// ghosts within the cutoff with its neighbours and migrates particles that cross its border.
     Domain,
 }
 
 #[derive(Debug, Error, PartialEq)]
 pub enum DecompError {
     #[error(
-        "--decomp domain needs --kernel cell-list (a short-range law with a cutoff); \
+        "--decomp domain needs --kernel cell-list or verlet (a short-range law with a cutoff); \
          use --decomp allgather with {0}"
     )]
     DomainKernel(&'static str),
@@ -51,7 +51,7 @@ impl Decomposition {
     pub fn supports(self, kernel: KernelKind) -> bool {
         match self {
             Decomposition::Allgather => true,
-            Decomposition::Domain => kernel == KernelKind::CellList,
+            Decomposition::Domain => matches!(kernel, KernelKind::CellList | KernelKind::Verlet),
         }
     }
 
@@ -70,12 +70,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn domain_runs_the_cell_list_only() {
+    fn domain_runs_the_short_range_kernels_only() {
         for k in KernelKind::ALL {
             assert!(Decomposition::Allgather.check(k).is_ok());
             assert_eq!(
                 Decomposition::Domain.check(k).is_ok(),
-                k == KernelKind::CellList
+                matches!(k, KernelKind::CellList | KernelKind::Verlet)
             );
         }
         let msg = Decomposition::Domain

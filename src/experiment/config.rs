@@ -467,7 +467,7 @@ impl SweepConfig {
                 return Err(bad(
                     "mpi.decomp",
                     format!(
-                        "has no decomposition for kernel `{}`; domain runs the cell list only, allgather any kernel",
+                        "has no decomposition for kernel `{}`; domain runs the cell list and the Verlet list only, allgather any kernel",
                         k.name()
                     ),
                 ));

@@ -2,8 +2,9 @@
 //! every particle's position; it owns a contiguous block of particles (sizes differing by at
 //! most one), integrates them, and every step an Allgatherv shares the new positions.
 //!
-//! Forces: kernels that visit each target's own pairs (naive, cell list, octree) compute the
-//! block's targets against all particles. The symmetric kernels (symmetric, per-thread) would
+//! Forces: kernels that visit each target's own pairs (naive, cell list, octree, and the Verlet
+//! list through full lists of the block's targets, kept between steps) compute the block's
+//! targets against all particles. The symmetric kernels (symmetric, per-thread) would
 //! lose Newton's third law that way, so each rank evaluates a balanced share of the pair tiles,
 //! adding each force to both ends, and an Allreduce sums the shares (in f64).
 //!

@@ -95,7 +95,9 @@ impl SystemJob for MpiJob<'_> {
                     Box::new(Allgather::new(system, spec.kernel, kernel, comm)?)
                 }
                 Decomposition::Domain => {
-                    let border = spec.kernel.build::<T, L, D>(law, &spec.params)?;
+                    // The border system is made of new particles every step: a Verlet list
+                    // kept between steps would be rebuilt every time, so it gets a cell list.
+                    let border = KernelKind::CellList.build::<T, L, D>(law, &spec.params)?;
                     Box::new(Domain::new(system, kernel, border, &spec.domain, comm)?)
                 }
             };

@@ -1,5 +1,6 @@
-//! Spatial decomposition for the cell list (source 000's second task): each rank owns a
-//! region of the box ([`Regions`]) and the particles in it.
+//! Spatial decomposition for the short-range kernels, the cell list and the Verlet list
+//! (source 000's second task): each rank owns a region of the box ([`Regions`]) and the
+//! particles in it.
 //!
 //! A step: kick, drift and walls on the owned particles; a status exchange (one small
 //! Allgather: errors, far migrants, particle counts); particles that left the region go to its
@@ -9,6 +10,11 @@
 //! neighbour's region are sent to it as ghosts with nonblocking messages while the forces from
 //! the owned particles are computed, and once the ghosts are in, the few particles near a
 //! border get their forces again with the ghosts.
+//!
+//! A Verlet list over the owned particles re-sorts them at its rebuilds (it asks for an order
+//! every step, [`ForceKernel::sort_every`]) and is rebuilt in every step that changed the
+//! number of particles a rank owns (a particle migrated in or out); its slot test keeps it
+//! exact whatever the migration did to the slots.
 
 mod forces;
 mod migrate;
@@ -46,7 +52,8 @@ pub struct DomainOptions {
 }
 
 pub struct Domain<T: Real, const D: usize> {
-    /// Cell lists over the owned particles, and over the particles near the borders.
+    /// The kernel over the owned particles (cell list or Verlet list), and a cell list over
+    /// the particles near the borders.
     interior: Box<dyn ForceKernel<T, D>>,
     border: Box<dyn ForceKernel<T, D>>,
     regions: Regions<D>,
@@ -153,7 +160,7 @@ impl<T: Real, const D: usize> Domain<T, D> {
         Ok(domain)
     }
 
-    /// Puts the owned particles in the cell list's order (locality of the force loop).
+    /// Puts the owned particles in the kernel's bin order (locality of the force loop).
     fn sort(&mut self) {
         if let Some(order) = self.interior.spatial_order(&self.owned) {
             self.owned.permute(&order, &mut [&mut self.forces]);
