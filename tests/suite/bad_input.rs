@@ -287,6 +287,65 @@ fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
 }
 
 #[test]
+fn skin_with_a_kernel_that_ignores_it_or_out_of_range_is_refused() {
+    let run = |kernel: &str, skin: &str| {
+        bin()
+            .args([
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                kernel,
+                "-n",
+                "50",
+            ])
+            .args(["--steps", "2", "--skin", skin])
+            .output()
+            .unwrap()
+    };
+    refused(
+        &run("cell-list", "0.003"),
+        "--skin applies to the verlet kernel only",
+    );
+    for bad in ["0", "-0.001", "inf", "nan"] {
+        let o = run("verlet", bad);
+        assert_eq!(
+            o.status.code(),
+            Some(2),
+            "--skin {bad}: {}",
+            text(&o.stderr)
+        );
+        assert!(text(&o.stderr).contains("--skin"), "{}", text(&o.stderr));
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("run.json");
+    let o = bin()
+        .args([
+            "run",
+            "--scenario",
+            "lj-box",
+            "--kernel",
+            "verlet",
+            "-n",
+            "50",
+        ])
+        .args(["--steps", "2", "--skin", "0.005", "--json"])
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["kernel_params"]["skin"], 0.005);
+    assert!(v["counters"]["total"]["list_entries"].is_u64());
+    assert!(
+        text(&o.stdout).contains("neighbour list"),
+        "{}",
+        text(&o.stdout)
+    );
+}
+
+#[test]
 fn the_trajectory_ends_with_the_final_state() {
     let dir = tempfile::tempdir().unwrap();
     let frames = |steps: &str| {
