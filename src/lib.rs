@@ -29,6 +29,7 @@ pub mod output;
 pub mod physics;
 pub mod plot;
 pub mod real;
+pub mod render;
 pub mod report;
 pub mod run;
 pub mod scenario;
@@ -37,4 +38,5 @@ pub mod state;
 pub mod stats;
 #[doc(hidden)]
 pub mod testing;
+pub mod units;
 pub mod validate;

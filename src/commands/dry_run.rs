@@ -3,12 +3,12 @@
 //! time budget asks first (or, without a terminal, refuses unless `--yes` is given). Nothing
 //! here writes a file or creates a directory.
 
-use super::fmt_ns;
 use crate::cli::SweepArgs;
 use crate::experiment::config::SweepConfig;
-use crate::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed, fmt_duration};
+use crate::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
 use crate::experiment::plan::cases;
 use crate::experiment::results::ResultsFile;
+use crate::units::{Duration, WallTime};
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::Path;
 
@@ -53,7 +53,7 @@ pub fn before_sweep(
     }
     eprintln!(
         "estimated wall time: {} (probe took {:.2} s; `--dry-run` lists the cases)",
-        fmt_duration(est.total_s),
+        WallTime(est.total_s),
         probed.seconds
     );
     if est.total_s <= LONG_SWEEP_S || config.measure.budget_s > 0.0 || args.yes {
@@ -62,13 +62,13 @@ pub fn before_sweep(
     let mut longest: Vec<_> = est.cases.iter().collect();
     longest.sort_by(|a, b| b.wall_s.total_cmp(&a.wall_s));
     for c in longest.iter().take(3) {
-        eprintln!("  {:<52} {}", c.case.key(), fmt_duration(c.wall_s));
+        eprintln!("  {:<52} {}", c.case.key(), WallTime(c.wall_s));
     }
     if std::io::stdin().is_terminal() {
         eprint!(
             "sweep `{}` is estimated at {}, more than an hour; continue? [y/N] ",
             config.name,
-            fmt_duration(est.total_s)
+            WallTime(est.total_s)
         );
         std::io::stderr().flush()?;
         let mut answer = String::new();
@@ -83,7 +83,7 @@ pub fn before_sweep(
          measure.budget_s is 0; pass --yes to start it anyway, or set measure.budget_s in {} to \
          stop starting cases after that many seconds (`--resume` continues later)",
         config.name,
-        fmt_duration(est.total_s),
+        WallTime(est.total_s),
         est.total_s,
         args.config.display()
     )
@@ -142,8 +142,8 @@ fn print_plan(
             theta,
             c.rounds,
             c.samples,
-            fmt_ns(c.step_s * 1e9),
-            fmt_duration(c.wall_s)
+            Duration(c.step_s),
+            WallTime(c.wall_s)
         );
     }
     let cases_s = est.total_s - est.calibration_s;
@@ -158,9 +158,9 @@ fn print_plan(
     );
     outln!(
         "estimated wall time: {} (cases {}, calibration {})",
-        fmt_duration(est.total_s),
-        fmt_duration(cases_s),
-        fmt_duration(est.calibration_s)
+        WallTime(est.total_s),
+        WallTime(cases_s),
+        WallTime(est.calibration_s)
     );
     if let (Some(_), Some(path)) = (&args.resume, path) {
         outln!(

@@ -12,8 +12,6 @@ mod run;
 mod sweep;
 mod validate;
 
-pub use run::fmt_ns;
-
 use crate::cli::{Cli, Command, KernelArgs, SystemArgs};
 use crate::kernels::{KernelKind, KernelParams};
 use crate::scenario::{ScenarioKind, Setup};

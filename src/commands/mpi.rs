@@ -36,6 +36,7 @@ mod with_mpi {
     use crate::kernels::KernelKind;
     use crate::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
     use crate::scenario::Precision;
+    use crate::units::Duration;
     use anyhow::Context;
     use std::path::PathBuf;
 
@@ -364,13 +365,13 @@ mod with_mpi {
             outln!(
                 "{:>10} {:>14} {:>14.3} {:>18}",
                 p.bytes,
-                crate::commands::fmt_ns(pp * 1e9),
+                Duration(pp),
                 if pp > 0.0 {
                     p.bytes as f64 / pp * 1e-9
                 } else {
                     0.0
                 },
-                crate::commands::fmt_ns(ag * 1e9)
+                Duration(ag)
             );
         }
         let text = serde_json::to_string_pretty(&file).context("serializing the timings")?;

@@ -1,6 +1,7 @@
 use super::{kernel_params, setup};
 use crate::cli::RunArgs;
 use crate::run::{RunJob, RunOutcome, RunSpec, TrajectorySpec, logical_cpus};
+use crate::units::{Duration, WallTime};
 use anyhow::Context;
 
 pub fn run(args: RunArgs) -> anyhow::Result<i32> {
@@ -85,9 +86,9 @@ pub(crate) fn refuse_long_run(
         anyhow::bail!(
             "this run is estimated at {} ({steps} step{} of {n} particles, from a probe at small n); \
              it is refused above {}: lower --steps or -n, or pass --yes to run it anyway",
-            crate::experiment::estimate::fmt_duration(wall_s),
+            WallTime(wall_s),
             if steps == 1 { "" } else { "s" },
-            crate::experiment::estimate::fmt_duration(limit),
+            WallTime(limit),
         );
     }
     Ok(())
@@ -123,12 +124,15 @@ pub(super) fn print_summary(r: &RunOutcome) {
     let p = &t.per_step_ns;
     outln!(
         "time per step     p50 {}  p90 {}  p99 {}  max {}",
-        fmt_ns(p.p50 as f64),
-        fmt_ns(p.p90 as f64),
-        fmt_ns(p.p99 as f64),
-        fmt_ns(p.max as f64)
+        Duration::from_ns(p.p50 as f64),
+        Duration::from_ns(p.p90 as f64),
+        Duration::from_ns(p.p99 as f64),
+        Duration::from_ns(p.max as f64)
     );
-    outln!("per particle-step {}", fmt_ns(t.ns_per_particle_step));
+    outln!(
+        "per particle-step {}",
+        Duration::from_ns(t.ns_per_particle_step)
+    );
     outln!(
         "throughput        {:.3e} particle-steps/s, {:.3e} pair-evaluations/s",
         r.throughput.particle_steps_per_s,
@@ -174,17 +178,4 @@ pub(super) fn print_summary(r: &RunOutcome) {
         r.energy.last.total(),
         r.energy.rel_drift
     );
-}
-
-/// A duration in ns, printed with a readable unit.
-pub fn fmt_ns(ns: f64) -> String {
-    if ns >= 1e9 {
-        format!("{:.3} s", ns * 1e-9)
-    } else if ns >= 1e6 {
-        format!("{:.3} ms", ns * 1e-6)
-    } else if ns >= 1e3 {
-        format!("{:.3} us", ns * 1e-3)
-    } else {
-        format!("{ns:.2} ns")
-    }
 }

@@ -2,6 +2,7 @@ use super::{kernel_params, setup};
 use crate::cli::ValidateArgs;
 use crate::kernels::KernelKind;
 use crate::scenario::ScenarioKind;
+use crate::units::WallTime;
 use crate::validate::{ScenarioCheck, ValidateJob};
 use std::path::PathBuf;
 
@@ -107,8 +108,8 @@ fn refuse_long_check(
             "checking {} at n = {n} is estimated at {} (the check at n = {PROBE_N}, carried as n²); \
              it is refused above {}: lower -n, or pass --yes to run it anyway",
             setup.scenario.name(),
-            crate::experiment::estimate::fmt_duration(wall_s),
-            crate::experiment::estimate::fmt_duration(limit),
+            WallTime(wall_s),
+            WallTime(limit),
         );
     }
     Ok(())

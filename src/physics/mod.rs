@@ -44,6 +44,16 @@ impl LawKind {
     pub fn is_inverse_square(self) -> bool {
         matches!(self, LawKind::Coulomb | LawKind::Gravity)
     }
+
+    /// Nominal floating-point operations per pair evaluation in our pair loops (a square root
+    /// and a division count as one each), to express pair rates as a share of the FMA peak.
+    pub fn flops_per_pair(self) -> f64 {
+        match self {
+            LawKind::LennardJones => 18.0,
+            LawKind::Gravity => 20.0,
+            LawKind::Coulomb => 21.0,
+        }
+    }
 }
 
 /// A central pair interaction.
