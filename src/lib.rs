@@ -4,7 +4,9 @@
 //! Layers, bottom up: [`real`] and [`simd`] (precision and instruction set), [`state`] and
 //! [`physics`] (particles and pair laws), [`kernels`] (ways of visiting the pairs),
 //! [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
-//! [`run`] and [`validate`] (measured runs and force checks), [`output`], and the CLI.
+//! [`run`] and [`validate`] (measured runs and force checks), [`output`]; above them the
+//! experiment runner, the analysis, its rendering and the gate. The command line is the binary
+//! crate's (`src/main.rs`, `src/cli/`), so nothing here can depend on it.
 
 // First, so that its `outln!` and `out!` macros are in scope in every module below.
 #[macro_use]
@@ -13,8 +15,6 @@ pub mod console;
 pub mod analysis;
 pub mod boundary;
 pub mod calibrate;
-pub mod cli;
-pub mod commands;
 pub mod decomp;
 pub mod engine;
 pub mod experiment;

@@ -3,12 +3,12 @@
 //! time budget asks first (or, without a terminal, refuses unless `--yes` is given). Nothing
 //! here writes a file or creates a directory.
 
-use crate::cli::SweepArgs;
-use crate::experiment::config::SweepConfig;
-use crate::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
-use crate::experiment::plan::cases;
-use crate::experiment::results::ResultsFile;
-use crate::units::{Duration, WallTime};
+use crate::cli::args::SweepArgs;
+use nbody_bench::experiment::config::SweepConfig;
+use nbody_bench::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
+use nbody_bench::experiment::plan::cases;
+use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::units::{Duration, WallTime};
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::Path;
 
@@ -45,7 +45,7 @@ pub fn before_sweep(
     let planned = cases(config);
     let probed = estimate::probe(config, &planned)?;
     let calibrate = !args.no_calibration;
-    let logical = crate::run::logical_cpus();
+    let logical = nbody_bench::run::logical_cpus();
     let est = estimate::estimate(config, &probed.cases, &done, calibrate, logical);
     if args.dry_run {
         print_plan(args, config, &est, &probed, logical, path);
@@ -184,7 +184,7 @@ fn print_plan(
         Some(path) => outln!("results would go to {}", path.display()),
         None => outln!(
             "results would go to a new run directory {}/<UTC time>/",
-            crate::experiment::locate::runs_dir(&config.out, &config.name).display()
+            nbody_bench::experiment::locate::runs_dir(&config.out, &config.name).display()
         ),
     }
     outln!("estimate_s: {:.3}", est.total_s);

@@ -1,11 +1,11 @@
-use crate::cli::SweepArgs;
-use crate::experiment::config::SweepConfig;
-use crate::experiment::locate;
-use crate::experiment::measure::WallClock;
-use crate::experiment::progress;
-use crate::experiment::results::{ResultsFile, utc_now};
-use crate::experiment::runner::{SweepOptions, run_sweep};
-use crate::units::Duration;
+use crate::cli::args::SweepArgs;
+use nbody_bench::experiment::config::SweepConfig;
+use nbody_bench::experiment::locate;
+use nbody_bench::experiment::measure::WallClock;
+use nbody_bench::experiment::progress;
+use nbody_bench::experiment::results::{ResultsFile, utc_now};
+use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
+use nbody_bench::units::Duration;
 use std::path::{Path, PathBuf};
 
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
@@ -13,7 +13,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let (config, text) = SweepConfig::load(&config_path)?;
     let target = where_to_write(&args, &config)?;
     let existing = match &target {
-        Target::Out => Some(crate::experiment::runner::results_path(
+        Target::Out => Some(nbody_bench::experiment::runner::results_path(
             &config,
             args.out.as_deref(),
         )),

@@ -1,7 +1,7 @@
 use super::{kernel_params, setup};
-use crate::cli::RunArgs;
-use crate::run::{RunJob, RunOutcome, RunSpec, TrajectorySpec, logical_cpus};
-use crate::units::{Duration, WallTime};
+use crate::cli::args::RunArgs;
+use nbody_bench::run::{RunJob, RunOutcome, RunSpec, TrajectorySpec, logical_cpus};
+use nbody_bench::units::{Duration, WallTime};
 use anyhow::Context;
 
 pub fn run(args: RunArgs) -> anyhow::Result<i32> {
@@ -14,13 +14,13 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     .into_iter()
     .filter_map(|(flag, path)| Some((flag, path?)))
     .collect();
-    crate::output::check_outputs(&outputs, &[])?;
+    nbody_bench::output::check_outputs(&outputs, &[])?;
     if let Some(decomp) = args.decomp {
         return super::mpi::run(args, decomp);
     }
     let setup = setup(args.scenario, &args.system);
     setup.validate()?;
-    crate::run::check_memory(&setup, args.kernel, args.kernel_args.threads, 1)?;
+    nbody_bench::run::check_memory(&setup, args.kernel, args.kernel_args.threads, 1)?;
     if !args.yes {
         refuse_long_run(&setup, args.kernel, &args.kernel_args, args.steps as u64)?;
     }
@@ -47,28 +47,28 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     print_summary(&outcome);
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
-        crate::output::write_atomic(path, text.as_bytes())?;
+        nbody_bench::output::write_atomic(path, text.as_bytes())?;
         outln!("result written to {}", path.display());
     }
     Ok(0)
 }
 
 /// Runs this small need no estimate: even the naive kernel in f64 finishes them in minutes.
-const SMALL_RUN_N: usize = crate::experiment::estimate::PROBE_MAX_N;
+const SMALL_RUN_N: usize = nbody_bench::experiment::estimate::PROBE_MAX_N;
 const SMALL_RUN_STEPS: u64 = 100_000;
 
 /// Refuses a run estimated at more than an hour (the sweep's limit) unless `--yes` is given.
 pub(crate) fn refuse_long_run(
-    setup: &crate::scenario::Setup,
-    kernel: crate::kernels::KernelKind,
-    kernel_args: &crate::cli::KernelArgs,
+    setup: &nbody_bench::scenario::Setup,
+    kernel: nbody_bench::kernels::KernelKind,
+    kernel_args: &crate::cli::args::KernelArgs,
     steps: u64,
 ) -> anyhow::Result<()> {
     let n = setup.n();
     if n <= SMALL_RUN_N && steps <= SMALL_RUN_STEPS {
         return Ok(());
     }
-    let case = crate::experiment::plan::Case {
+    let case = nbody_bench::experiment::plan::Case {
         scenario: setup.scenario,
         kernel,
         n,
@@ -80,7 +80,7 @@ pub(crate) fn refuse_long_run(
         time_factor: 1,
         decomp: None,
     };
-    let wall_s = crate::experiment::estimate::run_seconds(&case, steps, logical_cpus())?;
+    let wall_s = nbody_bench::experiment::estimate::run_seconds(&case, steps, logical_cpus())?;
     let limit = super::dry_run::LONG_SWEEP_S;
     if wall_s > limit {
         anyhow::bail!(
