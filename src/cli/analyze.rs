@@ -1,7 +1,7 @@
 //! `analyze`: refit and re-plot a saved sweep.
 
-use nbody_bench::analysis;
 use crate::cli::args::AnalyzeArgs;
+use nbody_bench::analysis;
 use nbody_bench::experiment::locate;
 use nbody_bench::experiment::results::ResultsFile;
 use nbody_bench::render::Written;

@@ -1,10 +1,10 @@
 //! Command-line interface: argument definitions only; the work is in `commands`.
 
+use clap::{Args, Parser, Subcommand};
 use nbody_bench::decomp::Decomposition;
 use nbody_bench::kernels::KernelKind;
 use nbody_bench::output::nbview::NbviewFormat;
 use nbody_bench::scenario::{Precision, ScenarioKind};
-use clap::{Args, Parser, Subcommand};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]

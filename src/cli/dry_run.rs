@@ -189,3 +189,48 @@ fn print_plan(
     }
     outln!("estimate_s: {:.3}", est.total_s);
 }
+
+/// Runs this small need no estimate: even the naive kernel in f64 finishes them in minutes.
+const SMALL_RUN_N: usize = nbody_bench::experiment::estimate::PROBE_MAX_N;
+const SMALL_RUN_STEPS: u64 = 100_000;
+
+/// Refuses a run estimated at more than an hour (the sweep's limit) unless `--yes` is given.
+pub fn refuse_long_run(
+    setup: &nbody_bench::scenario::Setup,
+    kernel: nbody_bench::kernels::KernelKind,
+    kernel_args: &crate::cli::args::KernelArgs,
+    steps: u64,
+) -> anyhow::Result<()> {
+    let n = setup.n();
+    if n <= SMALL_RUN_N && steps <= SMALL_RUN_STEPS {
+        return Ok(());
+    }
+    let case = nbody_bench::experiment::plan::Case {
+        scenario: setup.scenario,
+        kernel,
+        n,
+        threads: kernel_args.threads,
+        ranks: 1,
+        theta: kernel_args.theta,
+        seed: setup.seed,
+        precision: setup.precision,
+        time_factor: 1,
+        decomp: None,
+    };
+    let wall_s = nbody_bench::experiment::estimate::run_seconds(
+        &case,
+        steps,
+        nbody_bench::run::logical_cpus(),
+    )?;
+    let limit = LONG_SWEEP_S;
+    if wall_s > limit {
+        anyhow::bail!(
+            "this run is estimated at {} ({steps} step{} of {n} particles, from a probe at small n); \
+             it is refused above {}: lower --steps or -n, or pass --yes to run it anyway",
+            WallTime(wall_s),
+            if steps == 1 { "" } else { "s" },
+            WallTime(limit),
+        );
+    }
+    Ok(())
+}

@@ -2,9 +2,9 @@
 
 use super::fit_tables;
 use crate::cli::args::{CostModel, FitArgs, FitModel};
+use anyhow::{Context, bail};
 use nbody_bench::fit::csv::{self, WeakTable};
 use nbody_bench::fit::{ComplexityClass, fit_power, fit_strong, fit_weak, fit_weak_with_n};
-use anyhow::{Context, bail};
 use serde::Serialize;
 use std::path::Path;
 

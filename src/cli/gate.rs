@@ -2,9 +2,9 @@
 //! baseline file on its machine class, else A/B against the baseline's revision).
 
 use crate::cli::args::GateArgs;
+use nbody_bench::clock::WallClock;
 use nbody_bench::experiment::config::SweepConfig;
 use nbody_bench::experiment::locate;
-use nbody_bench::experiment::measure::WallClock;
 use nbody_bench::experiment::results::{ResultsFile, utc_now};
 use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
 use nbody_bench::gate::ab::{self, AbPlan};

@@ -13,6 +13,7 @@ mod list;
 mod mpi;
 mod report;
 mod run;
+mod summary;
 mod sweep;
 mod validate;
 

@@ -30,14 +30,14 @@ pub use with_mpi::{bench, check, run};
 mod with_mpi {
     use super::*;
     use crate::cli::args::{KernelArgs, MpiOptions};
-    use crate::cli::run::print_summary;
+    use crate::cli::summary::print_summary;
     use crate::cli::{kernel_params, setup};
+    use anyhow::Context;
     use nbody_bench::decomp::stats::MpiReport;
     use nbody_bench::kernels::KernelKind;
     use nbody_bench::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
     use nbody_bench::scenario::Precision;
     use nbody_bench::units::Duration;
-    use anyhow::Context;
     use std::path::PathBuf;
 
     /// Prints an error on the ranks that should, and gives exit code 2.
@@ -120,7 +120,7 @@ mod with_mpi {
             let setup = setup(args.scenario, &args.system);
             if setup.validate().is_ok() {
                 let steps = (args.steps + args.mpi.warmup_steps) as u64;
-                crate::cli::run::refuse_long_run(
+                crate::cli::dry_run::refuse_long_run(
                     &setup,
                     args.kernel,
                     &args.kernel_args,

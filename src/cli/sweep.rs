@@ -1,7 +1,7 @@
 use crate::cli::args::SweepArgs;
+use nbody_bench::clock::WallClock;
 use nbody_bench::experiment::config::SweepConfig;
 use nbody_bench::experiment::locate;
-use nbody_bench::experiment::measure::WallClock;
 use nbody_bench::experiment::progress;
 use nbody_bench::experiment::results::{ResultsFile, utc_now};
 use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
