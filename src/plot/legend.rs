@@ -1,6 +1,6 @@
-//! Markers and the legend. The legend is plotters' own series-label box, placed in a column
-//! right of the plot area so that it never covers data; labels too long for the column wrap
-//! onto a second line.
+//! Markers, legend samples and the legend. The legend is plotters' own series-label box,
+//! drawn in a column right of the plot area so that it never covers data; labels too long for
+//! the column wrap onto a second line.
 
 use plotters::element::{DashedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
@@ -10,7 +10,7 @@ use super::page::{Area, LEGEND_SIZE, style, width, wrap};
 use super::palette::Marker;
 use super::render::{DrawResult, err};
 
-pub const MARKER_RADIUS: i32 = 5;
+const MARKER_RADIUS: i32 = 5;
 pub const LINE_WIDTH: u32 = 3;
 pub const DASH: (i32, i32) = (9, 6);
 const SWATCH_WIDTH: i32 = 30;

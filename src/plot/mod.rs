@@ -4,8 +4,9 @@
 //! [`StackedBars`] describe a figure with plain numbers and strings; [`figures`] builds the
 //! figures this project reports from per-kernel measurements. [`render`] and
 //! [`render_stacked`] draw them once, to SVG with plotters, and rasterize that SVG with resvg,
-//! both with an embedded font, writing `stem.svg` and `stem.png` (1000×650) atomically. Without the `plot` cargo feature the types and
-//! constructors remain, and rendering returns [`PlotError::Disabled`].
+//! both with an embedded font, writing `stem.svg` and `stem.png` (1000×650) atomically.
+//! Without the `plot` cargo feature the types and constructors remain, and rendering returns
+//! [`PlotError::Disabled`].
 
 #[cfg_attr(not(feature = "plot"), allow(dead_code))]
 mod axis;

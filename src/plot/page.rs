@@ -15,11 +15,11 @@ use super::render::{DrawResult, err};
 pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 pub type Plot<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<ResolvedAxis, ResolvedAxis>>;
 
-pub const TITLE_SIZE: f64 = 22.0;
+const TITLE_SIZE: f64 = 22.0;
 pub const TICK_SIZE: f64 = 14.0;
-pub const AXIS_LABEL_SIZE: f64 = 16.0;
+const AXIS_LABEL_SIZE: f64 = 16.0;
 pub const LEGEND_SIZE: f64 = 14.0;
-pub const CAPTION_SIZE: f64 = 13.0;
+const CAPTION_SIZE: f64 = 13.0;
 pub const NOTE_SIZE: f64 = 12.0;
 const TEXT_COLOR: RGBColor = RGBColor(0x22, 0x22, 0x22);
 pub const MUTED_COLOR: RGBColor = RGBColor(0x55, 0x55, 0x55);

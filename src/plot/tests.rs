@@ -269,11 +269,8 @@ fn kernel_figures_render_for_every_input() {
             ("karp-flatt", figures::karp_flatt(&kernels, CAPTION)),
         ];
         for (name, chart) in charts {
-            render_and_check(
-                &chart,
-                dir.path(),
-                &format!("{name}-{}", case.replace(' ', "-")),
-            );
+            let stem = format!("{name}-{}", case.replace(' ', "-"));
+            render_and_check(&chart, dir.path(), &stem);
         }
     }
 }
@@ -294,7 +291,7 @@ fn a_missing_series_fails_the_check() {
 }
 
 #[test]
-fn detail_figures_render_for_every_input() {
+fn bar_figures_render_for_every_input() {
     let dir = tempfile::tempdir().unwrap();
     let phase = |case: &str, v: f64| PhaseTimes {
         case: case.into(),
@@ -330,7 +327,11 @@ fn detail_figures_render_for_every_input() {
             check(&rendered, &texts, &drawn);
         }
     }
+}
 
+#[test]
+fn detail_figures_render_for_every_input() {
+    let dir = tempfile::tempdir().unwrap();
     let pct = |kernel: &str, p50: f64| Percentiles {
         kernel: kernel.into(),
         p50,
@@ -347,16 +348,22 @@ fn detail_figures_render_for_every_input() {
         name: "galaxy".into(),
         points,
     };
-    let measured = vec![
+    let measured = [
         Measured::with_ci(1.0, 1e-4, 9e-5, 1.2e-4),
         Measured::new(2.0, 0.0),
     ];
-    let predicted = Curve::new("model", vec![(1.0, 1e-4), (8.0, 8e-4)])
+    let model = Curve::new("model", vec![(1.0, 1e-4), (8.0, 8e-4)])
         .with_band(vec![(1.0, 5e-5, 2e-4), (8.0, 4e-4, 1.6e-3)]);
-    let comm = |x: Axis, measured: &[Measured], predicted: &Curve| CommTimes {
-        x,
-        measured: measured.to_vec(),
-        predicted: predicted.clone(),
+    let comm = |x: Axis, measured: &[Measured], predicted: &Curve| {
+        let (measured, predicted) = (measured.to_vec(), predicted.clone());
+        figures::comm_time(
+            &CommTimes {
+                x,
+                measured,
+                predicted,
+            },
+            CAPTION,
+        )
     };
     let three = [
         pct("naive", 1e-3),
@@ -375,22 +382,9 @@ fn detail_figures_render_for_every_input() {
         figures::octree_accuracy(&[], CAPTION),
         figures::octree_accuracy(&[sweep(vec![theta(0.5, 1e-2, 3e-4)])], CAPTION),
         figures::octree_accuracy(&[sweep(thetas)], CAPTION),
-        figures::comm_time(
-            &comm(
-                Axis::linear("ranks").unit(Unit::Count),
-                &measured,
-                &predicted,
-            ),
-            CAPTION,
-        ),
-        figures::comm_time(
-            &comm(Axis::log("bytes").unit(Unit::Bytes), &measured, &predicted),
-            CAPTION,
-        ),
-        figures::comm_time(
-            &comm(Axis::linear("ranks"), &[], &Curve::new("model", vec![])),
-            CAPTION,
-        ),
+        comm(Axis::linear("ranks").unit(Unit::Count), &measured, &model),
+        comm(Axis::log("bytes").unit(Unit::Bytes), &measured, &model),
+        comm(Axis::linear("ranks"), &[], &Curve::new("model", vec![])),
     ];
     for (i, chart) in charts.iter().enumerate() {
         render_and_check(chart, dir.path(), &format!("detail-{i}"));
