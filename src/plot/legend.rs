@@ -6,9 +6,8 @@ use plotters::element::{DashedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
 use plotters_backend::{BackendCoord, DrawingErrorKind};
 
-use super::page::{Area, LEGEND_SIZE, style, width, wrap};
 use super::palette::Marker;
-use super::render::{DrawResult, err};
+use super::text::{Area, DrawResult, LEGEND_SIZE, err, style, width, wrap};
 
 const MARKER_RADIUS: i32 = 5;
 pub const LINE_WIDTH: u32 = 3;

@@ -30,6 +30,7 @@ mod page;
 mod render;
 #[cfg(all(test, feature = "plot"))]
 mod tests;
+mod text;
 
 pub use format::value_label as format_value;
 pub use spec::{

@@ -7,8 +7,8 @@ use resvg::{tiny_skia, usvg};
 use std::fs;
 use std::path::Path;
 
-use super::page::Area;
 use super::spec::Rendered;
+use super::text::Area;
 use super::{PlotError, font};
 use crate::output::write_atomic;
 
@@ -20,11 +20,7 @@ pub const SIZE: (u32, u32) = (1000, 650);
 /// viewers use their own bold face.
 const FAKE_BOLD: &str = "text[font-weight=bold] { stroke: #222222; stroke-width: 1.0 }";
 
-pub type DrawResult = Result<(), String>;
-
-pub fn err(e: impl std::fmt::Display) -> String {
-    e.to_string()
-}
+pub use super::text::{DrawResult, err};
 
 /// Draws a figure with `draw` into `dir/stem.svg` and `dir/stem.png`, creating `dir` if needed.
 pub fn render_figure(
