@@ -84,8 +84,9 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     fn cutoff(&self) -> Option<T>;
 }
 
-/// Adds the force of source `j` on target `i` to `acc` given the separation `dx = x_j − x_i`.
-/// Shared by every kernel's scalar paths.
+/// The force of source `j` on target `i` given the separation `dx = x_j − x_i`, returned: the
+/// law's pair interaction written out plainly, for the f64 reference sum of `validate` and the
+/// tests of the SIMD rows (the kernels themselves go through `kernels::rows`).
 #[inline(always)]
 pub fn pair_force<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,
