@@ -4,7 +4,9 @@
 //! Layers, bottom up: [`real`] and [`simd`] (precision and instruction set), [`state`] and
 //! [`physics`] (particles and pair laws), [`kernels`] (ways of visiting the pairs),
 //! [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
-//! [`run`] and [`validate`] (measured runs and force checks), [`output`], and the CLI.
+//! [`run`] and [`validate`] (measured runs and force checks), [`output`]; above them the
+//! experiment runner, the analysis, its rendering and the gate. The command line is the binary
+//! crate's (`src/main.rs`, `src/cli/`), so nothing here can depend on it.
 
 // First, so that its `outln!` and `out!` macros are in scope in every module below.
 #[macro_use]
@@ -13,8 +15,7 @@ pub mod console;
 pub mod analysis;
 pub mod boundary;
 pub mod calibrate;
-pub mod cli;
-pub mod commands;
+pub mod clock;
 pub mod decomp;
 pub mod engine;
 pub mod experiment;
@@ -29,6 +30,7 @@ pub mod output;
 pub mod physics;
 pub mod plot;
 pub mod real;
+pub mod render;
 pub mod report;
 pub mod run;
 pub mod scenario;
@@ -37,4 +39,5 @@ pub mod state;
 pub mod stats;
 #[doc(hidden)]
 pub mod testing;
+pub mod units;
 pub mod validate;

@@ -1,5 +1,10 @@
 use clap::Parser;
-use nbody_bench::cli::Cli;
+#[macro_use]
+extern crate nbody_bench;
+
+mod cli;
+
+use cli::args::Cli;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -9,10 +14,10 @@ fn main() -> ExitCode {
     // written under a temporary name and renamed into place, and whatever is half-written when
     // the signal comes is removed here. Results saved before the signal are whole.
     let _ = ctrlc::set_handler(|| nbody_bench::output::remove_temporaries_and_exit(130));
-    let code = match nbody_bench::commands::dispatch(cli) {
+    let code = match cli::dispatch(cli) {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {}", nbody_bench::commands::error_chain(&err));
+            eprintln!("error: {}", cli::error_chain(&err));
             2
         }
     };

@@ -1,6 +1,7 @@
 //! One measured run: a scenario integrated with one kernel for a number of steps, timed per
 //! step and per phase, with work counters and an energy check. Used by `run` and by sweeps.
 
+use crate::clock::Clock;
 use crate::engine::{Energy, PhaseTimes, Simulation};
 use crate::kernels::{KernelKind, KernelParams, WorkCounters, footprint};
 use crate::output::nbview::{self, NbviewFormat};
@@ -12,7 +13,6 @@ use crate::simd;
 use crate::stats::StepPercentiles;
 use serde::Serialize;
 use std::path::PathBuf;
-use std::time::Instant;
 
 /// Schema tag of the `run --json` document.
 pub const RUN_SCHEMA: &str = "nbody-bench/run/v1";
@@ -136,10 +136,11 @@ pub struct MomentumCheck {
     pub last: Vec<f64>,
 }
 
-/// Runs `spec` on the system it is given (see [`crate::scenario::Setup::dispatch`]).
-pub struct RunJob<'a>(pub &'a RunSpec);
+/// Runs `spec` on the system it is given (see [`crate::scenario::Setup::dispatch`]), its
+/// steps timed by the clock.
+pub struct RunJob<'a, C: Clock>(pub &'a RunSpec, pub &'a C);
 
-impl SystemJob for RunJob<'_> {
+impl<C: Clock> SystemJob for RunJob<'_, C> {
     type Output = Result<RunOutcome, RunError>;
 
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
@@ -154,12 +155,14 @@ impl SystemJob for RunJob<'_> {
             })?;
         let info = system.info.clone();
         let law = system.law.kind().name();
-        pool.install(|| measure(spec, &info, law, Simulation::new(system, kernel)))
+        let clock = self.1;
+        pool.install(|| measure(spec, clock, &info, law, Simulation::new(system, kernel)))
     }
 }
 
-fn measure<T: Real, const D: usize>(
+fn measure<T: Real, const D: usize, C: Clock>(
     spec: &RunSpec,
+    clock: &C,
     info: &SystemInfo,
     law: &'static str,
     mut sim: Simulation<T, D>,
@@ -173,21 +176,21 @@ fn measure<T: Real, const D: usize>(
     };
     // A histogram, not a vector: memory must not grow with --steps.
     let mut step_ns = crate::stats::StepHistogram::new();
-    let start = Instant::now();
+    let start = clock.now();
     for _ in 0..spec.steps {
-        let t = Instant::now();
+        let t = clock.now();
         sim.step()?;
-        step_ns.record(t.elapsed().as_nanos() as u64);
+        step_ns.record((clock.now() - t).as_nanos() as u64);
         if let Some(tr) = trajectory
             .as_mut()
             .filter(|tr| sim.step.is_multiple_of(tr.every))
         {
-            let t = Instant::now();
+            let t = clock.now();
             tr.frame(&sim)?;
-            sim.phases.output += t.elapsed().as_secs_f64();
+            sim.phases.output += (clock.now() - t).as_secs_f64();
         }
     }
-    let total_s = start.elapsed().as_secs_f64();
+    let total_s = (clock.now() - start).as_secs_f64();
     let e1 = sim.probe();
     if !e1.total().is_finite() {
         return Err(RunError::EnergyBlowUp {

@@ -2,17 +2,22 @@
 //! fixed n (strong scaling), over p with the work per worker held (weak scaling), and over θ
 //! (octree accuracy). Pure data; the fits and plots are elsewhere.
 
+use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
 use crate::experiment::config::Study;
 use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::KernelKind;
-use crate::scenario::ScenarioKind;
+use crate::scenario::{Precision, ScenarioKind};
 use crate::stats::StepPercentiles;
 use serde::Serialize;
 
 /// One measured case as the analysis sees it.
 #[derive(Clone, Debug, Serialize)]
 pub struct Point {
+    /// The case itself, typed; consumers read kernel, scenario and precision from here, never
+    /// from the key.
+    #[serde(skip)]
+    pub case: crate::experiment::plan::Case,
     pub key: String,
     pub n: usize,
     pub threads: usize,
@@ -21,7 +26,7 @@ pub struct Point {
     pub time_factor: u64,
     pub theta: Option<f64>,
     /// MPI decomposition of a case run under a launcher.
-    pub decomp: Option<String>,
+    pub decomp: Option<Decomposition>,
     /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases).
     pub comm_s_per_step: Option<f64>,
     pub bytes_per_step: Option<f64>,
@@ -45,6 +50,11 @@ impl Point {
     pub fn p(&self) -> usize {
         self.threads * self.ranks
     }
+
+    /// Whether this case ran with `p` workers, `p` as a fit gives it back (a float).
+    pub fn has_workers(&self, p: f64) -> bool {
+        p.is_finite() && p >= 0.0 && self.p() == p.round() as usize
+    }
 }
 
 /// What a series holds fixed. `None` fields vary along the series or do not apply.
@@ -52,12 +62,12 @@ impl Point {
 pub struct SeriesKey {
     pub scenario: ScenarioKind,
     pub kernel: KernelKind,
-    pub precision: String,
+    pub precision: Precision,
     pub theta: Option<f64>,
     pub n: Option<usize>,
     pub threads: Option<usize>,
     pub ranks: Option<usize>,
-    pub decomp: Option<String>,
+    pub decomp: Option<Decomposition>,
 }
 
 impl SeriesKey {
@@ -67,8 +77,8 @@ impl SeriesKey {
         if let Some(t) = self.theta {
             s.push_str(&format!(" θ={t}"));
         }
-        if let Some(d) = &self.decomp {
-            s.push_str(&format!(" ({d})"));
+        if let Some(d) = self.decomp {
+            s.push_str(&format!(" ({})", d.name()));
         }
         match (self.threads, self.ranks) {
             (Some(t), Some(1)) if t > 1 => s.push_str(&format!(", {t} threads")),
@@ -111,12 +121,12 @@ pub fn group(results: &ResultsFile) -> Groups {
     let base = |c: &Point, r: &CaseRecord| SeriesKey {
         scenario: r.case.scenario,
         kernel: r.case.kernel,
-        precision: precision_name(r),
+        precision: precision_of(r),
         theta: c.theta,
         n: Some(c.n),
         threads: Some(c.threads),
         ranks: Some(c.ranks),
-        decomp: c.decomp.clone(),
+        decomp: c.decomp,
     };
     // Each complete case with its record (`cases` was built from these records, in order).
     let records: Vec<(&Point, &CaseRecord)> = cases
@@ -183,11 +193,10 @@ pub fn group(results: &ResultsFile) -> Groups {
     }
 }
 
-fn precision_name(r: &CaseRecord) -> String {
-    match r.case.precision {
-        Some(p) => p.name().to_string(),
-        None => r.case.scenario.defaults().precision.name().to_string(),
-    }
+fn precision_of(r: &CaseRecord) -> Precision {
+    r.case
+        .precision
+        .unwrap_or(r.case.scenario.defaults().precision)
 }
 
 /// The analysis view of a complete case; `None` for a case still being measured.
@@ -197,13 +206,14 @@ fn point(r: &CaseRecord) -> Option<Point> {
         return None;
     }
     Some(Point {
+        case: r.case.clone(),
         key: r.key.clone(),
         n: r.n,
         threads: r.case.threads,
         ranks: r.case.ranks,
         time_factor: r.case.time_factor,
         theta: r.case.theta,
-        decomp: r.case.decomp.map(|d| d.name().to_string()),
+        decomp: r.case.decomp,
         comm_s_per_step: mpi_mean(r, &|m| m.reduced.comm_s.mean),
         bytes_per_step: mpi_mean(r, &|m| m.reduced.bytes_sent.mean),
         samples: r

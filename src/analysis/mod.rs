@@ -1,13 +1,11 @@
-//! Offline analysis of a sweep: the series of a results file ([`groups`]), the models fitted to
-//! them (complexity in n, strong and weak scaling, crossovers), the figures ([`figures`]) and a
-//! short Markdown summary ([`summary`]). `analyze` and the end of `sweep` both call [`analyze`]
-//! then [`write`]; everything is recomputed from the raw samples, with seeded bootstraps, so the
-//! same results file always gives the same output.
+//! Offline analysis of a sweep: the series of a results file ([`groups`]) and the models fitted
+//! to them (complexity in n, strong and weak scaling, crossovers). Pure computation: no file is
+//! read or written here; `crate::render` turns an [`Analysis`] into tables, figures and files.
+//! Everything is recomputed from the raw samples, with seeded bootstraps, so the same results
+//! file always gives the same analysis.
 
 pub mod comm;
-pub mod figures;
 pub mod groups;
-pub mod summary;
 
 use crate::calibrate::Calibration;
 use crate::experiment::config::{Study, WeakRule};
@@ -123,14 +121,33 @@ pub struct Analysis {
     pub incomplete: Vec<String>,
 }
 
+impl Analysis {
+    /// The pair rate of `p` as a share of the calibrated FMA peak of its workers (f64 at half
+    /// the f32 rate), at the law's nominal flops per pair; `None` without a calibration or a
+    /// pair rate.
+    pub fn peak_share(
+        &self,
+        p: &Point,
+        law: crate::physics::LawKind,
+        precision: crate::scenario::Precision,
+    ) -> Option<f64> {
+        let c = self.calibration.as_ref()?;
+        if p.pair_evals_per_s <= 0.0 {
+            return None;
+        }
+        let per_number = match precision {
+            crate::scenario::Precision::F32 => 1.0,
+            crate::scenario::Precision::F64 => 0.5,
+        };
+        let flops = c.fma_gflops_1t * 1e9 * p.p() as f64 * per_number;
+        Some(p.pair_evals_per_s * law.flops_per_pair() / flops)
+    }
+}
+
 #[derive(Debug, Error)]
 pub enum AnalysisError {
     #[error("{path} has no complete case to analyse; finish it with `nbody-bench sweep --resume`")]
     Empty { path: PathBuf },
-    #[error(transparent)]
-    Write(#[from] crate::output::WriteError),
-    #[error(transparent)]
-    Plot(#[from] crate::plot::PlotError),
 }
 
 /// Fits every series of `results` (read from `source`, for the record).
@@ -179,32 +196,6 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
             .map(|c| c.key.clone())
             .collect(),
         cases: groups.cases,
-    })
-}
-
-/// What `write` produced.
-pub struct Written {
-    pub fits: PathBuf,
-    pub summary: PathBuf,
-    pub figures: Vec<figures::Figure>,
-    /// Figures that could not be drawn (the fits and summary are written regardless).
-    pub figure_errors: Vec<String>,
-}
-
-/// Writes `fits.json`, `summary.md` and the figures into `dir` (atomically, file by file).
-pub fn write(analysis: &Analysis, dir: &Path) -> Result<Written, AnalysisError> {
-    let (figures, figure_errors) = figures::render_all(analysis, dir);
-    let fits = dir.join("fits.json");
-    let text = serde_json::to_string_pretty(analysis).expect("analysis serializes");
-    crate::output::write_atomic(&fits, text.as_bytes())?;
-    let summary = dir.join("summary.md");
-    let md = summary::markdown(analysis, &figures);
-    crate::output::write_atomic(&summary, md.as_bytes())?;
-    Ok(Written {
-        fits,
-        summary,
-        figures,
-        figure_errors,
     })
 }
 
@@ -258,7 +249,7 @@ fn crossovers(all: &[ComplexityAnalysis]) -> Vec<Crossover> {
             let (above, below) = if a_faster_above { (a, b) } else { (b, a) };
             out.push(Crossover {
                 scenario: a.series.scenario.name().into(),
-                precision: a.series.precision.clone(),
+                precision: a.series.precision.name().into(),
                 threads: a.series.threads.unwrap_or(1),
                 faster_above: above.label.clone(),
                 faster_below: below.label.clone(),

@@ -424,20 +424,5 @@ impl SystemJob for ProbeJob {
     }
 }
 
-/// A duration for people: seconds (two decimals below 10 s), minutes, hours or days.
-pub fn fmt_duration(s: f64) -> String {
-    if s < 10.0 {
-        format!("{s:.2} s")
-    } else if s < 60.0 {
-        format!("{s:.1} s")
-    } else if s < 3600.0 {
-        format!("{:.1} min", s / 60.0)
-    } else if s < 86_400.0 {
-        format!("{:.1} h", s / 3600.0)
-    } else {
-        format!("{:.1} days", s / 86_400.0)
-    }
-}
-
 #[cfg(test)]
 mod tests;

@@ -4,8 +4,9 @@
 //! compute, communication, waiting, traffic) is kept with the round.
 
 use super::config::MpiLaunch;
-use super::measure::{RoundOutcome, RoundSpec, WallClock, clock_cost};
+use super::measure::{RoundOutcome, RoundSpec};
 use super::plan::Case;
+use crate::clock::{WallClock, clock_cost};
 use crate::decomp::stats::MpiReport;
 use crate::engine::PhaseTimes;
 use crate::kernels::WorkCounters;

@@ -4,6 +4,7 @@
 use super::plan::Case;
 use super::reference::time_reference;
 use super::slowdown::TestSlowdown;
+use crate::clock::{Clock, clock_cost};
 use crate::engine::{PhaseTimes, Simulation};
 use crate::kernels::{KernelParams, WorkCounters};
 use crate::physics::PairLaw;
@@ -11,57 +12,6 @@ use crate::real::Real;
 use crate::run::RunError;
 use crate::scenario::{System, SystemJob};
 use serde::{Deserialize, Serialize};
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::{Duration, Instant};
-
-/// A monotonic time source; the runner and its tests are written against this trait so that
-/// tests can script the durations.
-pub trait Clock: Sync {
-    /// Time since an arbitrary fixed origin.
-    fn now(&self) -> Duration;
-}
-
-/// The real monotonic clock.
-pub struct WallClock(Instant);
-
-impl WallClock {
-    pub fn new() -> Self {
-        WallClock(Instant::now())
-    }
-}
-
-impl Default for WallClock {
-    fn default() -> Self {
-        Self::new()
-    }
-}
-
-impl Clock for WallClock {
-    fn now(&self) -> Duration {
-        self.0.elapsed()
-    }
-}
-
-/// A scripted clock for tests: every reading advances time by `tick`.
-pub struct MockClock {
-    ns: AtomicU64,
-    tick_ns: u64,
-}
-
-impl MockClock {
-    pub fn new(tick: Duration) -> Self {
-        MockClock {
-            ns: AtomicU64::new(0),
-            tick_ns: tick.as_nanos() as u64,
-        }
-    }
-}
-
-impl Clock for MockClock {
-    fn now(&self) -> Duration {
-        Duration::from_nanos(self.ns.fetch_add(self.tick_ns, Ordering::Relaxed) + self.tick_ns)
-    }
-}
 
 /// How one round of a case is measured.
 #[derive(Clone, Debug)]
@@ -241,14 +191,4 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         initial_work: Some(initial_work),
         mpi: None,
     })
-}
-
-/// Seconds per clock reading (two readings bracket each timed step).
-pub(super) fn clock_cost<C: Clock>(clock: &C) -> f64 {
-    let reps = 1000;
-    let t0 = clock.now();
-    for _ in 0..reps {
-        std::hint::black_box(clock.now());
-    }
-    (clock.now() - t0).as_secs_f64() / (reps + 1) as f64
 }

@@ -2,6 +2,7 @@
 
 use super::results::CaseRecord;
 use super::runner::Observer;
+use crate::units::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
 
 /// Chooses the bar on a terminal and plain lines elsewhere (CI logs, pipes).
@@ -72,7 +73,7 @@ impl Observer for Lines {
             self.total,
             record.key,
             round + 1,
-            crate::commands::fmt_ns(median * 1e9)
+            Duration(median)
         );
     }
 

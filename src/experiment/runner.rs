@@ -2,10 +2,11 @@
 //! file after every round of every case, and resumes an interrupted sweep.
 
 use super::config::SweepConfig;
-use super::measure::{Clock, MeasureJob, RoundSpec};
+use super::measure::{MeasureJob, RoundSpec};
 use super::plan::{Case, cases};
 use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
+use crate::clock::Clock;
 use crate::scenario::Setup;
 use std::path::{Path, PathBuf};
 use thiserror::Error;

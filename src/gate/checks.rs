@@ -159,7 +159,7 @@ pub(super) fn short(commit: &str) -> &str {
 }
 
 /// The first `chars` characters of `text` (a commit read from a file may hold anything).
-pub(crate) fn prefix(text: &str, chars: usize) -> &str {
+pub fn prefix(text: &str, chars: usize) -> &str {
     text.char_indices()
         .nth(chars)
         .map_or(text, |(i, _)| &text[..i])

@@ -24,7 +24,7 @@ mod render;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use checks::prefix;
+pub use checks::prefix;
 pub use compare::compare;
 pub use render::{Format, render};
 

@@ -3,7 +3,7 @@
 
 use super::checks::short;
 use super::{CaseComparison, GateReport, Normalization, Verdict};
-use crate::commands::fmt_ns;
+use crate::units::Duration;
 use std::fmt::Write;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
@@ -104,8 +104,8 @@ fn text(report: &GateReport) -> String {
             s,
             "{:<width$} {:>11} {:>11} {:>7.3} {:>17} {:>7.3}  {}{}",
             c.key,
-            fmt_ns(c.baseline_median_s * 1e9),
-            fmt_ns(c.current_median_s * 1e9),
+            Duration(c.baseline_median_s),
+            Duration(c.current_median_s),
             c.ratio,
             format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),
             c.raw_ratio,
@@ -154,8 +154,8 @@ fn markdown(report: &GateReport) -> String {
             s,
             "| `{}` | {} | {} | {:.3} | {:.3} – {:.3} | {:.3} | {}{} |",
             c.key,
-            fmt_ns(c.baseline_median_s * 1e9),
-            fmt_ns(c.current_median_s * 1e9),
+            Duration(c.baseline_median_s),
+            Duration(c.current_median_s),
             c.ratio,
             c.ci95[0],
             c.ci95[1],

@@ -44,6 +44,16 @@ impl LawKind {
     pub fn is_inverse_square(self) -> bool {
         matches!(self, LawKind::Coulomb | LawKind::Gravity)
     }
+
+    /// Nominal floating-point operations per pair evaluation in our pair loops (a square root
+    /// and a division count as one each), to express pair rates as a share of the FMA peak.
+    pub fn flops_per_pair(self) -> f64 {
+        match self {
+            LawKind::LennardJones => 18.0,
+            LawKind::Gravity => 20.0,
+            LawKind::Coulomb => 21.0,
+        }
+    }
 }
 
 /// A central pair interaction.
@@ -74,8 +84,9 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     fn cutoff(&self) -> Option<T>;
 }
 
-/// Adds the force of source `j` on target `i` to `acc` given the separation `dx = x_j − x_i`.
-/// Shared by every kernel's scalar paths.
+/// The force of source `j` on target `i` given the separation `dx = x_j − x_i`, returned: the
+/// law's pair interaction written out plainly, for the f64 reference sum of `validate` and the
+/// tests of the SIMD rows (the kernels themselves go through `kernels::rows`).
 #[inline(always)]
 pub fn pair_force<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,

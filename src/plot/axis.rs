@@ -1,6 +1,13 @@
 //! From an [`Axis`] and the values plotted on it to a drawable axis: the effective scale (log
 //! only when every value is positive), sane bounds even for one point or all-equal values, tick
-//! positions (decades on log axes) and their labels.
+//! positions (decades on log axes) and their labels. A [`ResolvedAxis`] is a plotters
+//! coordinate, so one type serves linear, log and categorical axes, and plotters' mesh draws
+//! exactly these ticks.
+
+#[cfg(feature = "plot")]
+use plotters::coord::ranged1d::{
+    KeyPointHint, KeyPointWeight, NoDefaultFormatting, Ranged, ValueFormatter,
+};
 
 use super::format;
 use super::spec::{Axis, Scale, Unit};
@@ -96,6 +103,19 @@ impl ResolvedAxis {
         f.is_finite() && (-1e-9..=1.0 + 1e-9).contains(&f)
     }
 
+    /// `value` pulled into the bounds (for bands and error bars that reach past them), or
+    /// `None` where the axis cannot place it: not finite, or not positive on a log axis.
+    pub fn clamp(&self, value: f64) -> Option<f64> {
+        let f = self.fraction(value);
+        f.is_finite().then_some(if f < 0.0 {
+            self.lo
+        } else if f > 1.0 {
+            self.hi
+        } else {
+            value
+        })
+    }
+
     /// The label of a major tick at `value`, or a freshly formatted one for any other value.
     pub fn label(&self, value: f64) -> String {
         let tolerance = 1e-9 * (self.hi - self.lo).abs();
@@ -107,6 +127,45 @@ impl ResolvedAxis {
             Some((_, label)) => label.clone(),
             None => format::value_label(value, self.unit),
         }
+    }
+}
+
+#[cfg(feature = "plot")]
+impl Ranged for ResolvedAxis {
+    type FormatOption = NoDefaultFormatting;
+    type ValueType = f64;
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        // Callers only pass values inside the axis; the clamp keeps a stray one from wrapping.
+        let fraction = self.fraction(*value);
+        let fraction = if fraction.is_finite() {
+            fraction.clamp(-1.0, 2.0)
+        } else {
+            0.0
+        };
+        limit.0 + (fraction * f64::from(limit.1 - limit.0)).round() as i32
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        match hint.weight() {
+            KeyPointWeight::Bold => self.major.iter().map(|(v, _)| *v).collect(),
+            KeyPointWeight::Any => self.minor.clone(),
+        }
+    }
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.lo..self.hi
+    }
+}
+
+#[cfg(feature = "plot")]
+impl ValueFormatter<f64> for ResolvedAxis {
+    fn format(value: &f64) -> String {
+        value.to_string()
+    }
+
+    fn format_ext(&self, value: &f64) -> String {
+        self.label(*value)
     }
 }
 

@@ -1,63 +1,252 @@
-//! Drawing a [`Chart`]: axes fitted to the data, the page around them, the legend entries,
-//! and then the plot area's contents (see [`super::canvas`]).
+//! Drawing a [`Chart`]: axes fitted to what can be drawn, the page around the plot, then the
+//! contents back to front. plotters does not clip what it draws in data coordinates, so points
+//! off the axes are left out (breaking a line there) and bands and error bars are cut at them.
 
-use plotters::coord::Shift;
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, VPos};
 
 use super::axis::ResolvedAxis;
-use super::canvas::Canvas;
-use super::coord::AxisCoord;
-use super::layout::{self, Frame};
-use super::legend::{Entry, Swatch};
-use super::palette::{self, REFERENCE};
-use super::shapes::{DrawResult, rgb};
+use super::legend::{DASH, Glyph, LINE_WIDTH, Swatch, rgb};
+use super::page::{self, Area, MUTED_COLOR, NOTE_SIZE, Page, Plot, TICK_SIZE, anchored};
+use super::palette::{self, Marker, REFERENCE, REFERENCE_INDEX};
+use super::render::{DrawResult, err};
 use super::spec::{Chart, Point, Scale, SeriesStyle};
-use super::text::{self, TICK_SIZE};
 
-pub const BAND_ALPHA: f64 = 0.18;
-pub const REGION_ALPHA: f64 = 0.09;
+const BAND_ALPHA: f64 = 0.18;
+const REGION_ALPHA: f64 = 0.09;
 
-pub type Plot<'a, DB> = ChartContext<'a, DB, Cartesian2d<AxisCoord, AxisCoord>>;
-
-pub fn draw<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, chart: &Chart) -> DrawResult {
+pub fn draw(root: &Area, chart: &Chart) -> DrawResult {
     let mut x = ResolvedAxis::resolve(&chart.x, x_values(chart));
     let y = ResolvedAxis::resolve(&chart.y, y_values(chart));
-    let entries = legend_entries(chart);
-    let frame = layout::frame(root, &chart.title, &chart.caption, &entries)?;
-    shorten_categories(root, &frame, &mut x);
-
-    let y_area = layout::y_label_area(root, &y, TICK_SIZE);
-    let mut builder = ChartBuilder::on(&frame.plot);
-    builder
-        .margin_top(8)
-        .margin_left(10)
-        .margin_right(if frame.legend.is_some() { 12 } else { 24 })
-        .x_label_area_size(layout::x_label_area())
-        .y_label_area_size(y_area);
-    let mut plot = builder
-        .build_cartesian_2d(AxisCoord(x.clone()), AxisCoord(y.clone()))
-        .map_err(|e| e.to_string())?;
-    plot.configure_mesh()
-        .x_desc(chart.x.label.as_str())
-        .y_desc(chart.y.label.as_str())
-        .label_style(text::style(TICK_SIZE))
-        .axis_desc_style(text::style(text::AXIS_LABEL_SIZE))
-        .bold_line_style(BLACK.mix(0.14))
-        .light_line_style(BLACK.mix(0.05))
-        .draw()
-        .map_err(|e| e.to_string())?;
-
-    let canvas = Canvas {
-        root,
-        plot: &plot,
-        x: &x,
-        y: &y,
-    };
-    let drew_data = canvas.draw_contents(chart)?;
-    if !drew_data {
-        canvas.note_no_data()?;
+    let page = Page::new(root, &chart.title, &chart.caption, legend(chart))?;
+    // Category names are cut to the width of their slot so that neighbours never overlap.
+    let slot = page.plot.dim_in_pixel().0.saturating_sub(120) / x.major.len().max(1) as u32;
+    for (_, label) in &mut x.major {
+        *label = page::shorten(root, label, &page::style(TICK_SIZE), slot.saturating_sub(8));
     }
-    frame.draw_legend(8)
+    let axes = (x.clone(), y.clone());
+    let mut plot = page.plot(axes, (&chart.x.label, &chart.y.label), TICK_SIZE, true)?;
+    if !draw_contents(root, &mut plot, chart, (&x, &y))? {
+        page::note_no_data(root, &plot)?;
+    }
+    Ok(())
+}
+
+/// Draws regions, bands, reference lines, series lines, error bars, markers and point labels;
+/// returns whether any data point or band was drawn.
+fn draw_contents(
+    root: &Area,
+    plot: &mut Plot,
+    chart: &Chart,
+    (x, y): (&ResolvedAxis, &ResolvedAxis),
+) -> Result<bool, String> {
+    let on_axes = |p: &&Point| x.contains(p.x) && y.contains(p.y);
+    let (xs, ys) = plot.plotting_area().get_pixel_range();
+    let note = anchored(NOTE_SIZE, HPos::Left, VPos::Top).color(&MUTED_COLOR);
+    for r in &chart.regions {
+        let ends = (x.clamp(r.x_from.min(r.x_to)), x.clamp(r.x_from.max(r.x_to)));
+        let (Some(from), Some(to)) = ends else {
+            continue;
+        };
+        let (left, right) = (
+            plot.backend_coord(&(from, y.lo)).0,
+            plot.backend_coord(&(to, y.lo)).0,
+        );
+        if right <= left {
+            continue;
+        }
+        let shade = rgb(REFERENCE).mix(REGION_ALPHA).filled();
+        plot.draw_series([Rectangle::new([(from, y.lo), (to, y.hi)], shade)])
+            .map_err(err)?;
+        let label = page::shorten(root, &r.label, &note, (right - left - 8).max(0) as u32);
+        if label != "…" {
+            root.draw_text(&label, &note, (left + 4, ys.start + 4))
+                .map_err(err)?;
+        }
+    }
+
+    let mut drew = false;
+    for (i, band) in chart.bands.iter().enumerate() {
+        let shade = series_color(i, band.color).mix(BAND_ALPHA).filled();
+        let triples = band.x.iter().zip(&band.lo).zip(&band.hi);
+        let edges = triples.map(|((&bx, &lo), &hi)| {
+            x.contains(bx).then_some(())?;
+            Some((bx, y.clamp(lo)?, y.clamp(hi)?))
+        });
+        for run in runs(edges) {
+            let upper = run.iter().map(|&(bx, _, hi)| (bx, hi));
+            let outline: Vec<_> = upper
+                .chain(run.iter().rev().map(|&(bx, lo, _)| (bx, lo)))
+                .collect();
+            plot.draw_series([Polygon::new(outline, shade)])
+                .map_err(err)?;
+            drew = true;
+        }
+    }
+    for h in chart.hlines.iter().filter(|h| y.contains(h.y)) {
+        let color = rgb(palette::color(h.color.unwrap_or(REFERENCE_INDEX)));
+        line(plot, vec![(x.lo, h.y), (x.hi, h.y)], color, h.dashed)?;
+    }
+    for (i, s) in chart.series.iter().enumerate() {
+        if s.style != SeriesStyle::Markers {
+            let points = s.points.iter().map(|p| on_axes(&p).then_some((p.x, p.y)));
+            for run in runs(points) {
+                line(
+                    plot,
+                    run,
+                    series_color(i, s.color),
+                    s.style == SeriesStyle::Dashed,
+                )?;
+                drew = true;
+            }
+        }
+    }
+    for (i, s) in chart.series.iter().enumerate() {
+        // 2 px: a 1 px line on whole-pixel coordinates is smeared over two pixels at half strength.
+        let style = series_color(i, s.color).stroke_width(2);
+        for p in s.points.iter().filter(|p| x.contains(p.x)) {
+            let Some((lo, hi)) = p.y_err else { continue };
+            let (Some(lo), Some(hi)) = (y.clamp(lo), y.clamp(hi)) else {
+                continue;
+            };
+            let ((bx, top), (_, bottom)) = (
+                plot.backend_coord(&(p.x, hi)),
+                plot.backend_coord(&(p.x, lo)),
+            );
+            let bar = [
+                (bx - 4, top),
+                (bx + 4, top),
+                (bx, top),
+                (bx, bottom),
+                (bx - 4, bottom),
+                (bx + 4, bottom),
+            ];
+            root.draw(&PathElement::new(bar, style)).map_err(err)?;
+        }
+    }
+    for (i, s) in chart.series.iter().enumerate() {
+        if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
+            let color = series_color(i, s.color);
+            let marker = palette::marker(s.color.unwrap_or(i));
+            let shown: Vec<&Point> = s.points.iter().filter(on_axes).collect();
+            let markers = shown.iter().map(|p| {
+                let hollow = p.hollow;
+                Glyph(
+                    (p.x, p.y),
+                    Swatch::Marker {
+                        color,
+                        marker,
+                        hollow,
+                    },
+                )
+            });
+            plot.draw_series(markers).map_err(err)?;
+            drew |= !shown.is_empty();
+        }
+    }
+
+    // Point labels go above right of the marker, or above left where they would leave the plot.
+    let right = anchored(NOTE_SIZE, HPos::Left, VPos::Bottom);
+    let left = anchored(NOTE_SIZE, HPos::Right, VPos::Bottom);
+    for p in chart.series.iter().flat_map(|s| &s.points).filter(on_axes) {
+        let Some(label) = &p.label else { continue };
+        let (px, py) = plot.backend_coord(&(p.x, p.y));
+        let fits = px + 7 + page::width(root, label, &right) as i32 <= xs.end;
+        let (style, at) = if fits {
+            (&right, px + 7)
+        } else {
+            (&left, px - 7)
+        };
+        root.draw_text(label, style, (at, py - 5)).map_err(err)?;
+    }
+    Ok(drew)
+}
+
+/// A solid or dashed line through `points`.
+fn line(plot: &mut Plot, points: Vec<(f64, f64)>, color: RGBColor, dashed: bool) -> DrawResult {
+    let style = color.stroke_width(LINE_WIDTH);
+    let drawn = if dashed {
+        plot.draw_series(DashedLineSeries::new(points, DASH.0, DASH.1, style))
+    } else {
+        plot.draw_series(LineSeries::new(points, style))
+    };
+    drawn.map(|_| ()).map_err(err)
+}
+
+/// Runs of consecutive `Some` items that are long enough to draw; a `None` ends a run.
+fn runs<T>(items: impl IntoIterator<Item = Option<T>>) -> Vec<Vec<T>> {
+    let mut runs = vec![Vec::new()];
+    for item in items {
+        match item {
+            Some(t) => runs.last_mut().expect("never empty").push(t),
+            None => runs.push(Vec::new()),
+        }
+    }
+    runs.retain(|r| r.len() >= 2);
+    runs
+}
+
+fn series_color(index: usize, color: Option<usize>) -> RGBColor {
+    rgb(palette::color(color.unwrap_or(index)))
+}
+
+/// Every labelled item in legend order: series, bands, reference lines, regions, and what a
+/// hollow marker means when some point is hollow.
+fn legend(chart: &Chart) -> Vec<(String, Swatch)> {
+    let mut entries = Vec::new();
+    for (i, s) in chart.series.iter().enumerate() {
+        let (color, shape) = (
+            series_color(i, s.color),
+            palette::marker(s.color.unwrap_or(i)),
+        );
+        let swatch = match s.style {
+            SeriesStyle::Markers => Swatch::Marker {
+                color,
+                marker: shape,
+                hollow: false,
+            },
+            style => Swatch::Line {
+                color,
+                dashed: style == SeriesStyle::Dashed,
+                marker: (style == SeriesStyle::LineMarkers).then_some(shape),
+            },
+        };
+        entries.push((s.label.clone(), swatch));
+    }
+    for (i, b) in chart.bands.iter().enumerate() {
+        let swatch = Swatch::Fill(series_color(i, b.color), BAND_ALPHA * 1.5);
+        entries.push((b.label.clone(), swatch));
+    }
+    for h in &chart.hlines {
+        let color = rgb(palette::color(h.color.unwrap_or(REFERENCE_INDEX)));
+        let swatch = Swatch::Line {
+            color,
+            dashed: h.dashed,
+            marker: None,
+        };
+        entries.push((h.label.clone(), swatch));
+    }
+    for r in &chart.regions {
+        entries.push((
+            r.label.clone(),
+            Swatch::Fill(rgb(REFERENCE), REGION_ALPHA * 2.0),
+        ));
+    }
+    if chart
+        .series
+        .iter()
+        .flat_map(|s| &s.points)
+        .any(|p| p.hollow)
+    {
+        let color = rgb(REFERENCE);
+        let hollow = Swatch::Marker {
+            color,
+            marker: Marker::Circle,
+            hollow: true,
+        };
+        entries.push((chart.hollow_label.clone(), hollow));
+    }
+    entries
 }
 
 /// Every x value the chart shows, for fitting the axis; with labelled points, one more value
@@ -76,13 +265,11 @@ fn x_values(chart: &Chart) -> Vec<f64> {
         .iter()
         .flat_map(|s| &s.points)
         .any(|p| p.label.is_some());
-    let (Some(lo), Some(hi)) = (
-        values.iter().copied().reduce(f64::min),
-        values.iter().copied().reduce(f64::max),
-    ) else {
-        return values;
-    };
-    if labelled && hi > lo {
+    let lo = values.iter().copied().reduce(f64::min);
+    let hi = values.iter().copied().reduce(f64::max);
+    if let (true, Some(lo), Some(hi)) = (labelled, lo, hi)
+        && hi > lo
+    {
         let log = chart.x.scale == Scale::Log && lo > 0.0;
         values.push(if log {
             hi * (hi / lo).powf(0.12)
@@ -121,111 +308,6 @@ fn band_triples(chart: &Chart) -> impl Iterator<Item = (f64, f64, f64)> + '_ {
     triples.filter(|(x, lo, hi)| x.is_finite() && lo.is_finite() && hi.is_finite())
 }
 
-pub fn series_color(index: usize, color: Option<usize>) -> RGBColor {
-    rgb(palette::color(color.unwrap_or(index)))
-}
-
-fn legend_entries(chart: &Chart) -> Vec<Entry> {
-    let mut entries = Vec::new();
-    for (i, s) in chart
-        .series
-        .iter()
-        .enumerate()
-        .filter(|(_, s)| !s.label.is_empty())
-    {
-        let color = series_color(i, s.color);
-        let marker = palette::marker(s.color.unwrap_or(i));
-        let swatch = match s.style {
-            SeriesStyle::Line => Swatch::Line {
-                color,
-                dashed: false,
-                marker: None,
-            },
-            SeriesStyle::Dashed => Swatch::Line {
-                color,
-                dashed: true,
-                marker: None,
-            },
-            SeriesStyle::LineMarkers => Swatch::Line {
-                color,
-                dashed: false,
-                marker: Some(marker),
-            },
-            SeriesStyle::Markers => Swatch::Markers { color, marker },
-        };
-        entries.push(Entry {
-            label: s.label.clone(),
-            swatch,
-        });
-    }
-    for (i, b) in chart
-        .bands
-        .iter()
-        .enumerate()
-        .filter(|(_, b)| !b.label.is_empty())
-    {
-        let swatch = Swatch::Fill {
-            color: series_color(i, b.color),
-            alpha: BAND_ALPHA * 1.5,
-        };
-        entries.push(Entry {
-            label: b.label.clone(),
-            swatch,
-        });
-    }
-    for h in chart.hlines.iter().filter(|h| !h.label.is_empty()) {
-        let color = h.color.map_or(rgb(REFERENCE), |c| rgb(palette::color(c)));
-        let swatch = Swatch::Line {
-            color,
-            dashed: h.dashed,
-            marker: None,
-        };
-        entries.push(Entry {
-            label: h.label.clone(),
-            swatch,
-        });
-    }
-    for r in chart.regions.iter().filter(|r| !r.label.is_empty()) {
-        let swatch = Swatch::Fill {
-            color: rgb(REFERENCE),
-            alpha: REGION_ALPHA * 2.0,
-        };
-        entries.push(Entry {
-            label: r.label.clone(),
-            swatch,
-        });
-    }
-    let any_hollow = chart
-        .series
-        .iter()
-        .flat_map(|s| &s.points)
-        .any(|p| p.hollow);
-    if any_hollow && !chart.hollow_label.is_empty() {
-        let swatch = Swatch::Hollow {
-            color: rgb(REFERENCE),
-        };
-        entries.push(Entry {
-            label: chart.hollow_label.clone(),
-            swatch,
-        });
-    }
-    entries
-}
-
-/// Category names on the x axis cut to the width of their slot so neighbours never overlap.
-fn shorten_categories<DB: DrawingBackend>(
-    root: &DrawingArea<DB, Shift>,
-    frame: &Frame<DB>,
-    x: &mut ResolvedAxis,
-) {
-    let count = x.major.len().max(1) as u32;
-    let slot = frame.plot.dim_in_pixel().0.saturating_sub(120) / count;
-    let style = text::style(TICK_SIZE);
-    for (_, label) in &mut x.major {
-        *label = text::shorten(root, label, &style, slot.saturating_sub(8));
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,5 +334,20 @@ mod tests {
         });
         assert_eq!(x_values(&chart), [1.0, 2.0, 3.0]);
         assert_eq!(y_values(&chart), [1.0, 2.0, 0.5, 3.0]);
+    }
+
+    #[test]
+    fn lines_break_where_a_point_is_missing() {
+        let items = [
+            Some(1),
+            Some(2),
+            None,
+            Some(3),
+            None,
+            Some(4),
+            Some(5),
+            Some(6),
+        ];
+        assert_eq!(runs(items), [vec![1, 2], vec![4, 5, 6]]);
     }
 }

@@ -1,16 +1,17 @@
-//! The embedded font. plotters' `ab_glyph` backend measures and draws text only with fonts
-//! registered at run time, so DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`)
-//! is compiled into the binary and registered once; no system font is needed.
+//! The embedded font, DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`),
+//! compiled into the binary so that no system font is needed. plotters measures text with it
+//! while laying a figure out, and resvg draws the SVG's text with it, so the two agree.
 
 use plotters::style::{FontStyle, register_font};
-use std::sync::Once;
+use resvg::usvg::fontdb::Database;
+use std::sync::{Arc, LazyLock, Once};
 
-pub static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
+static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// The family name every text style of this module uses.
 pub const FAMILY: &str = "sans-serif";
 
-/// Registers the font for the normal and bold styles; later calls do nothing.
+/// Registers the font with plotters for the normal and bold styles; later calls do nothing.
 pub fn register() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
@@ -21,3 +22,12 @@ pub fn register() {
         }
     });
 }
+
+/// The only font resvg sees: it stands for every generic family, so the PNG looks the same
+/// on every machine.
+pub static FONTS: LazyLock<Arc<Database>> = LazyLock::new(|| {
+    let mut db = Database::new();
+    db.load_font_data(DEJAVU_SANS.to_vec());
+    db.set_sans_serif_family("DejaVu Sans");
+    Arc::new(db)
+});

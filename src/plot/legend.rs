@@ -1,14 +1,30 @@
-//! The legend, drawn in its own panel to the right of the plot so it never covers data.
+//! Markers, legend samples and the legend. The legend is plotters' own series-label box,
+//! drawn in a column right of the plot area so that it never covers data; labels too long for
+//! the column wrap onto a second line.
 
-use plotters::coord::Shift;
+use plotters::element::{DashedPathElement, Drawable, PointCollection};
 use plotters::prelude::*;
-use plotters::style::text_anchor::{HPos, VPos};
+use plotters_backend::{BackendCoord, DrawingErrorKind};
 
 use super::palette::Marker;
-use super::shapes::{self, DrawResult, LINE_WIDTH};
-use super::text::{self, LEGEND_SIZE};
+use super::text::{Area, DrawResult, LEGEND_SIZE, err, style, width, wrap};
 
-/// How an entry's sample is drawn.
+const MARKER_RADIUS: i32 = 5;
+pub const LINE_WIDTH: u32 = 3;
+pub const DASH: (i32, i32) = (9, 6);
+const SWATCH_WIDTH: i32 = 30;
+const GAP: i32 = 8;
+const PADDING: i32 = 10;
+/// plotters' series labels are set 1.25 font sizes apart.
+const LINE_HEIGHT: f64 = 1.25 * LEGEND_SIZE;
+/// The legend never takes more than this share of the figure width.
+const MAX_SHARE: f64 = 0.3;
+
+pub fn rgb((r, g, b): (u8, u8, u8)) -> RGBColor {
+    RGBColor(r, g, b)
+}
+
+/// How a legend entry's sample, or a data marker, is drawn.
 #[derive(Clone, Copy, Debug)]
 pub enum Swatch {
     Line {
@@ -16,136 +32,159 @@ pub enum Swatch {
         dashed: bool,
         marker: Option<Marker>,
     },
-    Markers {
+    /// Filled, or hollow: white inside, so that grid lines and error bars do not show through.
+    Marker {
         color: RGBColor,
         marker: Marker,
+        hollow: bool,
     },
-    Fill {
-        color: RGBColor,
-        alpha: f64,
-    },
-    Hollow {
-        color: RGBColor,
-    },
+    /// A patch of `color` at the given opacity, as the band or region it stands for.
+    Fill(RGBColor, f64),
 }
 
-#[derive(Clone, Debug)]
-pub struct Entry {
-    pub label: String,
-    pub swatch: Swatch,
-}
+/// A [`Swatch`] as a plotters element, drawn in pixels centred on one point. It owns nothing
+/// of the backend, so plotters can box it as a legend sample.
+pub struct Glyph<C>(pub C, pub Swatch);
 
-const SWATCH_WIDTH: i32 = 30;
-const GAP: i32 = 8;
-const PADDING: i32 = 10;
-const LINE_HEIGHT: i32 = 18;
-const ENTRY_GAP: i32 = 6;
-/// The legend never takes more than this share of the figure width.
-const MAX_SHARE: f64 = 0.3;
+impl<'a, C> PointCollection<'a, C> for &'a Glyph<C> {
+    type Point = &'a C;
+    type IntoIter = std::iter::Once<&'a C>;
 
-/// Width the legend panel needs for `entries` (0 when there are none).
-pub fn panel_width<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, entries: &[Entry]) -> u32 {
-    if entries.is_empty() {
-        return 0;
+    fn point_iter(self) -> Self::IntoIter {
+        std::iter::once(&self.0)
     }
-    let style = text::style(LEGEND_SIZE);
-    let widest = entries
-        .iter()
-        .map(|e| text::width(root, &e.label, &style))
-        .max()
-        .unwrap_or(0);
-    let wanted = widest as i32 + SWATCH_WIDTH + GAP + 2 * PADDING + 12;
-    let cap = (root.dim_in_pixel().0 as f64 * MAX_SHARE) as i32;
-    wanted.min(cap) as u32
 }
 
-/// Draws the entries top-down inside `panel`, starting `top` pixels below its top edge, in a
-/// light box. Labels wider than the panel wrap onto a second line.
-pub fn draw<DB: DrawingBackend>(
-    panel: &DrawingArea<DB, Shift>,
-    entries: &[Entry],
-    top: i32,
-) -> DrawResult {
-    if entries.is_empty() {
-        return Ok(());
-    }
-    let (width, height) = panel.dim_in_pixel();
-    let style = text::anchored(text::style(LEGEND_SIZE), HPos::Left, VPos::Center);
-    let text_width = (width as i32 - SWATCH_WIDTH - GAP - 2 * PADDING - 6).max(20) as u32;
-    let laid_out: Vec<(Vec<String>, Swatch)> = entries
-        .iter()
-        .map(|e| (text::wrap(panel, &e.label, &style, text_width, 2), e.swatch))
-        .collect();
-    let box_height: i32 = laid_out
-        .iter()
-        .map(|(lines, _)| lines.len() as i32 * LINE_HEIGHT + ENTRY_GAP)
-        .sum::<i32>()
-        - ENTRY_GAP
-        + 2 * PADDING;
-    let box_height = box_height.min(height as i32 - top);
-    let (left, right) = (2, width as i32 - 4);
-    let frame = [(left, top), (right, top + box_height)];
-    panel
-        .draw(&Rectangle::new(frame, WHITE.filled()))
-        .map_err(|e| e.to_string())?;
-    panel
-        .draw(&Rectangle::new(
-            frame,
-            RGBColor(0xBB, 0xBB, 0xBB).stroke_width(1),
-        ))
-        .map_err(|e| e.to_string())?;
-
-    let mut y = top + PADDING;
-    for (lines, swatch) in laid_out {
-        let centre = y + LINE_HEIGHT / 2;
-        if centre > top + box_height {
-            break;
-        }
-        draw_swatch(panel, swatch, (left + PADDING, centre))?;
-        for (i, line) in lines.iter().enumerate() {
-            let at = (
-                left + PADDING + SWATCH_WIDTH + GAP,
-                centre + i as i32 * LINE_HEIGHT,
-            );
-            panel
-                .draw_text(line, &style, at)
-                .map_err(|e| e.to_string())?;
-        }
-        y += lines.len() as i32 * LINE_HEIGHT + ENTRY_GAP;
-    }
-    Ok(())
-}
-
-/// The sample for one entry, its left edge at `x` and vertically centred on `y`.
-fn draw_swatch<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    swatch: Swatch,
-    (x, y): (i32, i32),
-) -> DrawResult {
-    let middle = (x + SWATCH_WIDTH / 2, y);
-    match swatch {
-        Swatch::Line {
-            color,
-            dashed,
-            marker,
-        } => {
-            let line = [(x, y), (x + SWATCH_WIDTH, y)];
-            shapes::polyline(area, &line, color.stroke_width(LINE_WIDTH), dashed)?;
-            match marker {
-                Some(m) => shapes::marker(area, middle, m, color, false),
-                None => Ok(()),
+impl<C, DB: DrawingBackend> Drawable<DB> for Glyph<C> {
+    fn draw<I: Iterator<Item = BackendCoord>>(
+        &self,
+        mut at: I,
+        backend: &mut DB,
+        size: (u32, u32),
+    ) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+        let Some((x, y)) = at.next() else {
+            return Ok(());
+        };
+        let half = SWATCH_WIDTH / 2;
+        match self.1 {
+            Swatch::Line {
+                color,
+                dashed,
+                marker,
+            } => {
+                let style = color.stroke_width(LINE_WIDTH);
+                let ends = [(x - half, y), (x + half, y)];
+                if dashed {
+                    let dashes = DashedPathElement::new(ends, DASH.0, DASH.1, style);
+                    dashes.draw(ends.into_iter(), backend, size)?;
+                } else {
+                    backend.draw_line(ends[0], ends[1], &style)?;
+                }
+                match marker {
+                    Some(m) => draw_marker(backend, (x, y), m, color, false),
+                    None => Ok(()),
+                }
+            }
+            Swatch::Marker {
+                color,
+                marker,
+                hollow,
+            } => draw_marker(backend, (x, y), marker, color, hollow),
+            Swatch::Fill(color, alpha) => {
+                let style = color.mix(alpha).filled();
+                backend.draw_rect((x - half, y - 7), (x + half, y + 7), &style, true)
             }
         }
-        Swatch::Markers { color, marker } => shapes::marker(area, middle, marker, color, false),
-        Swatch::Fill { color, alpha } => {
-            let rect = vec![
-                (x, y - 7),
-                (x + SWATCH_WIDTH, y - 7),
-                (x + SWATCH_WIDTH, y + 7),
-                (x, y + 7),
-            ];
-            shapes::fill(area, rect, color, alpha)
+    }
+}
+
+/// Filled and hollow markers share one outline: a 2 px ring of radius `MARKER_RADIUS`.
+fn draw_marker<DB: DrawingBackend>(
+    backend: &mut DB,
+    (x, y): BackendCoord,
+    marker: Marker,
+    color: RGBColor,
+    hollow: bool,
+) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+    let r = MARKER_RADIUS - 1;
+    let fill = if hollow { WHITE } else { color }.filled();
+    let ring = color.stroke_width(2);
+    let outline = match marker {
+        Marker::Circle => {
+            backend.draw_circle((x, y), r as u32, &fill, true)?;
+            return backend.draw_circle((x, y), r as u32, &ring, false);
         }
-        Swatch::Hollow { color } => shapes::marker(area, middle, Marker::Circle, color, true),
+        Marker::Square => vec![(-r, -r), (r, -r), (r, r), (-r, r)],
+        Marker::Triangle => vec![(0, -r - 1), (r + 1, r), (-r - 1, r)],
+        Marker::Diamond => vec![(0, -r - 1), (r + 1, 0), (0, r + 1), (-r - 1, 0)],
+    };
+    let outline: Vec<_> = outline.iter().map(|(dx, dy)| (x + dx, y + dy)).collect();
+    backend.fill_polygon(outline.clone(), &fill)?;
+    backend.draw_path(outline.iter().chain(&outline[..1]).copied(), &ring)
+}
+
+/// Legend entries laid out for the page: each label in one or two lines.
+pub struct Legend {
+    entries: Vec<(Vec<String>, Swatch)>,
+    /// The width of the legend box in pixels; 0 without entries.
+    pub width: u32,
+}
+
+impl Legend {
+    /// Wraps the labels to the widest legend the page allows and keeps the entries that fit
+    /// into `height` pixels; entries with an empty label are left out.
+    pub fn new(root: &Area, entries: Vec<(String, Swatch)>, height: u32) -> Legend {
+        let chrome = (SWATCH_WIDTH + GAP + 2 * PADDING) as u32 + 2;
+        let max_text = (f64::from(root.dim_in_pixel().0) * MAX_SHARE) as u32 - chrome;
+        let text = style(LEGEND_SIZE);
+        let mut room = ((f64::from(height) - 2.0 * f64::from(PADDING)) / LINE_HEIGHT) as usize;
+        let mut laid_out = Vec::new();
+        for (label, swatch) in entries.into_iter().filter(|(l, _)| !l.is_empty()) {
+            let lines = wrap(root, &label, &text, max_text, 2);
+            if lines.len() > room {
+                break;
+            }
+            room -= lines.len();
+            laid_out.push((lines, swatch));
+        }
+        let widest = laid_out.iter().flat_map(|(lines, _)| lines);
+        let widest = widest.map(|l| width(root, l, &text)).max();
+        Legend {
+            entries: laid_out,
+            width: widest.map_or(0, |w| w + chrome),
+        }
+    }
+
+    /// Draws the legend in `panel`, `top` pixels below its top edge. The panel gets a chart
+    /// of its own with nothing in it but series labels, which plotters lays out and boxes;
+    /// each line is a label of its own, and a continued label has no sample.
+    pub fn draw(&self, panel: &Area, top: i32) -> DrawResult {
+        if self.entries.is_empty() {
+            return Ok(());
+        }
+        let mut chart = ChartBuilder::on(panel)
+            .build_cartesian_2d(0.0..1.0, 0.0..1.0)
+            .map_err(err)?;
+        for (lines, swatch) in &self.entries {
+            for (i, line) in lines.iter().enumerate() {
+                let none = std::iter::empty::<EmptyElement<(f64, f64), _>>();
+                let label = chart.draw_series(none).map_err(err)?;
+                label.label(line.as_str());
+                if i == 0 {
+                    let swatch = *swatch;
+                    label.legend(move |(x, y)| Glyph((x + SWATCH_WIDTH / 2, y), swatch));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::Coordinate(0, top))
+            .label_font(style(LEGEND_SIZE))
+            .legend_area_size(SWATCH_WIDTH + GAP)
+            .margin(PADDING)
+            .border_style(RGBColor(0xBB, 0xBB, 0xBB))
+            .background_style(WHITE)
+            .draw()
+            .map_err(err)
     }
 }

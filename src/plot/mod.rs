@@ -3,9 +3,10 @@
 //! [`Chart`] (x-y series, error bars, bands, reference lines, shaded regions) and
 //! [`StackedBars`] describe a figure with plain numbers and strings; [`figures`] builds the
 //! figures this project reports from per-kernel measurements. [`render`] and
-//! [`render_stacked`] draw them with plotters and an embedded font, writing `stem.svg` and
-//! `stem.png` (1000×650) atomically. Without the `plot` cargo feature the types and
-//! constructors remain, and rendering returns [`PlotError::Disabled`].
+//! [`render_stacked`] draw them once, to SVG with plotters, and rasterize that SVG with resvg,
+//! both with an embedded font, writing `stem.svg` and `stem.png` (1000×650) atomically.
+//! Without the `plot` cargo feature the types and constructors remain, and rendering returns
+//! [`PlotError::Disabled`].
 
 #[cfg_attr(not(feature = "plot"), allow(dead_code))]
 mod axis;
@@ -18,26 +19,17 @@ mod spec;
 #[cfg(feature = "plot")]
 mod bars;
 #[cfg(feature = "plot")]
-mod canvas;
-#[cfg(feature = "plot")]
 mod chart;
-#[cfg(feature = "plot")]
-mod coord;
 #[cfg(feature = "plot")]
 mod font;
 #[cfg(feature = "plot")]
-mod layout;
-#[cfg(feature = "plot")]
 mod legend;
 #[cfg(feature = "plot")]
-mod raster;
+mod page;
 #[cfg(feature = "plot")]
 mod render;
-#[cfg(feature = "plot")]
-mod shapes;
 #[cfg(all(test, feature = "plot"))]
 mod tests;
-#[cfg(feature = "plot")]
 mod text;
 
 pub use format::value_label as format_value;
@@ -71,7 +63,7 @@ pub enum PlotError {
 /// pair only once both are drawn.
 pub fn render(chart: &Chart, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
     #[cfg(feature = "plot")]
-    return render::render_figure(chart, dir, stem);
+    return render::render_figure(|root| chart::draw(root, chart), dir, stem);
     #[cfg(not(feature = "plot"))]
     return disabled(&chart.title, dir, stem);
 }
@@ -79,7 +71,7 @@ pub fn render(chart: &Chart, dir: &Path, stem: &str) -> Result<Rendered, PlotErr
 /// Draws `bars` into `dir/stem.svg` and `dir/stem.png`, like [`render`].
 pub fn render_stacked(bars: &StackedBars, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
     #[cfg(feature = "plot")]
-    return render::render_figure(bars, dir, stem);
+    return render::render_figure(|root| bars::draw(root, bars), dir, stem);
     #[cfg(not(feature = "plot"))]
     return disabled(&bars.title, dir, stem);
 }

@@ -1,40 +1,33 @@
-//! Writing figures: each is drawn twice, to an SVG string and to a PNG under a temporary name,
-//! and only when both drawings succeeded are the files moved into place, so a failure never
-//! leaves a half-written or mismatched pair behind.
+//! Writing figures: each is drawn once, to an SVG string, and the PNG is that SVG rasterized by
+//! resvg. Both are finished in memory before either file is written, so a drawing failure
+//! never leaves a half-written or mismatched pair behind.
 
-use plotters::coord::Shift;
 use plotters::prelude::*;
+use resvg::{tiny_skia, usvg};
 use std::fs;
 use std::path::Path;
 
-use super::raster::GlyphText;
-use super::shapes::DrawResult;
-use super::spec::{Chart, Rendered, StackedBars};
-use super::{PlotError, bars, chart, font};
+use super::spec::Rendered;
+use super::text::Area;
+use super::{PlotError, font};
 use crate::output::write_atomic;
 
 /// Pixel size of both the SVG and the PNG.
 pub const SIZE: (u32, u32) = (1000, 650);
 
-/// Something that can draw itself on any plotters backend.
-pub trait Figure {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult;
-}
+/// Only a regular face is embedded, so resvg would draw bold text (the title) regular; a
+/// 1 px outline gives it about the weight of a real bold. It applies to the PNG only: SVG
+/// viewers use their own bold face.
+const FAKE_BOLD: &str = "text[font-weight=bold] { stroke: #222222; stroke-width: 1.0 }";
 
-impl Figure for Chart {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
-        chart::draw(root, self)
-    }
-}
+pub use super::text::{DrawResult, err};
 
-impl Figure for StackedBars {
-    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult {
-        bars::draw(root, self)
-    }
-}
-
-/// Draws `figure` into `dir/stem.svg` and `dir/stem.png`, creating `dir` if needed.
-pub fn render_figure(figure: &impl Figure, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
+/// Draws a figure with `draw` into `dir/stem.svg` and `dir/stem.png`, creating `dir` if needed.
+pub fn render_figure(
+    draw: impl Fn(&Area) -> DrawResult,
+    dir: &Path,
+    stem: &str,
+) -> Result<Rendered, PlotError> {
     super::check_stem(stem)?;
     font::register();
     fs::create_dir_all(dir).map_err(|source| PlotError::Dir {
@@ -43,48 +36,64 @@ pub fn render_figure(figure: &impl Figure, dir: &Path, stem: &str) -> Result<Ren
     })?;
     let svg_path = dir.join(format!("{stem}.svg"));
     let png_path = dir.join(format!("{stem}.png"));
+    let failed = |path: &Path| {
+        let path = path.to_path_buf();
+        move |message| PlotError::Draw { path, message }
+    };
 
     let mut svg = String::new();
     {
         let root = SVGBackend::with_string(&mut svg, SIZE).into_drawing_area();
-        let drawn = figure
-            .draw(&root)
-            .and_then(|()| root.present().map_err(|e| e.to_string()));
-        drawn.map_err(|message| PlotError::Draw {
-            path: svg_path.clone(),
-            message,
-        })?;
+        draw(&root)
+            .and_then(|()| root.present().map_err(|e| e.to_string()))
+            .map_err(failed(&svg_path))?;
     }
-
-    // The bitmap backend picks the image format from the extension, so the temporary name
-    // must end in `.png` too.
-    let png_tmp = dir.join(format!(".{stem}.{}.tmp.png", std::process::id()));
-    let drawn = draw_png(figure, &png_tmp);
-    let finished = drawn
-        .map_err(|message| PlotError::Draw {
-            path: png_path.clone(),
-            message,
-        })
-        .and_then(|()| Ok(write_atomic(&svg_path, svg.as_bytes())?))
-        .and_then(|()| {
-            fs::rename(&png_tmp, &png_path).map_err(|source| {
-                PlotError::Write(crate::output::WriteError {
-                    path: png_path.clone(),
-                    source,
-                })
-            })
-        });
-    if finished.is_err() {
-        let _ = fs::remove_file(&png_tmp);
-    }
-    finished.map(|()| Rendered {
+    let png = rasterize(&svg).map_err(failed(&png_path))?;
+    write_atomic(&svg_path, svg.as_bytes())?;
+    write_atomic(&png_path, &png)?;
+    Ok(Rendered {
         svg: svg_path,
         png: png_path,
     })
 }
 
-fn draw_png(figure: &impl Figure, path: &Path) -> DrawResult {
-    let root = GlyphText(BitMapBackend::new(path, SIZE)).into_drawing_area();
-    figure.draw(&root)?;
-    root.present().map_err(|e| e.to_string())
+/// The PNG of `svg`, drawn with the embedded font only.
+pub fn rasterize(svg: &str) -> Result<Vec<u8>, String> {
+    let options = usvg::Options {
+        fontdb: font::FONTS.clone(),
+        style_sheet: Some(FAKE_BOLD.into()),
+        ..usvg::Options::default()
+    };
+    let tree = usvg::Tree::from_str(svg, &options).map_err(|e| e.to_string())?;
+    let mut pixmap = tiny_skia::Pixmap::new(SIZE.0, SIZE.1).ok_or("empty image size")?;
+    pixmap.fill(tiny_skia::Color::WHITE);
+    resvg::render(&tree, tiny_skia::Transform::default(), &mut pixmap.as_mut());
+    pixmap.encode_png().map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Dark pixels in the PNG of `svg`.
+    fn ink(svg: &str) -> usize {
+        let png = rasterize(svg).unwrap();
+        let pixmap = tiny_skia::Pixmap::decode_png(&png).unwrap();
+        pixmap.pixels().iter().filter(|p| p.red() < 128).count()
+    }
+
+    #[test]
+    fn text_is_drawn_with_the_embedded_font_and_bold_is_heavier() {
+        let svg = |weight: &str| {
+            format!(
+                r#"<svg xmlns="http://www.w3.org/2000/svg" width="1000" height="650"><text x="10" y="50" font-family="sans-serif" font-size="30" font-weight="{weight}">Heavy text</text></svg>"#
+            )
+        };
+        let (regular, bold) = (ink(&svg("normal")), ink(&svg("bold")));
+        assert!(regular > 500, "no text drawn: {regular} dark pixels");
+        assert!(
+            bold as f64 > 1.2 * regular as f64,
+            "bold {bold}, regular {regular}"
+        );
+    }
 }

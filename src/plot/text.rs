@@ -1,5 +1,5 @@
-//! Text that fits: sizes and styles used across figures, and wrapping or shortening a string to
-//! a pixel width measured with the embedded font.
+//! What every drawing shares: the drawing area, text sizes, colours and styles, measuring,
+//! shortening and wrapping text, and the result type of a drawing step.
 
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -7,13 +7,21 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::font::FAMILY;
 
+pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+
+/// The result of a drawing step; the error is plotters' message.
+pub type DrawResult = Result<(), String>;
+
+pub fn err(e: impl std::fmt::Display) -> String {
+    e.to_string()
+}
+
 pub const TITLE_SIZE: f64 = 22.0;
 pub const TICK_SIZE: f64 = 14.0;
 pub const AXIS_LABEL_SIZE: f64 = 16.0;
 pub const LEGEND_SIZE: f64 = 14.0;
 pub const CAPTION_SIZE: f64 = 13.0;
 pub const NOTE_SIZE: f64 = 12.0;
-
 pub const TEXT_COLOR: RGBColor = RGBColor(0x22, 0x22, 0x22);
 pub const MUTED_COLOR: RGBColor = RGBColor(0x55, 0x55, 0x55);
 
@@ -21,96 +29,51 @@ pub fn style(size: f64) -> TextStyle<'static> {
     (FAMILY, size).into_font().color(&TEXT_COLOR)
 }
 
-pub fn bold(size: f64) -> TextStyle<'static> {
-    (FAMILY, size, FontStyle::Bold)
-        .into_font()
-        .color(&TEXT_COLOR)
-}
-
-pub fn anchored(style: TextStyle<'static>, h: HPos, v: VPos) -> TextStyle<'static> {
-    style.pos(Pos::new(h, v))
+pub fn anchored(size: f64, h: HPos, v: VPos) -> TextStyle<'static> {
+    style(size).pos(Pos::new(h, v))
 }
 
 /// Width in pixels of `text` drawn in `style` (0 if the font cannot measure it).
-pub fn width<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    text: &str,
-    style: &TextStyle,
-) -> u32 {
-    area.estimate_text_size(text, style)
-        .map(|(w, _)| w)
-        .unwrap_or(0)
+pub fn width(area: &Area, text: &str, style: &TextStyle) -> u32 {
+    area.estimate_text_size(text, style).map_or(0, |(w, _)| w)
 }
 
-/// Splits `text` at spaces (or `/`, keeping it) into at most `max_lines` lines no wider than
-/// `max_width`; the last line is shortened with an ellipsis if the text still does not fit.
-pub fn wrap<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
+/// `text` cut short with `…` so that it is no wider than `max_width`.
+pub fn shorten(area: &Area, text: &str, style: &TextStyle, max_width: u32) -> String {
+    let chars: Vec<char> = text.chars().collect();
+    let fits = |s: &str| width(area, s, style) <= max_width;
+    if fits(text) {
+        return text.to_string();
+    }
+    (1..chars.len())
+        .rev()
+        .map(|keep| chars[..keep].iter().collect::<String>() + "…")
+        .find(|s| fits(s))
+        .unwrap_or_else(|| "…".into())
+}
+
+/// Splits `text` after spaces or `/` (so case names such as `lj-box/cell-list/n=1000` break
+/// between parts) into at most `max_lines` lines no wider than `max_width`, shortening the last.
+pub fn wrap(
+    area: &Area,
     text: &str,
     style: &TextStyle,
     max_width: u32,
     max_lines: usize,
 ) -> Vec<String> {
-    let fits = |s: &str| width(area, s, style) <= max_width;
-    let mut lines: Vec<String> = Vec::new();
-    let mut current = String::new();
-    for word in words(text) {
+    let mut lines = vec![String::new()];
+    for word in text.split_inclusive([' ', '/']) {
+        let full = lines.len() >= max_lines;
+        let current = lines.last_mut().expect("never empty");
         let candidate = format!("{current}{word}");
-        if current.is_empty() || fits(candidate.trim_end()) {
-            current = candidate;
+        if full || current.is_empty() || width(area, candidate.trim_end(), style) <= max_width {
+            *current = candidate;
         } else {
-            lines.push(current.trim_end().to_string());
-            current = word.trim_start().to_string();
+            lines.push(word.to_string());
         }
     }
-    if !current.trim().is_empty() || lines.is_empty() {
-        lines.push(current.trim_end().to_string());
-    }
-    if lines.len() > max_lines {
-        let rest = lines.split_off(max_lines - 1).join(" ");
-        lines.push(rest);
-    }
-    if let Some(last) = lines.last_mut() {
-        *last = shorten(area, last, style, max_width);
-    }
-    lines
-}
-
-/// Words of `text` with their trailing separator: spaces, and `/` so that case names such as
-/// `lj-box/cell-list/n=1000` can break between parts.
-fn words(text: &str) -> Vec<&str> {
-    let mut out = Vec::new();
-    let mut start = 0;
-    for (i, c) in text.char_indices() {
-        if c == ' ' || c == '/' {
-            out.push(&text[start..i + c.len_utf8()]);
-            start = i + c.len_utf8();
-        }
-    }
-    if start < text.len() {
-        out.push(&text[start..]);
-    }
-    out
-}
-
-/// `text` cut short with `…` so that it is no wider than `max_width`.
-pub fn shorten<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    text: &str,
-    style: &TextStyle,
-    max_width: u32,
-) -> String {
-    if width(area, text, style) <= max_width {
-        return text.to_string();
-    }
-    let chars: Vec<char> = text.chars().collect();
-    let mut keep = chars.len();
-    while keep > 0 {
-        keep -= 1;
-        let candidate: String = chars[..keep].iter().collect::<String>() + "…";
-        if width(area, &candidate, style) <= max_width {
-            return candidate;
-        }
-    }
-    "…".into()
+    let lines = lines
+        .iter()
+        .map(|l| shorten(area, l.trim(), style, max_width));
+    lines.collect()
 }

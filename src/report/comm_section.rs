@@ -4,10 +4,11 @@
 use super::Sweep;
 use super::keep::region;
 use crate::analysis::comm::{CommModel, Prediction};
-use crate::analysis::figures::Figure;
-use crate::analysis::summary::{est, secs};
+use crate::decomp::Decomposition;
 use crate::plot::figures::{self as fig, CommTimes, Curve, Measured};
 use crate::plot::{Axis, Unit};
+use crate::render::figures::Figure;
+use crate::units::{Duration, Plain, WithCi};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -19,12 +20,12 @@ pub struct Comm {
 }
 
 /// Measured communication per step of `decomp` at each rank count of the MPI sweep.
-fn measured(weak_mpi: Option<&Sweep>, decomp: &str) -> Vec<Measured> {
+fn measured(weak_mpi: Option<&Sweep>, decomp: Decomposition) -> Vec<Measured> {
     let Some(s) = weak_mpi else { return Vec::new() };
     s.analysis
         .cases
         .iter()
-        .filter(|c| c.decomp.as_deref() == Some(decomp) && c.ranks > 1)
+        .filter(|c| c.decomp == Some(decomp) && c.ranks > 1)
         .filter_map(|c| {
             Some(Measured::new(c.ranks as f64, c.comm_s_per_step?).oversubscribed(c.oversubscribed))
         })
@@ -51,22 +52,28 @@ pub fn comm_figures(
     dir: &Path,
 ) -> (Vec<Figure>, Vec<String>) {
     let caption = weak_mpi
-        .map(|s| crate::analysis::figures::caption(&s.analysis))
+        .map(|s| crate::render::figures::caption(&s.analysis))
         .unwrap_or_else(|| model.source.clone());
     let mut figures = Vec::new();
     let mut errors = Vec::new();
-    for (decomp, points) in [("allgather", &model.allgather), ("domain", &model.domain)] {
+    for (decomp, points) in [
+        (Decomposition::Allgather, &model.allgather),
+        (Decomposition::Domain, &model.domain),
+    ] {
         if points.is_empty() {
             continue;
         }
         let comm = CommTimes {
             x: Axis::log("MPI ranks p (n = n₀·p)").unit(Unit::Count),
             measured: measured(weak_mpi, decomp),
-            predicted: curve(&format!("α-β prediction ({decomp})"), points),
+            predicted: curve(&format!("α-β prediction ({})", decomp.name()), points),
         };
         let mut chart = fig::comm_time(&comm, &caption);
-        chart.title = format!("Communication per step, {decomp}: measured vs predicted");
-        let stem = format!("comm-{decomp}");
+        chart.title = format!(
+            "Communication per step, {}: measured vs predicted",
+            decomp.name()
+        );
+        let stem = format!("comm-{}", decomp.name());
         match crate::plot::render(&chart, dir, &stem) {
             Ok(_) => figures.push(Figure {
                 stem,
@@ -100,12 +107,12 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
             let _ = writeln!(
                 md,
                 "| {} | {}{} | {} | {} | {} | {:.1}% | {:.0} |",
-                c.decomp.as_deref().unwrap_or(""),
+                c.decomp.map_or("", |d| d.name()),
                 c.ranks,
                 if c.oversubscribed { "*" } else { "" },
                 c.n,
-                secs(c.median_s),
-                secs(comm_s),
+                Duration(c.median_s),
+                Duration(comm_s),
                 100.0 * comm_s / c.median_s.max(f64::MIN_POSITIVE),
                 c.bytes_per_step.unwrap_or(0.0)
             );
@@ -118,7 +125,7 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
             Some(f) => {
                 let _ = writeln!(
                     md,
-                    "α-β fit of the ping-pong in `{}` ({} ranks{}): latency α = {} µs, inverse bandwidth β = {} ns/byte \
+                    "α-β fit of the ping-pong in `{}` ({} ranks{}): latency α = {:.3} µs, inverse bandwidth β = {:.4} ns/byte \
                      (bootstrap 95% CIs). **Prediction** (not measured) for a weak-scaling series of lj-box with \
                      n = {}·p, f32: replicated data moves every position each step (⌈log2 p⌉ latencies + the gathered \
                      bytes), the spatial decomposition only ghosts within rc of the region borders.\n",
@@ -129,8 +136,8 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
                     } else {
                         ""
                     },
-                    est(&f.alpha.map(|a| a * 1e6), 3),
-                    est(&f.beta.map(|b| b * 1e9), 4),
+                    WithCi::of(&f.alpha.map(|a| a * 1e6), Plain),
+                    WithCi::of(&f.beta.map(|b| b * 1e9), Plain),
                     m.n_per_rank
                 );
                 md.push_str("| ranks | n | allgather bytes/rank | allgather predicted | domain bytes/rank | domain predicted |\n|---|---|---|---|---|---|\n");
@@ -141,13 +148,13 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
                         a.ranks,
                         a.n,
                         a.bytes_per_rank,
-                        secs(a.seconds),
-                        secs(a.ci95[0]),
-                        secs(a.ci95[1]),
+                        Duration(a.seconds),
+                        Duration(a.ci95[0]),
+                        Duration(a.ci95[1]),
                         d.bytes_per_rank,
-                        secs(d.seconds),
-                        secs(d.ci95[0]),
-                        secs(d.ci95[1])
+                        Duration(d.seconds),
+                        Duration(d.ci95[0]),
+                        Duration(d.ci95[1])
                     );
                 }
                 md.push('\n');

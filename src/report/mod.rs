@@ -53,7 +53,7 @@ pub struct Sweep {
     pub analysis: Analysis,
     /// Directory of the figures relative to the report's directory, with `/` separators.
     pub figures_dir: String,
-    pub figures: Vec<analysis::figures::Figure>,
+    pub figures: Vec<crate::render::figures::Figure>,
 }
 
 /// What `generate` wrote.
@@ -106,7 +106,7 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
             .parent()
             .expect("results files are in a directory")
             .join("analysis");
-        let written = analysis::write(&a, &dir)?;
+        let written = crate::render::write(&a, &dir)?;
         figure_errors.extend(written.figure_errors);
         sweeps.push(Sweep {
             figures_dir: relative(&dir, report_dir),

@@ -2,26 +2,13 @@
 
 use super::Sweep;
 use super::keep::region;
-use crate::analysis::Analysis;
-use crate::analysis::groups::Point;
-use crate::analysis::summary::{est, est_percent, secs};
 use crate::experiment::config::Study;
-use crate::physics::LawKind;
+use crate::render::tables;
 use std::fmt::Write;
 use std::path::Path;
 
 const NO_NOTES: &str =
     "_No interpretation written yet: write it here; `nbody-bench report` keeps this region._";
-
-/// Nominal floating-point operations per pair evaluation in our pair loops (a square root and
-/// a division count as one each), used to express pair rates as a share of the FMA peak.
-fn flops_per_pair(law: LawKind) -> f64 {
-    match law {
-        LawKind::LennardJones => 18.0,
-        LawKind::Gravity => 20.0,
-        LawKind::Coulomb => 21.0,
-    }
-}
 
 pub use super::comm_section::{Comm, comm_figures};
 
@@ -117,20 +104,6 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
     md.push('\n');
 }
 
-fn peak_share(a: &Analysis, p: &Point, law: LawKind, precision: &str) -> String {
-    let Some(c) = &a.calibration else {
-        return "–".into();
-    };
-    if p.pair_evals_per_s <= 0.0 {
-        return "–".into();
-    }
-    let flops = c.fma_gflops_1t * 1e9 * (p.p() as f64) * if precision == "f64" { 0.5 } else { 1.0 };
-    format!(
-        "{:.0}%",
-        100.0 * p.pair_evals_per_s * flops_per_pair(law) / flops
-    )
-}
-
 fn complexity(md: &mut String, sweeps: &[Sweep]) {
     let with: Vec<&Sweep> = sweeps
         .iter()
@@ -145,41 +118,14 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
         let _ = writeln!(
             md,
             "From `{}`. Time per step at the largest n, the free power law `T = c·n^k` (bootstrap 95% CI) and the \
-             complexity class chosen by leave-one-out cross-validation (SMAPE). \"Peak\" is the pair rate as a share \
-             of the calibrated FMA peak of the threads used, at a nominal {} / {} / {} flops per LJ / gravity / \
-             Coulomb pair (f64 at half the f32 rate).\n",
+             complexity class chosen by leave-one-out cross-validation (SMAPE). {}\n",
             a.source,
-            flops_per_pair(LawKind::LennardJones),
-            flops_per_pair(LawKind::Gravity),
-            flops_per_pair(LawKind::Coulomb)
+            tables::peak_note()
         );
-        md.push_str("| scenario | kernel | n | time/step | ns/particle-step | pair-evals/s | peak | k [95% CI] | class |\n|---|---|---|---|---|---|---|---|---|\n");
-        for c in &a.complexity {
-            let (Some(first), Some(last)) = (c.points.first(), c.points.last()) else {
-                continue;
-            };
-            let (k, class) = match &c.fit.fit {
-                Some(f) => (est(&f.exponent, 2), f.class.name().to_string()),
-                None => ("–".into(), "not fitted".into()),
-            };
-            let _ = writeln!(
-                md,
-                "| {} | {} | {}–{} | {} | {:.1} | {:.2e} | {} | {k} | {class} |",
-                c.series.scenario.name(),
-                c.label,
-                first.n,
-                last.n,
-                secs(last.median_s),
-                last.ns_per_particle_step,
-                last.pair_evals_per_s,
-                peak_share(a, last, c.series.scenario.law(), &c.series.precision)
-            );
-        }
+        md.push_str(&tables::complexity(a));
         if !a.crossovers.is_empty() {
             md.push_str("\nCrossovers of the fitted curves:\n\n");
-            for x in &a.crossovers {
-                let _ = writeln!(md, "- {}", crate::analysis::crossover_sentence(x));
-            }
+            md.push_str(&tables::crossovers(a));
         }
         md.push('\n');
         figure_links(md, s, "time-vs-n-");
@@ -205,74 +151,9 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
              oversubscription, not parallel speedup.\n",
             a.source
         );
-        md.push_str("| scenario | kernel | n | speedup by p (÷ ceiling) | Amdahl f [95% CI] | 1/f | Karp-Flatt | f from phase timers |\n|---|---|---|---|---|---|---|---|\n");
-        for st in &a.strong {
-            let Some(f) = &st.fit.fit else {
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | not fitted: {} | | | | |",
-                    st.series.scenario.name(),
-                    st.label,
-                    st.series.n.unwrap_or(0),
-                    st.fit.error.as_deref().unwrap_or("")
-                );
-                continue;
-            };
-            let cells: Vec<String> = st
-                .measured
-                .iter()
-                .filter(|p| p.p > 1.0)
-                .map(|p| {
-                    let over = st
-                        .points
-                        .iter()
-                        .any(|c| c.p() as f64 == p.p && c.oversubscribed);
-                    let rel = p
-                        .speedup_vs_ceiling
-                        .as_ref()
-                        .map(|e| format!(" (÷ {:.2})", e.estimate))
-                        .unwrap_or_default();
-                    format!(
-                        "{}{}: {}{rel}",
-                        p.p,
-                        if over { "*" } else { "" },
-                        est(&p.speedup, 2)
-                    )
-                })
-                .collect();
-            let max = if f.max_speedup.estimate.is_finite() {
-                format!("{:.1}", f.max_speedup.estimate)
-            } else {
-                "∞".into()
-            };
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {max} | {} | {} |",
-                st.series.scenario.name(),
-                st.label,
-                st.series.n.unwrap_or(0),
-                cells.join("<br>"),
-                est_percent(&f.serial_fraction),
-                f.karp_flatt_trend.verdict.name(),
-                st.timed_serial
-                    .as_ref()
-                    .map(|t| format!("{:.2}%", 100.0 * t.fraction))
-                    .unwrap_or_else(|| "–".into())
-            );
-        }
+        md.push_str(&tables::strong(a));
         md.push_str("\nTimed vs fitted serial fraction (source 002's method next to the fit):\n\n");
-        for st in &a.strong {
-            if let Some(c) = &st.serial_comparison {
-                let _ = writeln!(
-                    md,
-                    "- {} {} n={}: {}",
-                    st.series.scenario.name(),
-                    st.label,
-                    st.series.n.unwrap_or(0),
-                    c.explanation
-                );
-            }
-        }
+        md.push_str(&tables::serial_comparisons(a));
         md.push('\n');
         figure_links(md, s, "speedup-");
         figure_links(md, s, "karp-flatt-");
@@ -299,45 +180,7 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
              fraction α from S(p) = p − α(p − 1). * = oversubscribed.\n",
             a.source
         );
-        md.push_str("| scenario | kernel | p: n, efficiency | Gustafson α |\n|---|---|---|---|\n");
-        for w in &a.weak {
-            let Some(f) = &w.fit.fit else {
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | not fitted: {} | |",
-                    w.series.scenario.name(),
-                    w.label,
-                    w.fit.error.as_deref().unwrap_or("")
-                );
-                continue;
-            };
-            let cells: Vec<String> = w
-                .measured
-                .iter()
-                .map(|e| {
-                    let c = w.points.iter().find(|c| c.p() as f64 == e.p);
-                    format!(
-                        "{}{}: n={}, {}",
-                        e.p,
-                        if c.is_some_and(|c| c.oversubscribed) {
-                            "*"
-                        } else {
-                            ""
-                        },
-                        c.map(|c| c.n).unwrap_or(0),
-                        est(&e.e, 2)
-                    )
-                })
-                .collect();
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} |",
-                w.series.scenario.name(),
-                w.label,
-                cells.join("<br>"),
-                est_percent(&f.serial_fraction)
-            );
-        }
+        md.push_str(&tables::weak(a));
         md.push('\n');
         figure_links(md, s, "weak-efficiency-");
     }
@@ -359,23 +202,7 @@ fn octree(md: &mut String, sweeps: &[Sweep]) {
             "From `{}`. Relative force error against an f64 direct sum on sampled particles.\n",
             s.analysis.source
         );
-        md.push_str("| scenario | n | θ | time/step | µs/particle-step | median / max relative force error |\n|---|---|---|---|---|---|\n");
-        for t in &s.analysis.theta {
-            for p in &t.points {
-                let _ = writeln!(
-                    md,
-                    "| {} | {} | {} | {} | {:.2} | {} |",
-                    t.series.scenario.name(),
-                    p.n,
-                    p.theta.unwrap_or(f64::NAN),
-                    secs(p.median_s),
-                    p.ns_per_particle_step * 1e-3,
-                    p.force_error
-                        .map(|[m, x]| format!("{m:.2e} / {x:.2e}"))
-                        .unwrap_or_else(|| "not measured".into())
-                );
-            }
-        }
+        md.push_str(&tables::theta(&s.analysis));
         md.push('\n');
         figure_links(md, s, "octree-accuracy");
     }
@@ -386,37 +213,11 @@ fn sanity(md: &mut String, sweeps: &[Sweep]) {
     md.push_str(
         "\n## Physics sanity: energy drift per kernel\n\n\
          Largest |relative energy drift| over the measured steps of any case, per sweep, scenario and kernel; \
-         a case over its sweep's limit is flagged and counted.\n\n\
-         | sweep | scenario | kernel | cases | largest drift | flagged |\n|---|---|---|---|---|---|\n",
+         a case over its sweep's limit is flagged and counted.\n\n",
     );
+    md.push_str(tables::sanity_header(true));
     for s in sweeps {
-        let mut rows: Vec<(String, String, usize, f64, usize)> = Vec::new();
-        for c in &s.analysis.cases {
-            let mut parts = c.key.split('/');
-            let scen = parts.next().unwrap_or("").to_string();
-            let kernel = parts.next().unwrap_or("").to_string();
-            match rows.iter_mut().find(|r| r.0 == scen && r.1 == kernel) {
-                Some(r) => {
-                    r.2 += 1;
-                    r.3 = r.3.max(c.max_energy_drift);
-                    r.4 += usize::from(!c.sanity_ok);
-                }
-                None => rows.push((
-                    scen,
-                    kernel,
-                    1,
-                    c.max_energy_drift,
-                    usize::from(!c.sanity_ok),
-                )),
-            }
-        }
-        for (scen, kernel, n, drift, flagged) in rows {
-            let _ = writeln!(
-                md,
-                "| {} | {scen} | {kernel} | {n} | {drift:.1e} | {flagged} |",
-                s.analysis.name
-            );
-        }
+        md.push_str(&tables::sanity_rows(&s.analysis, Some(&s.analysis.name)));
     }
     md.push('\n');
     md.push_str(&region("sanity", NO_NOTES));

@@ -85,3 +85,39 @@ fn analyze_refuses_truncated_and_foreign_files_with_exit_2() {
         assert!(!dir.path().join("out").join("fits.json").exists());
     }
 }
+
+/// Snapshots: the committed sweeps give exactly their committed `summary.md` and `fits.json`
+/// (the tables `summary.md` shares with REPORT.md come from one renderer; a change of any table
+/// shows here as a diff to review and commit with `nbody-bench report`).
+#[test]
+fn committed_sweeps_give_their_committed_summaries_byte_for_byte() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut checked = 0;
+    for entry in std::fs::read_dir(root.join("results")).unwrap().flatten() {
+        let sweep = entry.path();
+        let committed = sweep.join("analysis/summary.md");
+        if !sweep.join("results.json").is_file() || !committed.is_file() {
+            continue;
+        }
+        let name = sweep.file_name().unwrap().to_string_lossy().into_owned();
+        let dir = tempfile::tempdir().unwrap();
+        let out = bin()
+            .current_dir(root)
+            .args(["analyze", &format!("results/{name}/results.json"), "--out"])
+            .arg(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for file in ["summary.md", "fits.json"] {
+            let want = std::fs::read_to_string(sweep.join("analysis").join(file)).unwrap();
+            let got = std::fs::read_to_string(dir.path().join(file)).unwrap();
+            assert!(got == want, "{name}/{file} differs from the committed one");
+        }
+        checked += 1;
+    }
+    assert!(checked >= 5, "only {checked} committed sweeps found");
+}

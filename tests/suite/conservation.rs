@@ -21,7 +21,8 @@ fn drift(scenario: ScenarioKind, kernel: KernelKind, n: usize, steps: u64, dt: O
         trajectory: None,
         dump_state: None,
     };
-    let r = setup.dispatch(RunJob(&spec)).unwrap().unwrap();
+    let clock = nbody_bench::clock::WallClock::new();
+    let r = setup.dispatch(RunJob(&spec, &clock)).unwrap().unwrap();
     assert_eq!(r.steps, steps);
     r.energy.rel_drift
 }
@@ -152,4 +153,32 @@ fn two_body_circular_orbit_stays_circular() {
         );
         assert!(((sim.probe().total() - e0) / e0).abs() < 1e-8);
     }
+}
+
+#[test]
+fn run_times_its_steps_with_the_clock_it_is_given() {
+    // Every reading of the scripted clock advances 1 ms, and two readings bracket a step: the
+    // step percentiles are exactly 1 ms and the run's total is 2 ms per step plus one.
+    let mut setup = Setup::new(ScenarioKind::LjBox);
+    setup.n = Some(50);
+    let spec = RunSpec {
+        kernel: KernelKind::Naive,
+        params: KernelParams::default(),
+        steps: 20,
+        threads: 1,
+        trajectory: None,
+        dump_state: None,
+    };
+    let clock = nbody_bench::clock::MockClock::new(std::time::Duration::from_millis(1));
+    let r = setup.dispatch(RunJob(&spec, &clock)).unwrap().unwrap();
+    let p = &r.timing.per_step_ns;
+    // The step histogram keeps three significant digits.
+    for ns in [p.min, p.p50, p.p99, p.max] {
+        assert!((ns as f64 - 1e6).abs() <= 1e3, "{p:?}");
+    }
+    assert!(
+        (r.timing.total_s - 0.041).abs() < 1e-9,
+        "{}",
+        r.timing.total_s
+    );
 }

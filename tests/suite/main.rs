@@ -18,6 +18,7 @@ mod gate;
 mod invariants;
 mod kernel_parts;
 mod kernels_agree;
+mod layering;
 mod mpi_cli;
 mod parsers;
 mod report;

@@ -1,8 +1,8 @@
 //! The runner with a scripted clock (deterministic sample counts, resume without loss or
 //! repetition) and an end-to-end sweep through the CLI.
 
+use nbody_bench::clock::MockClock;
 use nbody_bench::experiment::config::SweepConfig;
-use nbody_bench::experiment::measure::MockClock;
 use nbody_bench::experiment::results::{RESULTS_SCHEMA, ResultsFile};
 use nbody_bench::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
 use std::path::Path;

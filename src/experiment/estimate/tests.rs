@@ -201,12 +201,3 @@ fn a_probe_measures_each_set_up_once() {
     let e = estimate(&c, &probed.cases, &Done::default(), true, 2);
     assert!(e.total_s.is_finite() && e.total_s > e.calibration_s);
 }
-
-#[test]
-fn durations_read_in_the_right_unit() {
-    assert_eq!(fmt_duration(1.234), "1.23 s");
-    assert_eq!(fmt_duration(12.34), "12.3 s");
-    assert_eq!(fmt_duration(90.0), "1.5 min");
-    assert_eq!(fmt_duration(5400.0), "1.5 h");
-    assert_eq!(fmt_duration(3.0 * 86_400.0), "3.0 days");
-}

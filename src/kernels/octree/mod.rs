@@ -55,7 +55,9 @@ pub struct Octree<L, T, const D: usize> {
 }
 
 impl<L, T: Real, const D: usize> Octree<L, T, D> {
-    /// `theta ≥ 0` and `1 ≤ leaf_size` are validated by the caller (`KernelParams::validate`).
+    /// Takes `theta ≥ 0` and `1 ≤ leaf_size` as given: outside this module the tree is only
+    /// built by `KernelKind::build`, which checks them first (`KernelParams::validate`); the
+    /// module's own tests pass valid values.
     pub fn new(law: L, theta: f64, leaf_size: usize) -> Self {
         Octree {
             law,

@@ -1,7 +1,7 @@
 //! Figures that look inside a run: where a step's time goes, how its time is spread, how the
 //! octree trades accuracy for cost, and how measured communication compares with a model.
 
-use super::{Curve, Measured};
+use super::{Curve, Measured, extent};
 use crate::plot::spec::{
     Axis, Band, Chart, Point, Region, Scale, Series, SeriesStyle, StackedBars, Unit,
 };
@@ -173,46 +173,29 @@ pub fn comm_time(comm: &CommTimes, caption: &str) -> Chart {
         Series::new("measured (median, 95% CI)", points, SeriesStyle::Markers).color(MEASURED),
     );
 
-    let finite = |xs: &mut dyn Iterator<Item = f64>| -> Option<(f64, f64)> {
-        let xs: Vec<f64> = xs.filter(|x| x.is_finite()).collect();
-        Some((
-            xs.iter().copied().reduce(f64::min)?,
-            xs.iter().copied().reduce(f64::max)?,
-        ))
+    let measured = extent(comm.measured.iter().map(|m| m.x));
+    let predicted_x = predicted.points.iter().map(|p| p.0);
+    let predicted_x = extent(predicted_x.chain(predicted.band.iter().map(|b| b.0)));
+    // Shaded: the predicted x range beyond the measured one on either side, or all of it
+    // without measurements. Only the first part is named in the legend.
+    let spans = match (predicted_x, measured) {
+        (None, _) => vec![],
+        (Some(predicted), None) => vec![predicted],
+        (Some((p_lo, p_hi)), Some((m_lo, m_hi))) => vec![(m_hi, p_hi), (p_lo, m_lo)],
     };
-    let measured = finite(&mut comm.measured.iter().map(|m| m.x));
-    let predicted_x = finite(
-        &mut predicted
-            .points
-            .iter()
-            .map(|p| p.0)
-            .chain(predicted.band.iter().map(|b| b.0)),
-    );
-    if let Some((p_lo, p_hi)) = predicted_x {
-        let label = "prediction only (not measured)";
-        let (m_lo, m_hi) = measured.unwrap_or((p_hi, p_hi));
-        if measured.is_none() {
-            chart.regions.push(Region {
-                label: label.into(),
-                x_from: p_lo,
-                x_to: p_hi,
-            });
-        }
-        if measured.is_some() && p_hi > m_hi {
-            chart.regions.push(Region {
-                label: label.into(),
-                x_from: m_hi,
-                x_to: p_hi,
-            });
-        }
-        if measured.is_some() && p_lo < m_lo {
-            let label = if p_hi > m_hi { "" } else { label };
-            chart.regions.push(Region {
-                label: label.into(),
-                x_from: p_lo,
-                x_to: m_lo,
-            });
-        }
+    let spans = spans.into_iter().filter(|(from, to)| to > from);
+    for (k, (x_from, x_to)) in spans.enumerate() {
+        let label = if k == 0 {
+            "prediction only (not measured)"
+        } else {
+            ""
+        };
+        let label = label.into();
+        chart.regions.push(Region {
+            label,
+            x_from,
+            x_to,
+        });
     }
     chart
 }

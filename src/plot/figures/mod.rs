@@ -102,6 +102,13 @@ pub fn grid(lo: f64, hi: f64, count: usize, scale: Scale) -> Vec<f64> {
         .collect()
 }
 
+/// The smallest and largest finite value.
+fn extent(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
+    let finite: Vec<f64> = values.filter(|v| v.is_finite()).collect();
+    let lo = finite.iter().copied().reduce(f64::min)?;
+    Some((lo, finite.iter().copied().fold(lo, f64::max)))
+}
+
 /// One kernel's measurements and, optionally, the model fitted to them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KernelSeries {

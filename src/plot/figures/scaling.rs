@@ -1,6 +1,6 @@
 //! Scaling figures: cost against n, and speedup, efficiency and Karp-Flatt against threads.
 
-use super::{KernelSeries, kernel_chart};
+use super::{KernelSeries, extent, kernel_chart};
 use crate::plot::palette::REFERENCE_INDEX;
 use crate::plot::spec::{Axis, Chart, RefLine, Series, SeriesStyle, Unit};
 
@@ -11,25 +11,16 @@ pub fn time_per_step(kernels: &[KernelSeries], caption: &str) -> Chart {
     kernel_chart("Time per step vs particle count", x, y, kernels, caption)
 }
 
-/// The smallest and largest x over all kernels' measurements and fits.
-fn x_extent(kernels: &[KernelSeries]) -> Option<(f64, f64)> {
-    let measured = kernels.iter().flat_map(|k| k.measured.iter().map(|m| m.x));
-    let fitted = kernels
-        .iter()
-        .flat_map(|k| k.fit.iter().flat_map(|f| f.points.iter().map(|p| p.0)));
-    let xs: Vec<f64> = measured.chain(fitted).filter(|x| x.is_finite()).collect();
-    let lo = xs.iter().copied().reduce(f64::min)?;
-    let hi = xs.iter().copied().reduce(f64::max)?;
-    Some((lo, hi))
-}
-
 /// Speedup T(1)/T(p) against threads with the ideal line S = p, the hardware ceiling measured
 /// by calibration as `(p, ceiling)` points, and each kernel's fit (e.g. Amdahl) with its band.
 pub fn speedup(kernels: &[KernelSeries], ceiling: &[(f64, f64)], caption: &str) -> Chart {
     let x = Axis::linear("threads p").unit(Unit::Count);
     let y = Axis::linear("speedup T(1) / T(p)").from_zero();
     let mut chart = kernel_chart("Strong scaling: speedup vs threads", x, y, kernels, caption);
-    if let Some((lo, hi)) = x_extent(kernels) {
+    let measured = kernels.iter().flat_map(|k| k.measured.iter().map(|m| m.x));
+    let fits = kernels.iter().flat_map(|k| &k.fit);
+    if let Some((lo, hi)) = extent(measured.chain(fits.flat_map(|f| f.points.iter().map(|p| p.0))))
+    {
         let ideal = Series::from_xy("ideal S = p", [(lo, lo), (hi, hi)], SeriesStyle::Dashed)
             .color(REFERENCE_INDEX);
         chart.series.insert(0, ideal);

@@ -1,5 +1,5 @@
-use crate::kernels::KernelKind;
-use crate::scenario::ScenarioKind;
+use nbody_bench::kernels::KernelKind;
+use nbody_bench::scenario::ScenarioKind;
 
 pub fn list() -> anyhow::Result<i32> {
     outln!("Kernels:");
@@ -51,7 +51,7 @@ pub fn list() -> anyhow::Result<i32> {
             "  {:<10} ({}): {}",
             s.name(),
             s.law().name(),
-            crate::kernels::supported_for(s.law())
+            nbody_bench::kernels::supported_for(s.law())
         );
     }
     Ok(0)

@@ -1,32 +1,7 @@
 //! The readable tables `fit` prints.
 
-use super::fmt_ns;
-use crate::fit::{CiMethod, ComplexityClass, Estimate, Input, PowerFit, StrongFit, WeakFit};
-
-/// A number in a width-friendly form: fixed below 1e4, scientific far from 1.
-fn num(x: f64) -> String {
-    if x.is_infinite() {
-        if x > 0.0 { "inf" } else { "-inf" }.to_string()
-    } else if x != 0.0 && (x.abs() >= 1e4 || x.abs() < 1e-3) {
-        format!("{x:.3e}")
-    } else {
-        format!("{x:.4}")
-    }
-}
-
-fn est(e: &Estimate) -> String {
-    format!(
-        "{} [{}, {}]",
-        num(e.estimate),
-        num(e.ci95[0]),
-        num(e.ci95[1])
-    )
-}
-
-fn est_s(e: &Estimate) -> String {
-    let s = |t: f64| fmt_ns(t * 1e9);
-    format!("{} [{}, {}]", s(e.estimate), s(e.ci95[0]), s(e.ci95[1]))
-}
+use nbody_bench::fit::{CiMethod, ComplexityClass, Input, PowerFit, StrongFit, WeakFit};
+use nbody_bench::units::{Duration, Number, WithCi};
 
 fn r2(r2: Option<f64>) -> String {
     r2.map_or("-".to_string(), |r| format!("{r:.4}"))
@@ -69,17 +44,17 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
             .karp_flatt
             .iter()
             .find(|k| k.p == pt.p)
-            .map_or("-".to_string(), |k| est(&k.e));
+            .map_or("-".to_string(), |k| WithCi::of(&k.e, Number).to_string());
         let ceiling = match (pt.ceiling, pt.speedup_vs_ceiling) {
-            (Some(c), Some(rel)) => format!("  {} of ceiling {c:.2}x", est(&rel)),
+            (Some(c), Some(rel)) => format!("  {} of ceiling {c:.2}x", WithCi::of(&rel, Number)),
             _ => String::new(),
         };
         let line = format!(
             "{:>6} {:>11}  {:<28} {:<28} {:<28}{ceiling}",
             pt.p,
-            fmt_ns(pt.median_s * 1e9),
-            est(&pt.speedup),
-            est(&pt.efficiency),
+            Duration(pt.median_s),
+            WithCi::of(&pt.speedup, Number),
+            WithCi::of(&pt.efficiency, Number),
             e
         );
         outln!("{}", line.trim_end());
@@ -87,15 +62,18 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
     outln!();
     outln!(
         "serial fraction f   {}{}",
-        est(&fit.serial_fraction),
+        WithCi::of(&fit.serial_fraction, Number),
         if fit.clamped {
             " (clamped to [0, 1])"
         } else {
             ""
         }
     );
-    outln!("T1                  {}", est_s(&fit.t1));
-    outln!("max speedup 1/f     {}", est(&fit.max_speedup));
+    outln!("T1                  {}", WithCi::of(&fit.t1, Duration));
+    outln!(
+        "max speedup 1/f     {}",
+        WithCi::of(&fit.max_speedup, Number)
+    );
     outln!(
         "fit of T(p)         r2 {}, SMAPE {:.2}%",
         r2(fit.goodness.r2),
@@ -106,7 +84,7 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         .slope_per_doubling
         .as_ref()
         .map_or(String::new(), |s| {
-            format!(" (slope per doubling of p {})", est(s))
+            format!(" (slope per doubling of p {})", WithCi::of(s, Number))
         });
     outln!(
         "Karp-Flatt trend    {}{slope}: {}",
@@ -129,8 +107,8 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         Some(k) => outln!(
             "overhead term       {} kept: c = {} s, f with it {} (leave-one-out SMAPE: {})",
             k.term.name(),
-            est(&k.coefficient),
-            est(&k.serial_fraction),
+            WithCi::of(&k.coefficient, Number),
+            WithCi::of(&k.serial_fraction, Number),
             loo.join(", ")
         ),
         None => outln!(
@@ -165,16 +143,16 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
         let line = format!(
             "{:>6} {:>11}  {:<28} {:<28} {work}",
             input.x,
-            fmt_ns(input.median * 1e9),
-            est(&fit.efficiency[i].e),
-            est(&fit.scaled_speedup[i].s),
+            Duration(input.median),
+            WithCi::of(&fit.efficiency[i].e, Number),
+            WithCi::of(&fit.scaled_speedup[i].s, Number),
         );
         outln!("{}", line.trim_end());
     }
     outln!();
     outln!(
         "serial fraction     alpha = {}{}  (S = p - alpha (p - 1))",
-        est(&fit.serial_fraction),
+        WithCi::of(&fit.serial_fraction, Number),
         if fit.clamped {
             " (clamped to [0, 1])"
         } else {
@@ -206,20 +184,27 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         outln!(
             "{:>12} {:>11} {:>8}",
             input.x,
-            fmt_ns(input.median * 1e9),
+            Duration(input.median),
             input.samples
         );
     }
     outln!();
-    outln!("exponent k          {}  (T = c*n^k)", est(&fit.exponent));
+    outln!(
+        "exponent k          {}  (T = c*n^k)",
+        WithCi::of(&fit.exponent, Number)
+    );
     outln!(
         "c                   {} s; log-log r2 {}",
-        est(&fit.coefficient),
+        WithCi::of(&fit.coefficient, Number),
         r2(fit.power_law_goodness.r2)
     );
     let sel = &fit.selected;
     let model = if sel.with_constant {
-        format!("a + c*{}, a = {} s", sel.class.name(), est(&sel.constant))
+        format!(
+            "a + c*{}, a = {} s",
+            sel.class.name(),
+            WithCi::of(&sel.constant, Number)
+        )
     } else {
         format!("c*{}", sel.class.name())
     };
@@ -227,7 +212,7 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         "complexity class    {} ({model}, c = {}); leave-one-out SMAPE {:.2}%, chosen by {:.0}% \
          of bootstrap replicates",
         sel.class.name(),
-        est(&sel.coefficient),
+        WithCi::of(&sel.coefficient, Number),
         sel.loo_smape_percent,
         100.0 * sel.support
     );

@@ -3,8 +3,8 @@
 //! step-time percentiles, and octree error vs cost. Each states machine, commit and sweep in
 //! its caption.
 
-use super::groups::Point;
-use super::{Analysis, ComplexityAnalysis, StrongAnalysis};
+use crate::analysis::groups::Point;
+use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis};
 use crate::plot::figures::{
     self as fig, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
@@ -103,7 +103,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         let k = &c.series;
         let id = (
             k.scenario.name().to_string(),
-            k.precision.clone(),
+            k.precision.name().to_string(),
             k.threads.unwrap_or(1),
             k.ranks.unwrap_or(1),
         );
@@ -141,7 +141,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         let id = (
             s.series.scenario.name().to_string(),
             s.series.n,
-            s.series.precision.clone(),
+            s.series.precision.name().to_string(),
         );
         if strong_seen.contains(&id) {
             continue;
@@ -250,11 +250,10 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         weak_seen.push(scen);
     }
     // Phase breakdown and step-time percentiles per scenario, at each case's largest n.
-    let mut scenarios: Vec<String> = a.cases.iter().map(|c| scenario_of(&c.key)).collect();
+    let mut scenarios: Vec<&str> = a.cases.iter().map(|c| c.case.scenario.name()).collect();
+    scenarios.sort_unstable();
     scenarios.dedup();
-    scenarios.sort();
-    scenarios.dedup();
-    for scen in &scenarios {
+    for scen in scenarios {
         let cases = representative_cases(a, scen);
         if cases.is_empty() {
             continue;
@@ -316,11 +315,8 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
     out
 }
 
-fn scenario_of(key: &str) -> String {
-    key.split('/').next().unwrap_or(key).to_string()
-}
-
-/// "octree θ=0.5 p=2 n=16384" — short enough for a category axis.
+/// "octree θ=0.5 p=2 n=16384" — short enough for a category axis: the case key (whose form
+/// the results file fixes) without its scenario, seed and single rank.
 pub fn case_label(c: &Point) -> String {
     let mut parts: Vec<&str> = c.key.split('/').collect();
     parts.retain(|p| !p.starts_with("seed=") && *p != "r=1");
@@ -330,10 +326,13 @@ pub fn case_label(c: &Point) -> String {
 /// The cases of a scenario worth a bar each: for every kernel and p, the largest n measured.
 fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
     let mut out: Vec<&Point> = Vec::new();
-    for c in a.cases.iter().filter(|c| scenario_of(&c.key) == scenario) {
-        let kernel = |p: &Point| p.key.split('/').nth(1).map(str::to_string);
+    for c in a
+        .cases
+        .iter()
+        .filter(|c| c.case.scenario.name() == scenario)
+    {
         let same = |o: &&Point| {
-            kernel(o) == kernel(c)
+            o.case.kernel == c.case.kernel
                 && o.threads == c.threads
                 && o.ranks == c.ranks
                 && o.theta == c.theta
@@ -350,7 +349,7 @@ fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
 }
 
 fn oversubscribed_at(points: &[Point], p: f64) -> bool {
-    points.iter().any(|c| c.p() as f64 == p && c.oversubscribed)
+    points.iter().any(|c| c.has_workers(p) && c.oversubscribed)
 }
 
 fn time_series(c: &ComplexityAnalysis) -> KernelSeries {

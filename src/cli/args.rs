@@ -1,10 +1,10 @@
 //! Command-line interface: argument definitions only; the work is in `commands`.
 
-use crate::decomp::Decomposition;
-use crate::kernels::KernelKind;
-use crate::output::nbview::NbviewFormat;
-use crate::scenario::{Precision, ScenarioKind};
 use clap::{Args, Parser, Subcommand};
+use nbody_bench::decomp::Decomposition;
+use nbody_bench::kernels::KernelKind;
+use nbody_bench::output::nbview::NbviewFormat;
+use nbody_bench::scenario::{Precision, ScenarioKind};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -295,9 +295,9 @@ fn parse_count_at_most<const MAX: usize>(s: &str) -> Result<usize, String> {
 
 fn parse_threads(s: &str) -> Result<usize, String> {
     match parse_count(s)? {
-        t if t > crate::run::MAX_THREADS => Err(format!(
+        t if t > nbody_bench::run::MAX_THREADS => Err(format!(
             "{t} threads is more than {} (each is an OS thread with its own stack)",
-            crate::run::MAX_THREADS
+            nbody_bench::run::MAX_THREADS
         )),
         t => Ok(t),
     }
@@ -413,7 +413,7 @@ pub struct FitArgs {
     pub json: Option<PathBuf>,
     /// Seed of the bootstrap that gives the confidence intervals (fixed by default, so the
     /// output is reproducible).
-    #[arg(long, default_value_t = crate::fit::DEFAULT_SEED)]
+    #[arg(long, default_value_t = nbody_bench::fit::DEFAULT_SEED)]
     pub seed: u64,
     /// gustafson with an n column: the cost g(n) of the whole problem; times are normalised to
     /// the one-worker run's work per worker g(n)/p [default: n].
@@ -453,7 +453,7 @@ pub struct GateArgs {
     #[arg(long, value_name = "FILE|NAME", conflicts_with = "current")]
     pub config: Option<PathBuf>,
     /// Rounds of every case per build in an A/B run.
-    #[arg(long, default_value_t = crate::gate::AB_ROUNDS, value_parser = parse_count, conflicts_with = "current")]
+    #[arg(long, default_value_t = nbody_bench::gate::AB_ROUNDS, value_parser = parse_count, conflicts_with = "current")]
     pub rounds: usize,
     /// Where a measuring gate keeps what it measured [default: results/runs/gate/<UTC time>/].
     #[arg(long, value_name = "DIR", conflicts_with = "current")]
@@ -466,11 +466,11 @@ pub struct GateArgs {
     pub threshold: Option<f64>,
     /// Output format; markdown is made for a CI job summary.
     #[arg(long, value_enum, default_value = "text")]
-    pub format: crate::gate::Format,
+    pub format: nbody_bench::gate::Format,
     /// What the times are divided by before comparing: the reference workload timed around each
     /// case, the sweep's calibration, or nothing; auto takes the best both files have.
     #[arg(long, value_enum, default_value = "auto")]
-    pub normalize: crate::gate::NormalizationChoice,
+    pub normalize: nbody_bench::gate::NormalizationChoice,
     /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
     #[arg(long)]
     pub force: bool,

@@ -3,12 +3,12 @@
 //! time budget asks first (or, without a terminal, refuses unless `--yes` is given). Nothing
 //! here writes a file or creates a directory.
 
-use super::fmt_ns;
-use crate::cli::SweepArgs;
-use crate::experiment::config::SweepConfig;
-use crate::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed, fmt_duration};
-use crate::experiment::plan::cases;
-use crate::experiment::results::ResultsFile;
+use crate::cli::args::SweepArgs;
+use nbody_bench::experiment::config::SweepConfig;
+use nbody_bench::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
+use nbody_bench::experiment::plan::cases;
+use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::units::{Duration, WallTime};
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::Path;
 
@@ -45,7 +45,7 @@ pub fn before_sweep(
     let planned = cases(config);
     let probed = estimate::probe(config, &planned)?;
     let calibrate = !args.no_calibration;
-    let logical = crate::run::logical_cpus();
+    let logical = nbody_bench::run::logical_cpus();
     let est = estimate::estimate(config, &probed.cases, &done, calibrate, logical);
     if args.dry_run {
         print_plan(args, config, &est, &probed, logical, path);
@@ -53,7 +53,7 @@ pub fn before_sweep(
     }
     eprintln!(
         "estimated wall time: {} (probe took {:.2} s; `--dry-run` lists the cases)",
-        fmt_duration(est.total_s),
+        WallTime(est.total_s),
         probed.seconds
     );
     if est.total_s <= LONG_SWEEP_S || config.measure.budget_s > 0.0 || args.yes {
@@ -62,13 +62,13 @@ pub fn before_sweep(
     let mut longest: Vec<_> = est.cases.iter().collect();
     longest.sort_by(|a, b| b.wall_s.total_cmp(&a.wall_s));
     for c in longest.iter().take(3) {
-        eprintln!("  {:<52} {}", c.case.key(), fmt_duration(c.wall_s));
+        eprintln!("  {:<52} {}", c.case.key(), WallTime(c.wall_s));
     }
     if std::io::stdin().is_terminal() {
         eprint!(
             "sweep `{}` is estimated at {}, more than an hour; continue? [y/N] ",
             config.name,
-            fmt_duration(est.total_s)
+            WallTime(est.total_s)
         );
         std::io::stderr().flush()?;
         let mut answer = String::new();
@@ -83,7 +83,7 @@ pub fn before_sweep(
          measure.budget_s is 0; pass --yes to start it anyway, or set measure.budget_s in {} to \
          stop starting cases after that many seconds (`--resume` continues later)",
         config.name,
-        fmt_duration(est.total_s),
+        WallTime(est.total_s),
         est.total_s,
         args.config.display()
     )
@@ -142,8 +142,8 @@ fn print_plan(
             theta,
             c.rounds,
             c.samples,
-            fmt_ns(c.step_s * 1e9),
-            fmt_duration(c.wall_s)
+            Duration(c.step_s),
+            WallTime(c.wall_s)
         );
     }
     let cases_s = est.total_s - est.calibration_s;
@@ -158,9 +158,9 @@ fn print_plan(
     );
     outln!(
         "estimated wall time: {} (cases {}, calibration {})",
-        fmt_duration(est.total_s),
-        fmt_duration(cases_s),
-        fmt_duration(est.calibration_s)
+        WallTime(est.total_s),
+        WallTime(cases_s),
+        WallTime(est.calibration_s)
     );
     if let (Some(_), Some(path)) = (&args.resume, path) {
         outln!(
@@ -184,8 +184,53 @@ fn print_plan(
         Some(path) => outln!("results would go to {}", path.display()),
         None => outln!(
             "results would go to a new run directory {}/<UTC time>/",
-            crate::experiment::locate::runs_dir(&config.out, &config.name).display()
+            nbody_bench::experiment::locate::runs_dir(&config.out, &config.name).display()
         ),
     }
     outln!("estimate_s: {:.3}", est.total_s);
+}
+
+/// Runs this small need no estimate: even the naive kernel in f64 finishes them in minutes.
+const SMALL_RUN_N: usize = nbody_bench::experiment::estimate::PROBE_MAX_N;
+const SMALL_RUN_STEPS: u64 = 100_000;
+
+/// Refuses a run estimated at more than an hour (the sweep's limit) unless `--yes` is given.
+pub fn refuse_long_run(
+    setup: &nbody_bench::scenario::Setup,
+    kernel: nbody_bench::kernels::KernelKind,
+    kernel_args: &crate::cli::args::KernelArgs,
+    steps: u64,
+) -> anyhow::Result<()> {
+    let n = setup.n();
+    if n <= SMALL_RUN_N && steps <= SMALL_RUN_STEPS {
+        return Ok(());
+    }
+    let case = nbody_bench::experiment::plan::Case {
+        scenario: setup.scenario,
+        kernel,
+        n,
+        threads: kernel_args.threads,
+        ranks: 1,
+        theta: kernel_args.theta,
+        seed: setup.seed,
+        precision: setup.precision,
+        time_factor: 1,
+        decomp: None,
+    };
+    let wall_s = nbody_bench::experiment::estimate::run_seconds(
+        &case,
+        steps,
+        nbody_bench::run::logical_cpus(),
+    )?;
+    let limit = LONG_SWEEP_S;
+    if wall_s > limit {
+        anyhow::bail!(
+            "this run is estimated at {} ({steps} step{} of {n} particles, from a probe at small n); \
+             it is refused above {}: lower --steps or -n, or pass --yes to run it anyway",
+            WallTime(wall_s),
+            if steps == 1 { "" } else { "s" },
+            WallTime(limit),
+        );
+    }
+    Ok(())
 }

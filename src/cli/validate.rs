@@ -1,8 +1,9 @@
 use super::{kernel_params, setup};
-use crate::cli::ValidateArgs;
-use crate::kernels::KernelKind;
-use crate::scenario::ScenarioKind;
-use crate::validate::{ScenarioCheck, ValidateJob};
+use crate::cli::args::ValidateArgs;
+use nbody_bench::kernels::KernelKind;
+use nbody_bench::scenario::ScenarioKind;
+use nbody_bench::units::WallTime;
+use nbody_bench::validate::{ScenarioCheck, ValidateJob};
 use std::path::PathBuf;
 
 pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
@@ -17,7 +18,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
             .collect();
         let outputs: Vec<(&str, &std::path::Path)> =
             paths.iter().map(|p| ("--dump", p.as_path())).collect();
-        crate::output::check_outputs(&outputs, &[])?;
+        nbody_bench::output::check_outputs(&outputs, &[])?;
     }
     let params = kernel_params(&args.kernel_args, None)?;
     let mut results: Vec<ScenarioCheck> = Vec::new();
@@ -34,9 +35,9 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         // The tree and the Verlet list hold the most memory of the kernels checked, the O(n²)
         // direct sums take the time: the f64 reference and the three quadratic kernels, one
         // force computation each.
-        crate::run::check_memory(&s, KernelKind::Octree, args.kernel_args.threads, 1)?;
-        crate::run::check_memory(&s, KernelKind::Verlet, args.kernel_args.threads, 1)?;
-        crate::run::check_memory(&s, KernelKind::PerThread, args.kernel_args.threads, 1)?;
+        nbody_bench::run::check_memory(&s, KernelKind::Octree, args.kernel_args.threads, 1)?;
+        nbody_bench::run::check_memory(&s, KernelKind::Verlet, args.kernel_args.threads, 1)?;
+        nbody_bench::run::check_memory(&s, KernelKind::PerThread, args.kernel_args.threads, 1)?;
         if !args.yes {
             refuse_long_check(&s, params, args.kernel_args.threads)?;
         }
@@ -48,7 +49,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         let check = s.dispatch(job)??;
         if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
             let path = dump_file(path, scenarios.len(), scenario);
-            crate::output::write_atomic(&path, text.as_bytes())?;
+            nbody_bench::output::write_atomic(&path, text.as_bytes())?;
             if !args.json {
                 outln!("forces written to {}", path.display());
             }
@@ -83,8 +84,8 @@ const PROBE_N: usize = 1000;
 /// Refuses a check estimated at more than an hour unless `--yes` is given: the same check at
 /// [`PROBE_N`] particles, timed, carried to n as n² (its direct sums dominate).
 fn refuse_long_check(
-    setup: &crate::scenario::Setup,
-    params: crate::kernels::KernelParams,
+    setup: &nbody_bench::scenario::Setup,
+    params: nbody_bench::kernels::KernelParams,
     threads: usize,
 ) -> anyhow::Result<()> {
     let n = setup.n();
@@ -108,8 +109,8 @@ fn refuse_long_check(
             "checking {} at n = {n} is estimated at {} (the check at n = {PROBE_N}, carried as n²); \
              it is refused above {}: lower -n, or pass --yes to run it anyway",
             setup.scenario.name(),
-            crate::experiment::estimate::fmt_duration(wall_s),
-            crate::experiment::estimate::fmt_duration(limit),
+            WallTime(wall_s),
+            WallTime(limit),
         );
     }
     Ok(())

@@ -5,22 +5,22 @@
 //! only; an error of one rank (say, a particle stuck outside a wall) by that rank, and rank 0
 //! points to it. Only rank 0 prints results and writes files.
 
-use crate::cli::{MpiBenchArgs, MpiCheckArgs, RunArgs};
-use crate::decomp::Decomposition;
+use crate::cli::args::{MpiBenchArgs, MpiCheckArgs, RunArgs};
+use nbody_bench::decomp::Decomposition;
 
 #[cfg(not(feature = "mpi"))]
 pub fn run(_args: RunArgs, _decomp: Decomposition) -> anyhow::Result<i32> {
-    anyhow::bail!(crate::decomp::WITHOUT_MPI)
+    anyhow::bail!(nbody_bench::decomp::WITHOUT_MPI)
 }
 
 #[cfg(not(feature = "mpi"))]
 pub fn check(_args: MpiCheckArgs) -> anyhow::Result<i32> {
-    anyhow::bail!(crate::decomp::WITHOUT_MPI)
+    anyhow::bail!(nbody_bench::decomp::WITHOUT_MPI)
 }
 
 #[cfg(not(feature = "mpi"))]
 pub fn bench(_args: MpiBenchArgs) -> anyhow::Result<i32> {
-    anyhow::bail!(crate::decomp::WITHOUT_MPI)
+    anyhow::bail!(nbody_bench::decomp::WITHOUT_MPI)
 }
 
 #[cfg(feature = "mpi")]
@@ -29,14 +29,15 @@ pub use with_mpi::{bench, check, run};
 #[cfg(feature = "mpi")]
 mod with_mpi {
     use super::*;
-    use crate::cli::{KernelArgs, MpiOptions};
-    use crate::commands::run::print_summary;
-    use crate::commands::{kernel_params, setup};
-    use crate::decomp::stats::MpiReport;
-    use crate::kernels::KernelKind;
-    use crate::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
-    use crate::scenario::Precision;
+    use crate::cli::args::{KernelArgs, MpiOptions};
+    use crate::cli::summary::print_summary;
+    use crate::cli::{kernel_params, setup};
     use anyhow::Context;
+    use nbody_bench::decomp::stats::MpiReport;
+    use nbody_bench::kernels::KernelKind;
+    use nbody_bench::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
+    use nbody_bench::scenario::Precision;
+    use nbody_bench::units::Duration;
     use std::path::PathBuf;
 
     /// Prints an error on the ranks that should, and gives exit code 2.
@@ -44,7 +45,7 @@ mod with_mpi {
         if err.printed_by(rank) {
             eprintln!(
                 "error: {}",
-                crate::commands::error_chain(&anyhow::Error::from(err))
+                crate::cli::error_chain(&anyhow::Error::from(err))
             );
         }
         2
@@ -88,7 +89,7 @@ mod with_mpi {
     /// Refuses a job whose ranks on this machine would not fit in its memory: with allgather
     /// every rank holds all n particles, with domain about n / ranks.
     fn fits(
-        setup: &crate::scenario::Setup,
+        setup: &nbody_bench::scenario::Setup,
         kernel: KernelKind,
         decomp: Decomposition,
         kernel_args: &KernelArgs,
@@ -107,7 +108,7 @@ mod with_mpi {
         if let Err(e) = setup.validate() {
             return Err(MpiError::Usage(e.to_string()));
         }
-        crate::run::check_memory(setup, kernel, kernel_args.threads, copies)
+        nbody_bench::run::check_memory(setup, kernel, kernel_args.threads, copies)
             .map_err(|e| MpiError::Usage(e.to_string()))
     }
 
@@ -119,7 +120,7 @@ mod with_mpi {
             let setup = setup(args.scenario, &args.system);
             if setup.validate().is_ok() {
                 let steps = (args.steps + args.mpi.warmup_steps) as u64;
-                crate::commands::run::refuse_long_run(
+                crate::cli::dry_run::refuse_long_run(
                     &setup,
                     args.kernel,
                     &args.kernel_args,
@@ -164,7 +165,7 @@ mod with_mpi {
                 "warning: {} ranks x {} threads on {} logical CPUs: oversubscribed; timings do not show real parallel speedup",
                 mpi.size(),
                 outcome.threads,
-                crate::run::logical_cpus()
+                nbody_bench::run::logical_cpus()
             );
         }
         print_summary(&outcome);
@@ -173,7 +174,7 @@ mod with_mpi {
         }
         if let Some(path) = &args.json {
             let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
-            crate::output::write_atomic(path, text.as_bytes())?;
+            nbody_bench::output::write_atomic(path, text.as_bytes())?;
             outln!("result written to {}", path.display());
         }
         Ok(0)
@@ -197,7 +198,7 @@ mod with_mpi {
             r.rebalances,
             r.library.lines().next().unwrap_or("")
         );
-        let span = |m: &crate::decomp::stats::MinMeanMax| {
+        let span = |m: &nbody_bench::decomp::stats::MinMeanMax| {
             format!("{:.4}/{:.4}/{:.4}", m.min, m.mean, m.max)
         };
         outln!(
@@ -326,7 +327,7 @@ mod with_mpi {
     }
 
     pub fn bench(args: MpiBenchArgs) -> anyhow::Result<i32> {
-        crate::output::check_outputs(&[("--out", &args.out)], &[])?;
+        nbody_bench::output::check_outputs(&[("--out", &args.out)], &[])?;
         let mut mpi = Mpi::init()?;
         let rank = mpi.rank();
         let options = BenchOptions {
@@ -359,22 +360,22 @@ mod with_mpi {
             "allgatherv p50"
         );
         for (p, a) in file.ping_pong.points.iter().zip(&file.allgatherv.points) {
-            let pp = crate::stats::median(&p.seconds).unwrap_or(0.0);
-            let ag = crate::stats::median(&a.seconds).unwrap_or(0.0);
+            let pp = nbody_bench::stats::median(&p.seconds).unwrap_or(0.0);
+            let ag = nbody_bench::stats::median(&a.seconds).unwrap_or(0.0);
             outln!(
                 "{:>10} {:>14} {:>14.3} {:>18}",
                 p.bytes,
-                crate::commands::fmt_ns(pp * 1e9),
+                Duration(pp),
                 if pp > 0.0 {
                     p.bytes as f64 / pp * 1e-9
                 } else {
                     0.0
                 },
-                crate::commands::fmt_ns(ag * 1e9)
+                Duration(ag)
             );
         }
         let text = serde_json::to_string_pretty(&file).context("serializing the timings")?;
-        crate::output::write_atomic(&args.out, text.as_bytes())?;
+        nbody_bench::output::write_atomic(&args.out, text.as_bytes())?;
         outln!("timings written to {}", args.out.display());
         Ok(0)
     }

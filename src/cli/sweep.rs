@@ -1,11 +1,11 @@
-use crate::cli::SweepArgs;
-use crate::commands::fmt_ns;
-use crate::experiment::config::SweepConfig;
-use crate::experiment::locate;
-use crate::experiment::measure::WallClock;
-use crate::experiment::progress;
-use crate::experiment::results::{ResultsFile, utc_now};
-use crate::experiment::runner::{SweepOptions, run_sweep};
+use crate::cli::args::SweepArgs;
+use nbody_bench::clock::WallClock;
+use nbody_bench::experiment::config::SweepConfig;
+use nbody_bench::experiment::locate;
+use nbody_bench::experiment::progress;
+use nbody_bench::experiment::results::{ResultsFile, utc_now};
+use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
+use nbody_bench::units::Duration;
 use std::path::{Path, PathBuf};
 
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
@@ -13,7 +13,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let (config, text) = SweepConfig::load(&config_path)?;
     let target = where_to_write(&args, &config)?;
     let existing = match &target {
-        Target::Out => Some(crate::experiment::runner::results_path(
+        Target::Out => Some(nbody_bench::experiment::runner::results_path(
             &config,
             args.out.as_deref(),
         )),
@@ -166,12 +166,8 @@ fn print_table(results: &ResultsFile) {
         outln!(
             "{:<52} {:>11} {:>23} {:>11.1} {:>10.2e} {:>6}{}",
             c.key,
-            fmt_ns(s.median_s * 1e9),
-            format!(
-                "[{}, {}]",
-                fmt_ns(s.ci95_s[0] * 1e9),
-                fmt_ns(s.ci95_s[1] * 1e9)
-            ),
+            Duration(s.median_s),
+            format!("[{}, {}]", Duration(s.ci95_s[0]), Duration(s.ci95_s[1])),
             s.ns_per_particle_step,
             s.pair_evals_per_s,
             if s.sanity_ok { "ok" } else { "DRIFT" },

@@ -1,9 +1,10 @@
 //! `analyze`: refit and re-plot a saved sweep.
 
-use crate::analysis::{self, Written};
-use crate::cli::AnalyzeArgs;
-use crate::experiment::locate;
-use crate::experiment::results::ResultsFile;
+use crate::cli::args::AnalyzeArgs;
+use nbody_bench::analysis;
+use nbody_bench::experiment::locate;
+use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::render::Written;
 use std::path::{Path, PathBuf};
 
 pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
@@ -26,7 +27,7 @@ pub fn default_dir(results: &Path) -> PathBuf {
 /// Analyses `results` into `dir`; shared with the end of `sweep`.
 pub fn run(results: &ResultsFile, source: &Path, dir: &Path) -> anyhow::Result<Written> {
     let analysis = analysis::analyze(results, source)?;
-    Ok(analysis::write(&analysis, dir)?)
+    Ok(nbody_bench::render::write(&analysis, dir)?)
 }
 
 pub fn print_written(w: &Written) {

@@ -1,14 +1,14 @@
 //! `gate`: compare two results files, or measure this build and judge it (against the
 //! baseline file on its machine class, else A/B against the baseline's revision).
 
-use crate::cli::GateArgs;
-use crate::experiment::config::SweepConfig;
-use crate::experiment::locate;
-use crate::experiment::measure::WallClock;
-use crate::experiment::results::{ResultsFile, utc_now};
-use crate::experiment::runner::{SweepOptions, run_sweep};
-use crate::gate::ab::{self, AbPlan};
-use crate::gate::{
+use crate::cli::args::GateArgs;
+use nbody_bench::clock::WallClock;
+use nbody_bench::experiment::config::SweepConfig;
+use nbody_bench::experiment::locate;
+use nbody_bench::experiment::results::{ResultsFile, utc_now};
+use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
+use nbody_bench::gate::ab::{self, AbPlan};
+use nbody_bench::gate::{
     AB_THRESHOLD, FILE_THRESHOLD, GateOptions, GateReport, RunInfo, base_build, compare, render,
 };
 use std::path::{Path, PathBuf};
@@ -45,8 +45,8 @@ fn options(args: &GateArgs, default_threshold: f64) -> GateOptions {
 fn finish(report: &GateReport, args: &GateArgs, dir: Option<&Path>) -> anyhow::Result<i32> {
     out!("{}", render(report, args.format));
     if let Some(dir) = dir {
-        let json = render(report, crate::gate::Format::Json);
-        crate::output::write_atomic(&dir.join("gate.json"), json.as_bytes())?;
+        let json = render(report, nbody_bench::gate::Format::Json);
+        nbody_bench::output::write_atomic(&dir.join("gate.json"), json.as_bytes())?;
     }
     if !report.missing.is_empty() {
         let keys: Vec<&str> = report.missing.iter().map(|m| m.key.as_str()).collect();
@@ -71,9 +71,9 @@ fn this_machine() -> RunInfo {
         git_dirty: false,
         started: String::new(),
         host: String::new(),
-        cpu_model: Some(crate::calibrate::cpu_model()),
-        cpu_signature: crate::calibrate::cpu_signature(),
-        logical_cpus: Some(crate::run::logical_cpus()),
+        cpu_model: Some(nbody_bench::calibrate::cpu_model()),
+        cpu_signature: nbody_bench::calibrate::cpu_signature(),
+        logical_cpus: Some(nbody_bench::run::logical_cpus()),
         test_slowdown: None,
     }
 }
@@ -87,14 +87,14 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
     let (config_path, config_text) = match (&args.config, &baseline) {
         (Some(name), _) => {
             let path = locate::find_config(name)?;
-            let text = crate::input::read_text(&path)
+            let text = nbody_bench::input::read_text(&path)
                 .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
             (path, text)
         }
         (None, Some(b)) => (args.baseline.clone(), b.config_text.clone()),
         (None, None) => {
             let path = locate::find_config(Path::new("ci"))?;
-            let text = crate::input::read_text(&path)
+            let text = nbody_bench::input::read_text(&path)
                 .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
             (path, text)
         }
@@ -176,7 +176,7 @@ fn fast_path(
         calibrate: true,
         ..Default::default()
     };
-    let mut quiet = crate::experiment::runner::Silent;
+    let mut quiet = nbody_bench::experiment::runner::Silent;
     let report = run_sweep(config, text, &sweep, &WallClock::new(), &mut quiet)?;
     let current = ResultsFile::load(&report.path)?;
     let judged = compare(baseline, &current, &options(args, FILE_THRESHOLD))?;
@@ -203,7 +203,7 @@ fn a_b(
     let current: PathBuf = std::env::current_exe()
         .map_err(|e| anyhow::anyhow!("cannot find this program's binary: {e}"))?;
     say("calibrating the machine...");
-    let calibration = crate::calibrate::calibrate(&[1]);
+    let calibration = nbody_bench::calibrate::calibrate(&[1]);
     // Scratch of this process only: nothing else in `out` is removed.
     let work = out.join(format!(".scratch-{}", std::process::id()));
     let plan = AbPlan {
@@ -233,8 +233,8 @@ fn a_b(
         (Some(b), Some(c)) if b > 0.0 => ((c / b) - 1.0).abs() > REFERENCE_TOLERANCE,
         _ => false,
     };
-    if reference_moved && opts.normalization == crate::gate::NormalizationChoice::Auto {
-        opts.normalization = crate::gate::NormalizationChoice::None;
+    if reference_moved && opts.normalization == nbody_bench::gate::NormalizationChoice::Auto {
+        opts.normalization = nbody_bench::gate::NormalizationChoice::None;
     }
     let mut report = compare(&results.base, &results.current, &opts)?;
     if reference_moved {
@@ -278,5 +278,5 @@ fn a_b(
 }
 
 fn short(commit: &str) -> &str {
-    crate::gate::prefix(commit, 12)
+    nbody_bench::gate::prefix(commit, 12)
 }

@@ -1,4 +1,8 @@
-//! The subcommands. Each returns the process exit code or an error (reported with exit code 2).
+//! The command line: its arguments ([`args`]) and one module per subcommand. Each returns the
+//! process exit code or an error (reported with exit code 2). It lives in the binary crate, so
+//! the library never depends on it.
+
+pub mod args;
 
 mod analyze;
 mod dry_run;
@@ -9,14 +13,13 @@ mod list;
 mod mpi;
 mod report;
 mod run;
+mod summary;
 mod sweep;
 mod validate;
 
-pub use run::fmt_ns;
-
-use crate::cli::{Cli, Command, KernelArgs, SystemArgs};
-use crate::kernels::{KernelKind, KernelParams};
-use crate::scenario::{ScenarioKind, Setup};
+use crate::cli::args::{Cli, Command, KernelArgs, SystemArgs};
+use nbody_bench::kernels::{KernelKind, KernelParams};
+use nbody_bench::scenario::{ScenarioKind, Setup};
 
 /// Runs the parsed command line.
 pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {

@@ -1,0 +1,86 @@
+//! The Markdown summary of one analysis (`summary.md`): the tables of [`super::tables`], the
+//! failed physics checks, then the figures.
+
+use super::figures::Figure;
+use super::tables;
+use crate::analysis::Analysis;
+use std::fmt::Write;
+
+pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
+    let mut md = String::new();
+    let _ = writeln!(
+        md,
+        "# Analysis of sweep `{}` ({:?} study)\n",
+        a.name, a.study
+    );
+    let _ = writeln!(md, "{}\n", super::figures::caption(a));
+    if let Some(c) = &a.calibration {
+        let _ = writeln!(md, "Machine: {}\n", c.summary());
+    }
+    if !a.incomplete.is_empty() {
+        let _ = writeln!(
+            md,
+            "{} case(s) not complete and left out (resume the sweep to finish them).\n",
+            a.incomplete.len()
+        );
+    }
+    if !a.complexity.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Cost vs n\n\n{}\n\n{}",
+            tables::peak_note(),
+            tables::complexity(a)
+        );
+    }
+    if !a.crossovers.is_empty() {
+        let _ = writeln!(md, "## Crossovers\n\n{}", tables::crossovers(a));
+    }
+    if !a.strong.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Strong scaling\n\n* = more workers than logical CPUs (oversubscribed).\n\n{}",
+            tables::strong(a)
+        );
+        let comparisons = tables::serial_comparisons(a);
+        if !comparisons.is_empty() {
+            let _ = writeln!(md, "Timed vs fitted serial fraction:\n\n{comparisons}");
+        }
+    }
+    if !a.weak.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Weak scaling\n\n* = oversubscribed.\n\n{}",
+            tables::weak(a)
+        );
+    }
+    if !a.theta.is_empty() {
+        let _ = writeln!(md, "## Octree accuracy vs cost\n\n{}", tables::theta(a));
+    }
+    if !a.cases.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Energy checks\n\n{}{}",
+            tables::sanity_header(false),
+            tables::sanity_rows(a, None)
+        );
+    }
+    let flagged: Vec<_> = a.cases.iter().filter(|c| !c.sanity_ok).collect();
+    if !flagged.is_empty() {
+        md.push_str("## Physics checks that failed\n\n");
+        for c in flagged {
+            let _ = writeln!(
+                md,
+                "- {}: energy drift {:.2e} over the limit",
+                c.key, c.max_energy_drift
+            );
+        }
+        md.push('\n');
+    }
+    if !figures.is_empty() {
+        md.push_str("## Figures\n\n");
+        for f in figures {
+            let _ = writeln!(md, "![{}]({}.svg)\n", f.title, f.stem);
+        }
+    }
+    md
+}
