@@ -7,16 +7,14 @@ use super::plan::Case;
 use crate::calibrate::Calibration;
 use crate::engine::PhaseTimes;
 use crate::kernels::WorkCounters;
-use crate::stats::{StepPercentiles, bootstrap_median_ci, mad, median};
-use hdrhistogram::Histogram;
+use crate::stats::{
+    BOOTSTRAP_RESAMPLES, StepHistogram, StepPercentiles, bootstrap_median_ci, mad, median,
+};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 pub const RESULTS_SCHEMA: &str = "nbody-bench/results/v1";
-
-/// Bootstrap resamples for the median's confidence interval.
-const BOOTSTRAP_RESAMPLES: usize = 2000;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ResultsFile {
@@ -210,10 +208,9 @@ impl CaseRecord {
 
     /// Adds a measured round and recomputes the summary from all raw values.
     pub fn add_round(&mut self, round: RoundOutcome, max_drift: f64) {
-        let mut hist = self.histogram();
+        let mut hist = StepHistogram::from_counts(&self.step_histogram);
         for &ns in &round.step_ns {
-            // Values beyond the histogram's range (an hour) are clamped, not dropped.
-            hist.saturating_record(ns.max(1));
+            hist.record(ns);
         }
         self.push_rounds(hist, [round], max_drift);
     }
@@ -221,9 +218,9 @@ impl CaseRecord {
     /// Adds every round of `other`, the same case measured by another sweep (an A/B gate's
     /// one-case runs), with its step-time histogram.
     pub fn absorb(&mut self, other: CaseRecord, max_drift: f64) {
-        let mut hist = self.histogram();
+        let mut hist = StepHistogram::from_counts(&self.step_histogram);
         for &[value, count] in &other.step_histogram {
-            hist.saturating_record_n(value, count);
+            hist.record_n(value, count);
         }
         self.push_rounds(hist, other.rounds, max_drift);
     }
@@ -232,14 +229,11 @@ impl CaseRecord {
     /// recomputes the summary from all raw values.
     fn push_rounds(
         &mut self,
-        hist: Histogram<u64>,
+        hist: StepHistogram,
         rounds: impl IntoIterator<Item = RoundOutcome>,
         max_drift: f64,
     ) {
-        self.step_histogram = hist
-            .iter_recorded()
-            .map(|v| [v.value_iterated_to(), v.count_at_value()])
-            .collect();
+        self.step_histogram = hist.counts();
         for round in rounds {
             self.n = round.n;
             self.steps_per_sample = round.steps_per_sample;
@@ -249,16 +243,7 @@ impl CaseRecord {
         self.summary = Some(self.summarize(&hist, max_drift));
     }
 
-    fn histogram(&self) -> Histogram<u64> {
-        let mut h = Histogram::<u64>::new_with_bounds(1, 3_600_000_000_000, 3)
-            .expect("valid histogram bounds");
-        for &[value, count] in &self.step_histogram {
-            h.saturating_record_n(value, count);
-        }
-        h
-    }
-
-    fn summarize(&self, hist: &Histogram<u64>, max_drift: f64) -> Summary {
+    fn summarize(&self, hist: &StepHistogram, max_drift: f64) -> Summary {
         let samples: Vec<f64> = self
             .rounds
             .iter()
@@ -287,7 +272,7 @@ impl CaseRecord {
             min_s: samples.iter().copied().fold(f64::INFINITY, f64::min),
             mean_s: samples.iter().sum::<f64>() / samples.len().max(1) as f64,
             samples: samples.len(),
-            step_ns: StepPercentiles::of_histogram(hist).unwrap_or_default(),
+            step_ns: hist.percentiles().unwrap_or_default(),
             ns_per_particle_step: med * 1e9 / n,
             particle_steps_per_s: if med > 0.0 { n / med } else { 0.0 },
             pair_evals_per_s: if med > 0.0 { pair_checks / med } else { 0.0 },

@@ -1,13 +1,10 @@
 //! The seeded bootstrap shared by every fit: replicate per-x medians, refit, collect.
 
 use super::{Data, Estimate, FitError};
+use crate::stats::{BOOTSTRAP_RESAMPLES as RESAMPLES, bootstrap_medians, interval95};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::Serialize;
-
-/// Bootstrap replicates per fit. 2000 keeps the 2.5% and 97.5% percentiles stable to a few
-/// tenths of a percent of the interval while a fit stays in the millisecond range.
-pub const RESAMPLES: usize = 2000;
 
 /// How the replicate medians of a bootstrap were drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -55,19 +52,9 @@ pub(crate) fn bootstrap<T>(
 ) -> Result<Replicates<T>, FitError> {
     let m = data.len();
     let within = data.values.iter().all(|v| v.len() >= 2);
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let mut medians = vec![0.0; m];
-    let mut fits = Vec::with_capacity(RESAMPLES);
-    if within {
-        let mut buf = Vec::new();
-        for _ in 0..RESAMPLES {
-            for (i, values) in data.values.iter().enumerate() {
-                buf.clear();
-                buf.extend((0..values.len()).map(|_| values[rng.random_range(0..values.len())]));
-                medians[i] = median_in_place(&mut buf);
-            }
-            fits.extend(fit(&medians));
-        }
+    let fits = if within {
+        let groups: Vec<&[f64]> = data.values.iter().map(Vec::as_slice).collect();
+        bootstrap_medians(&groups, RESAMPLES, seed, &mut fit)
     } else {
         if m <= params {
             return Err(FitError::NoSpread {
@@ -86,13 +73,17 @@ pub(crate) fn bootstrap<T>(
         let mean = logs.iter().sum::<f64>() / m as f64;
         let inflate = (m as f64 / (m - params) as f64).sqrt();
         let residuals: Vec<f64> = logs.iter().map(|r| (r - mean) * inflate).collect();
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        let mut medians = vec![0.0; m];
+        let mut fits = Vec::with_capacity(RESAMPLES);
         for _ in 0..RESAMPLES {
             for i in 0..m {
                 medians[i] = fitted[i] * residuals[rng.random_range(0..m)].exp();
             }
             fits.extend(fit(&medians));
         }
-    }
+        fits
+    };
     if fits.len() * 2 < RESAMPLES {
         return Err(FitError::Degenerate {
             model,
@@ -109,39 +100,9 @@ pub(crate) fn bootstrap<T>(
     })
 }
 
-/// The median of a non-empty slice, reordering it (linear time: a bootstrap takes thousands).
-fn median_in_place(v: &mut [f64]) -> f64 {
-    let (len, mid) = (v.len(), v.len() / 2);
-    let (below, upper, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
-    let upper = *upper;
-    if len % 2 == 1 {
-        upper
-    } else {
-        let lower = below.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        0.5 * (lower + upper)
-    }
-}
-
-/// The 2.5% and 97.5% percentiles of `values` (NaN ignored; infinities kept); `None` if no
-/// value is left.
+/// The 95% percentile interval of replicates (see `stats::interval95`).
 pub(crate) fn percentile_ci(values: impl IntoIterator<Item = f64>) -> Option<[f64; 2]> {
-    let mut v: Vec<f64> = values.into_iter().filter(|x| !x.is_nan()).collect();
-    if v.is_empty() {
-        return None;
-    }
-    v.sort_by(f64::total_cmp);
-    let at = |q: f64| {
-        // Linear interpolation between order statistics.
-        let pos = q * (v.len() - 1) as f64;
-        let (lo, hi) = (pos.floor() as usize, pos.ceil() as usize);
-        let t = pos - lo as f64;
-        if t == 0.0 || v[lo] == v[hi] {
-            v[lo]
-        } else {
-            v[lo] + t * (v[hi] - v[lo])
-        }
-    };
-    Some([at(0.025), at(0.975)])
+    interval95(values)
 }
 
 /// A point estimate with the percentile interval of its replicates.
@@ -156,29 +117,6 @@ pub(crate) fn estimate(point: f64, replicates: impl IntoIterator<Item = f64>) ->
 mod tests {
     use super::*;
     use crate::fit::{Samples, XRule, prepare};
-
-    #[test]
-    fn percentiles_interpolate_and_skip_nan() {
-        let v: Vec<f64> = (0..=100).map(f64::from).collect();
-        assert_eq!(percentile_ci(v.iter().copied()), Some([2.5, 97.5]));
-        assert_eq!(percentile_ci([f64::NAN, 3.0]), Some([3.0, 3.0]));
-        assert_eq!(percentile_ci([f64::NAN]), None);
-        let e = estimate(1.0, [0.0, f64::INFINITY]);
-        assert_eq!(e.ci95[1], f64::INFINITY);
-    }
-
-    #[test]
-    fn median_in_place_agrees_with_stats_median() {
-        for v in [
-            vec![3.0],
-            vec![2.0, 1.0],
-            vec![5.0, 1.0, 4.0, 2.0],
-            vec![1.0, 9.0, 3.0, 3.0, 7.0],
-        ] {
-            let want = crate::stats::median(&v).unwrap();
-            assert_eq!(median_in_place(&mut v.clone()), want, "{v:?}");
-        }
-    }
 
     #[test]
     fn method_follows_the_sample_counts_and_is_reproducible() {

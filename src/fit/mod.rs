@@ -27,7 +27,8 @@ mod synthetic;
 pub mod timed;
 pub mod weak;
 
-pub use bootstrap::{CiMethod, RESAMPLES};
+pub use crate::stats::BOOTSTRAP_RESAMPLES as RESAMPLES;
+pub use bootstrap::CiMethod;
 pub use comm::{AlphaBetaFit, fit_alpha_beta};
 pub use karp_flatt::{KarpFlattPoint, KarpFlattTrend, Trend};
 pub use linear::Goodness;

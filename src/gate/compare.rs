@@ -8,9 +8,7 @@ use super::{
 };
 use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::WorkCounters;
-use crate::stats::median;
-use rand::{Rng, SeedableRng};
-use rand_pcg::Pcg64Mcg;
+use crate::stats::{bootstrap_ratio_ci, median};
 
 /// Compares `current` against `baseline`; see the module documentation for the rules.
 pub fn compare(
@@ -77,7 +75,8 @@ fn compare_case(
     let (bm, cm) = (median_of(&b_raw), median_of(&c_raw));
     let ratio = median_of(&c) / median_of(&b);
     let seed = options.seed ^ fnv1a(&base.key);
-    let ci95 = bootstrap_ratio_ci(&b, &c, options.resamples, seed);
+    // A side without a positive sample has no interval, and no change is claimed.
+    let ci95 = bootstrap_ratio_ci(&b, &c, options.resamples, seed).unwrap_or([f64::NAN; 2]);
     let t = options.threshold;
     let verdict = if ci95[0] > 1.0 + t {
         Verdict::Regressed
@@ -201,32 +200,6 @@ fn normalized(file: &ResultsFile, record: &CaseRecord, how: Normalization) -> Ve
             .filter(|s| s.is_finite() && *s > 0.0)
             .collect(),
     }
-}
-
-/// Percentile bootstrap 95% CI of median(current) / median(baseline): both sample sets are
-/// resampled with replacement, independently, from a generator seeded with `seed`.
-pub(super) fn bootstrap_ratio_ci(
-    baseline: &[f64],
-    current: &[f64],
-    resamples: usize,
-    seed: u64,
-) -> [f64; 2] {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let mut resample = |values: &[f64], buf: &mut Vec<f64>| {
-        buf.clear();
-        buf.extend((0..values.len()).map(|_| values[rng.random_range(0..values.len())]));
-        median_of(buf)
-    };
-    let (mut bb, mut cb) = (Vec::new(), Vec::new());
-    let mut ratios: Vec<f64> = (0..resamples.max(1))
-        .map(|_| {
-            let b = resample(baseline, &mut bb);
-            resample(current, &mut cb) / b
-        })
-        .collect();
-    ratios.sort_by(f64::total_cmp);
-    let at = |q: f64| ratios[((q * ratios.len() as f64) as usize).min(ratios.len() - 1)];
-    [at(0.025), at(0.975)]
 }
 
 /// The work of one force computation on the initial state, from the first round that has it.

@@ -1,6 +1,5 @@
 //! The gate on synthetic results files: every rule, deterministic (scripted samples).
 
-use super::compare::bootstrap_ratio_ci;
 use super::*;
 use crate::calibrate::Calibration;
 use crate::engine::PhaseTimes;
@@ -417,19 +416,6 @@ fn normalisation_falls_back_and_explicit_choices_are_checked() {
         matches!(e, GateError::NormalizationUnavailable { .. }),
         "{e}"
     );
-}
-
-#[test]
-fn bootstrap_ci_is_seeded_and_brackets_the_ratio() {
-    let b: Vec<f64> = (0..20).map(|i| 1.0 + 0.01 * i as f64).collect();
-    let c: Vec<f64> = b.iter().map(|x| 2.0 * x).collect();
-    let ci = bootstrap_ratio_ci(&b, &c, 2000, 7);
-    assert!(
-        ci[0] < 2.0 && ci[1] > 2.0 && ci[0] > 1.8 && ci[1] < 2.2,
-        "{ci:?}"
-    );
-    assert_eq!(ci, bootstrap_ratio_ci(&b, &c, 2000, 7));
-    assert_eq!(bootstrap_ratio_ci(&[1.0], &[3.0], 10, 1), [3.0, 3.0]);
 }
 
 #[test]
