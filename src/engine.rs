@@ -32,6 +32,33 @@ impl PhaseTimes {
     pub fn total(&self) -> f64 {
         self.force_build + self.force_interact + self.integrate + self.boundary + self.output
     }
+
+    /// Every phase divided by `steps` (at least one): seconds per step.
+    pub fn per_step(self, steps: u64) -> PhaseTimes {
+        let k = steps.max(1) as f64;
+        PhaseTimes {
+            force_build: self.force_build / k,
+            force_interact: self.force_interact / k,
+            integrate: self.integrate / k,
+            boundary: self.boundary / k,
+            output: self.output / k,
+        }
+    }
+}
+
+/// The time spent between two snapshots of the same running sums.
+impl std::ops::Sub for PhaseTimes {
+    type Output = PhaseTimes;
+
+    fn sub(self, earlier: PhaseTimes) -> PhaseTimes {
+        PhaseTimes {
+            force_build: self.force_build - earlier.force_build,
+            force_interact: self.force_interact - earlier.force_interact,
+            integrate: self.integrate - earlier.integrate,
+            boundary: self.boundary - earlier.boundary,
+            output: self.output - earlier.output,
+        }
+    }
 }
 
 /// Energies of the current state.
@@ -47,6 +74,29 @@ impl Energy {
     pub fn total(&self) -> f64 {
         self.kinetic + self.potential + self.external
     }
+
+    /// This energy, if its total is a finite number; the one blow-up check of `run`, the
+    /// sweep's measurements and the MPI drivers (`step` is the step it was probed after).
+    pub fn finite_after(self, step: u64) -> Result<Energy, EnergyBlowUp> {
+        if self.total().is_finite() {
+            Ok(self)
+        } else {
+            Err(EnergyBlowUp {
+                step,
+                energy: self.total(),
+            })
+        }
+    }
+}
+
+/// The total energy stopped being a finite number: the time step is too large for the forces.
+#[derive(Clone, Copy, Debug, thiserror::Error)]
+#[error(
+    "energy is not finite after step {step} (E = {energy}); the simulation blew up — reduce --dt"
+)]
+pub struct EnergyBlowUp {
+    pub step: u64,
+    pub energy: f64,
 }
 
 /// A system being integrated with one kernel.
@@ -149,7 +199,7 @@ impl<T: Real, const D: usize> Simulation<T, D> {
         kick(&mut self.state, &self.forces, self.external, half);
         let t5 = Instant::now();
         self.step += 1;
-        self.work.add(&report.work);
+        self.work += report.work;
         let force = (t4 - t3).as_secs_f64();
         self.phases.integrate += (t1 - t0).as_secs_f64() + (t5 - t4).as_secs_f64();
         self.phases.boundary += (t2 - t1).as_secs_f64();

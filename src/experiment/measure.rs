@@ -142,22 +142,10 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         samples.push(sum as f64 * 1e-9 / k as f64);
     }
     let steps = sim.step - steps0;
-    let e1 = sim.probe().total();
-    if !e1.is_finite() {
-        return Err(RunError::EnergyBlowUp {
-            step: sim.step,
-            energy: e1,
-        });
-    }
-    let per = |a: f64, b: f64| (a - b) / steps.max(1) as f64;
-    let phases = PhaseTimes {
-        force_build: per(sim.phases.force_build, phases0.force_build),
-        force_interact: per(sim.phases.force_interact, phases0.force_interact),
-        integrate: per(sim.phases.integrate, phases0.integrate),
-        boundary: per(sim.phases.boundary, phases0.boundary),
-        output: 0.0,
-    };
-    let work = sim.work.since(&work0);
+    let e1 = sim.probe().finite_after(sim.step)?.total();
+    // No trajectory is written while measuring: the output phase stays zero.
+    let phases = (sim.phases - phases0).per_step(steps);
+    let work = sim.work - work0;
     let force_error = (spec.force_error_sample > 0).then(|| {
         let (median, max) = crate::validate::sampled_force_error(
             law,

@@ -253,29 +253,47 @@ pub struct WorkCounters {
 }
 
 impl WorkCounters {
-    pub fn add(&mut self, o: &WorkCounters) {
-        self.pair_checks += o.pair_checks;
-        self.pairs_interacting += o.pairs_interacting;
-        self.cells_visited += o.cells_visited;
-        self.nodes_opened += o.nodes_opened;
-        self.nodes_accepted += o.nodes_accepted;
-        self.rebuilds += o.rebuilds;
-        self.list_entries += o.list_entries;
+    /// Every counter, in declaration order: the one list `+=` and `-` walk.
+    fn fields_mut(&mut self) -> [&mut u64; 7] {
+        [
+            &mut self.pair_checks,
+            &mut self.pairs_interacting,
+            &mut self.cells_visited,
+            &mut self.nodes_opened,
+            &mut self.nodes_accepted,
+            &mut self.rebuilds,
+            &mut self.list_entries,
+        ]
     }
+}
 
-    /// The work done since `earlier` (a snapshot of the same running sum).
-    pub fn since(&self, earlier: &WorkCounters) -> WorkCounters {
-        WorkCounters {
-            pair_checks: self.pair_checks.saturating_sub(earlier.pair_checks),
-            pairs_interacting: self
-                .pairs_interacting
-                .saturating_sub(earlier.pairs_interacting),
-            cells_visited: self.cells_visited.saturating_sub(earlier.cells_visited),
-            nodes_opened: self.nodes_opened.saturating_sub(earlier.nodes_opened),
-            nodes_accepted: self.nodes_accepted.saturating_sub(earlier.nodes_accepted),
-            rebuilds: self.rebuilds.saturating_sub(earlier.rebuilds),
-            list_entries: self.list_entries.saturating_sub(earlier.list_entries),
+impl std::ops::AddAssign for WorkCounters {
+    fn add_assign(&mut self, mut other: WorkCounters) {
+        for (a, b) in self.fields_mut().into_iter().zip(other.fields_mut()) {
+            *a += *b;
         }
+    }
+}
+
+impl std::ops::Add for WorkCounters {
+    type Output = WorkCounters;
+
+    fn add(mut self, other: WorkCounters) -> WorkCounters {
+        self += other;
+        self
+    }
+}
+
+/// The work done between two snapshots of the same running sum: `later - earlier`. Counters
+/// only grow, so a field that went down (a snapshot of another sum) saturates at zero.
+impl std::ops::Sub for WorkCounters {
+    type Output = WorkCounters;
+
+    fn sub(mut self, mut earlier: WorkCounters) -> WorkCounters {
+        for (a, b) in self.fields_mut().into_iter().zip(earlier.fields_mut()) {
+            *a = a.saturating_sub(*b);
+        }
+        self
     }
 }
 

@@ -1,4 +1,4 @@
-//! Replicated data (the MPI driver of source 000, the program of source 004): every rank holds
+//! Replicated data (the MPI driver of the LJ-box assignment, the program of the Coulomb MPI tutorial): every rank holds
 //! every particle's position; it owns a contiguous block of particles (sizes differing by at
 //! most one), integrates them, and every step an Allgatherv shares the new positions.
 //!
@@ -116,7 +116,7 @@ impl<T: Real, const D: usize> Allgather<T, D> {
             let report = self
                 .kernel
                 .compute_targets(&self.global, self.block.clone(), out);
-            self.tally.work.add(&report.work);
+            self.tally.work += report.work;
             self.tally.build_s += report.build_s;
             self.tally.force_s += t.elapsed().as_secs_f64();
             return Ok(());
@@ -125,7 +125,7 @@ impl<T: Real, const D: usize> Allgather<T, D> {
         let report = self
             .kernel
             .compute_share(&self.global, self.share, &mut self.pair_forces);
-        self.tally.work.add(&report.work);
+        self.tally.work += report.work;
         self.tally.build_s += report.build_s;
         self.sum_in.clear();
         for f in &self.pair_forces {

@@ -34,10 +34,8 @@ pub enum MpiError {
          use more ranks or fewer particles"
     )]
     TooLarge { bytes: usize },
-    #[error(
-        "energy is not finite after step {step} (E = {energy}); the simulation blew up — reduce --dt"
-    )]
-    EnergyBlowUp { step: u64, energy: f64 },
+    #[error(transparent)]
+    EnergyBlowUp(#[from] crate::engine::EnergyBlowUp),
     #[error(transparent)]
     Write(#[from] WriteError),
     #[error("cannot serialize the result: {0}")]

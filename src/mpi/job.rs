@@ -10,19 +10,16 @@ use super::driver::{Driver, Timeline, drive, pack_owned};
 use super::error::MpiError;
 use super::wire::{bytes_of, floats_of, particle_values};
 use crate::decomp::Decomposition;
-use crate::decomp::stats::{MpiReport, RankStats, Source004, attribute_waits, reduce};
+use crate::decomp::stats::{MasterSummary, MpiReport, RankStats, attribute_waits, reduce};
 use crate::engine::{PhaseTimes, Simulation};
 use crate::kernels::{KernelKind, KernelParams, WorkCounters};
 use crate::output::dump;
 use crate::physics::PairLaw;
 use crate::real::Real;
-use crate::run::{
-    Counters, EnergyCheck, MomentumCheck, RUN_SCHEMA, RunOutcome, Throughput, Timing, logical_cpus,
-};
+use crate::run::{Measured, RunOutcome};
 use crate::scenario::{System, SystemJob};
-use crate::simd;
 use crate::state::{Field, State, zero_field};
-use crate::stats::StepPercentiles;
+use crate::stats::StepHistogram;
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
@@ -228,7 +225,7 @@ fn mpi_report(
         .collect();
     let mut work = WorkCounters::default();
     for r in &records {
-        work.add(&r.work);
+        work += r.work;
     }
     let build_mean = records.iter().map(|r| r.build_s).sum::<f64>() / records.len() as f64;
     let far_migrated: u64 = records.iter().map(|r| r.far_migrated).sum();
@@ -246,7 +243,7 @@ fn mpi_report(
         hosts,
         warmup_steps: spec.warmup,
         rebalances,
-        source_004: Source004 {
+        master_summary: MasterSummary {
             communication_s: line.comm.seconds,
             computation_s: line.total_s - line.comm.seconds,
             interactions: work.pair_checks,
@@ -289,13 +286,7 @@ fn finish<T: Real, L: PairLaw<T>, const D: usize>(
         ..reference.clone()
     };
     let mut end = Simulation::new(last, serial_kernel()?);
-    let e1 = end.probe();
-    if !e1.total().is_finite() {
-        return Err(MpiError::EnergyBlowUp {
-            step: steps_done,
-            energy: e1.total(),
-        });
-    }
+    let e1 = end.probe().finite_after(steps_done)?;
     let info = &reference.info;
     if let Some(path) = &spec.dump_state {
         let header = format!(
@@ -324,71 +315,37 @@ fn finish<T: Real, L: PairLaw<T>, const D: usize>(
         .iter()
         .filter(|h| **h == report.hosts[0])
         .count();
-    let step_ns = &report.step_ns;
-    let per_step_ns = StepPercentiles::of(step_ns).unwrap_or_default();
-    let step_sum_s = step_ns.iter().sum::<u64>() as f64 * 1e-9;
-    let steps = spec.steps.max(1) as f64;
+    let mut step_ns = StepHistogram::new();
+    for &ns in &report.step_ns {
+        step_ns.record(ns);
+    }
     let mean = |f: &dyn Fn(&RankStats) -> f64| {
         report.per_rank.iter().map(f).sum::<f64>() / report.per_rank.len() as f64
     };
-    let per_second = |x: f64| {
-        if step_sum_s > 0.0 {
-            x / step_sum_s
-        } else {
-            0.0
-        }
+    let phases = PhaseTimes {
+        force_build: build_mean,
+        force_interact: mean(&|r| r.force_s) - build_mean,
+        integrate: mean(&|r| r.compute_s - r.force_s),
+        boundary: 0.0,
+        output: 0.0,
     };
-    let outcome = RunOutcome {
-        schema: RUN_SCHEMA,
-        tool_version: env!("CARGO_PKG_VERSION"),
-        scenario: info.scenario.name(),
-        kernel: spec.kernel.name(),
+    let outcome = RunOutcome::new::<T, D>(Measured {
+        info,
         law: reference.law.kind().name(),
+        kernel: spec.kernel,
+        params: spec.params,
         n,
-        n_requested: info.n_requested,
         steps: spec.steps,
         threads: spec.threads,
-        oversubscribed: spec.threads * ranks_here > logical_cpus(),
-        dim: D,
-        precision: T::NAME,
-        seed: info.seed,
-        dt: info.dt,
-        density: info.density,
-        box_side: info.box_side,
-        kernel_params: spec.params,
-        simd: simd::level().name(),
-        timing: Timing {
-            total_s: line.total_s,
-            per_step_ns,
-            phases: PhaseTimes {
-                force_build: build_mean,
-                force_interact: mean(&|r| r.force_s) - build_mean,
-                integrate: mean(&|r| r.compute_s - r.force_s),
-                boundary: 0.0,
-                output: 0.0,
-            },
-            ns_per_particle_step: per_step_ns.p50 as f64 / n as f64,
-        },
-        throughput: Throughput {
-            particle_steps_per_s: per_second(n as f64 * steps),
-            pair_evals_per_s: per_second(work.pair_checks as f64),
-        },
-        counters: Counters {
-            total: work,
-            pair_checks_per_step: work.pair_checks as f64 / steps,
-            pairs_interacting_final: end.probe_work().pairs_interacting,
-        },
-        energy: EnergyCheck {
-            initial: e0,
-            last: e1,
-            rel_drift: (e1.total() - e0.total()) / e0.total().abs(),
-            lj_potential: "shifted",
-        },
-        momentum: MomentumCheck {
-            initial: p0,
-            last: state.momentum().to_vec(),
-        },
+        threads_here: spec.threads * ranks_here,
+        total_s: line.total_s,
+        step_ns: &step_ns,
+        phases,
+        work,
+        pairs_interacting_final: end.probe_work().pairs_interacting,
+        energy: [e0, e1],
+        momentum: [p0, state.momentum().to_vec()],
         mpi: Some(report),
-    };
+    });
     Ok(RootResult { outcome, check })
 }

@@ -2,20 +2,20 @@
 //! step and per phase, with work counters and an energy check. Used by `run` and by sweeps.
 
 use crate::clock::Clock;
-use crate::engine::{Energy, PhaseTimes, Simulation};
-use crate::kernels::{KernelKind, KernelParams, WorkCounters, footprint};
+use crate::engine::Simulation;
+use crate::kernels::{KernelKind, KernelParams, footprint};
 use crate::output::nbview::{self, NbviewFormat};
 use crate::output::{AtomicFile, WriteError, dump};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::scenario::{Setup, System, SystemInfo, SystemJob};
-use crate::simd;
-use crate::stats::StepPercentiles;
-use serde::Serialize;
 use std::path::PathBuf;
 
-/// Schema tag of the `run --json` document.
-pub const RUN_SCHEMA: &str = "nbody-bench/run/v1";
+mod outcome;
+
+pub use outcome::{
+    Counters, EnergyCheck, Measured, MomentumCheck, RUN_SCHEMA, RunOutcome, Throughput, Timing,
+};
 
 /// What to run, besides the system.
 #[derive(Clone, Debug)]
@@ -49,91 +49,8 @@ pub enum RunError {
         threads: usize,
         source: rayon::ThreadPoolBuildError,
     },
-    #[error(
-        "energy is not finite after step {step} (E = {energy}); the simulation blew up — reduce --dt"
-    )]
-    EnergyBlowUp { step: u64, energy: f64 },
-}
-
-/// The result of a run, as written by `run --json`.
-#[derive(Clone, Debug, Serialize)]
-pub struct RunOutcome {
-    pub schema: &'static str,
-    pub tool_version: &'static str,
-    pub scenario: &'static str,
-    pub kernel: &'static str,
-    pub law: &'static str,
-    pub n: usize,
-    pub n_requested: usize,
-    pub steps: u64,
-    pub threads: usize,
-    /// Threads exceed the machine's logical CPUs.
-    pub oversubscribed: bool,
-    pub dim: usize,
-    pub precision: &'static str,
-    pub seed: u64,
-    pub dt: f64,
-    pub density: Option<f64>,
-    pub box_side: Option<f64>,
-    pub kernel_params: KernelParams,
-    /// Instruction set the pair loops ran with.
-    pub simd: &'static str,
-    pub timing: Timing,
-    pub throughput: Throughput,
-    pub counters: Counters,
-    pub energy: EnergyCheck,
-    pub momentum: MomentumCheck,
-    /// Ranks, decomposition and per-rank statistics of an MPI run (`--decomp`).
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub mpi: Option<crate::decomp::stats::MpiReport>,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct Timing {
-    /// Wall time of the stepping loop, including trajectory output.
-    pub total_s: f64,
-    /// Time per step (output excluded), nanoseconds.
-    pub per_step_ns: StepPercentiles,
-    /// Seconds per phase, summed over the steps.
-    pub phases: PhaseTimes,
-    /// Median ns per particle-step.
-    pub ns_per_particle_step: f64,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct Throughput {
-    /// n × steps / (sum of step times).
-    pub particle_steps_per_s: f64,
-    /// Pair distance evaluations per second of step time.
-    pub pair_evals_per_s: f64,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct Counters {
-    /// Work summed over the timed steps.
-    pub total: WorkCounters,
-    /// Pair evaluations per step (mean over the timed steps).
-    pub pair_checks_per_step: f64,
-    /// Interacting pairs in the final configuration (from the energy probe).
-    pub pairs_interacting_final: u64,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct EnergyCheck {
-    pub initial: Energy,
-    #[serde(rename = "final")]
-    pub last: Energy,
-    /// (E_final − E_initial) / |E_initial|.
-    pub rel_drift: f64,
-    /// The Lennard-Jones energy is shifted to zero at the cutoff (the force is not).
-    pub lj_potential: &'static str,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct MomentumCheck {
-    pub initial: Vec<f64>,
-    #[serde(rename = "final")]
-    pub last: Vec<f64>,
+    #[error(transparent)]
+    EnergyBlowUp(#[from] crate::engine::EnergyBlowUp),
 }
 
 /// Runs `spec` on the system it is given (see [`crate::scenario::Setup::dispatch`]), its
@@ -191,13 +108,7 @@ fn measure<T: Real, const D: usize, C: Clock>(
         }
     }
     let total_s = (clock.now() - start).as_secs_f64();
-    let e1 = sim.probe();
-    if !e1.total().is_finite() {
-        return Err(RunError::EnergyBlowUp {
-            step: sim.step,
-            energy: e1.total(),
-        });
-    }
+    let e1 = sim.probe().finite_after(sim.step)?;
     if let Some(mut tr) = trajectory {
         // The final state is always in the trajectory, also when --steps is not a multiple of
         // --every.
@@ -220,63 +131,24 @@ fn measure<T: Real, const D: usize, C: Clock>(
             dump::state_dump(&header, &sim.state, &sim.forces).as_bytes(),
         )?;
     }
-    let step_sum_s = step_ns.sum_s();
-    let per_step_ns = step_ns.percentiles().unwrap_or_default();
-    let steps = sim.step.max(1) as f64;
-    Ok(RunOutcome {
-        schema: RUN_SCHEMA,
-        tool_version: env!("CARGO_PKG_VERSION"),
-        scenario: info.scenario.name(),
-        kernel: spec.kernel.name(),
+    Ok(RunOutcome::new::<T, D>(Measured {
+        info,
         law,
+        kernel: spec.kernel,
+        params: spec.params,
         n,
-        n_requested: info.n_requested,
         steps: sim.step,
         threads: spec.threads,
-        oversubscribed: spec.threads > logical_cpus(),
-        dim: D,
-        precision: T::NAME,
-        seed: info.seed,
-        dt: info.dt,
-        density: info.density,
-        box_side: info.box_side,
-        kernel_params: spec.params,
-        simd: simd::level().name(),
-        timing: Timing {
-            total_s,
-            per_step_ns,
-            phases: sim.phases,
-            ns_per_particle_step: per_step_ns.p50 as f64 / n as f64,
-        },
-        throughput: Throughput {
-            particle_steps_per_s: if step_sum_s > 0.0 {
-                n as f64 * steps / step_sum_s
-            } else {
-                0.0
-            },
-            pair_evals_per_s: if step_sum_s > 0.0 {
-                sim.work.pair_checks as f64 / step_sum_s
-            } else {
-                0.0
-            },
-        },
-        counters: Counters {
-            total: sim.work,
-            pair_checks_per_step: sim.work.pair_checks as f64 / steps,
-            pairs_interacting_final: sim.probe_work().pairs_interacting,
-        },
-        energy: EnergyCheck {
-            initial: e0,
-            last: e1,
-            rel_drift: (e1.total() - e0.total()) / e0.total().abs(),
-            lj_potential: "shifted",
-        },
-        momentum: MomentumCheck {
-            initial: p0,
-            last: sim.state.momentum().to_vec(),
-        },
+        threads_here: spec.threads,
+        total_s,
+        step_ns: &step_ns,
+        phases: sim.phases,
+        work: sim.work,
+        pairs_interacting_final: sim.probe_work().pairs_interacting,
+        energy: [e0, e1],
+        momentum: [p0, sim.state.momentum().to_vec()],
         mpi: None,
-    })
+    }))
 }
 
 /// Most threads a run's pool may have: far beyond any oversubscription study on the machines

@@ -102,9 +102,9 @@ pub(super) struct Totals {
     pub interacting: u64,
 }
 
-impl Totals {
-    pub fn add(&mut self, o: &Totals) {
-        self.work.add(&o.work);
+impl std::ops::AddAssign for Totals {
+    fn add_assign(&mut self, o: Totals) {
+        self.work += o.work;
         self.energy += o.energy;
         self.interacting += o.interacting;
     }
@@ -331,6 +331,6 @@ where
         || for_group_runs(&groups[..mid], lo, offset, min_len, f),
         || for_group_runs(&groups[mid..], hi, offset + split, min_len, f),
     );
-    a.add(&b);
+    a += b;
     a
 }

@@ -53,8 +53,8 @@ pub struct BuildWork {
     pub rebuilds: u64,
 }
 
-impl BuildWork {
-    pub fn add(&mut self, other: &BuildWork) {
+impl std::ops::AddAssign for BuildWork {
+    fn add_assign(&mut self, other: BuildWork) {
         self.candidates += other.candidates;
         self.bins += other.bins;
         self.rebuilds += other.rebuilds;

@@ -186,7 +186,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             self.parts.par_iter_mut().enumerate().map(build).reduce(
                 BuildWork::default,
                 |mut a, b| {
-                    a.add(&b);
+                    a += b;
                     a
                 },
             )

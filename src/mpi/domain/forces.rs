@@ -34,7 +34,7 @@ impl<T: Real, const D: usize> Domain<T, D> {
             })?;
         let (report, interior_s) = report;
         force_s += interior_s;
-        self.tally.work.add(&report.work);
+        self.tally.work += report.work;
         self.tally.build_s += report.build_s;
 
         let t = Instant::now();
@@ -47,7 +47,7 @@ impl<T: Real, const D: usize> Domain<T, D> {
             }
             let out = self.border_forces.each_mut().map(|f| &mut f[..b]);
             let report = self.border.compute_targets(&self.shell, 0..b, out);
-            self.tally.work.add(&report.work);
+            self.tally.work += report.work;
             self.tally.build_s += report.build_s;
             for (k, &i) in self.border_slots.iter().enumerate() {
                 for d in 0..D {

@@ -1,5 +1,5 @@
 //! Spatial decomposition for the short-range kernels, the cell list and the Verlet list
-//! (source 000's second task): each rank owns a region of the box ([`Regions`]) and the
+//! (the LJ-box assignment's second task): each rank owns a region of the box ([`Regions`]) and the
 //! particles in it.
 //!
 //! A step: kick, drift and walls on the owned particles; a status exchange (one small
