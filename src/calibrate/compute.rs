@@ -161,58 +161,33 @@ pub(super) fn measure_fma(iters: u64, budget_s: f64) -> f64 {
     .fold(0.0, f64::max)
 }
 
-/// The parallel ceiling at each of `threads`.
+/// The parallel ceiling at `p` threads, or why a `p`-thread pool could not be built.
 ///
-/// Each repetition is a pair of runs, the reference on a 1-thread pool and then the same
-/// per-thread work on every thread of a `p`-thread pool (`ThreadPool::broadcast`), both
-/// started the same way so they pay the same overheads. The ratio of a pair's rates is taken
-/// and the **median** ratio kept: unlike a single-thread rate, the ceiling legitimately varies
-/// from run to run (where the hypervisor places the vCPUs), and the median is what a benchmark
-/// run is most likely to see; pairing adjacent runs cancels slow drifts (clock speed, load)
-/// common to both.
+/// Each repetition is a pair of runs, the reference on the 1-thread pool `reference` and then
+/// the same per-thread work on every thread of a `p`-thread pool (`ThreadPool::broadcast`),
+/// both started the same way so they pay the same overheads. The ratio of a pair's rates is
+/// taken and the **median** ratio kept: unlike a single-thread rate, the ceiling legitimately
+/// varies from run to run (where the hypervisor places the vCPUs), and the median is what a
+/// benchmark run is most likely to see; pairing adjacent runs cancels slow drifts (clock speed,
+/// load) common to both.
 pub(super) fn measure_ceiling(
-    threads: &[usize],
+    reference: &rayon::ThreadPool,
+    p: usize,
     iters: u64,
     budget_s: f64,
-    logical_cpus: usize,
-    warnings: &mut Vec<String>,
-) -> Vec<ThreadRatio> {
-    let reference = match rayon::ThreadPoolBuilder::new().num_threads(1).build() {
-        Ok(pool) => pool,
-        Err(e) => {
-            warnings.push(format!(
-                "parallel ceiling not measured: 1-thread rayon pool: {e}"
-            ));
-            return Vec::new();
-        }
-    };
-    let mut out = Vec::new();
-    for &p in threads {
-        if p == 0 {
-            warnings.push("parallel ceiling: 0 threads requested, skipped".to_string());
-            continue;
-        }
-        let pool = match rayon::ThreadPoolBuilder::new().num_threads(p).build() {
-            Ok(pool) => pool,
-            Err(e) => {
-                warnings.push(format!("parallel ceiling at {p} threads not measured: {e}"));
-                continue;
-            }
-        };
-        // Wake the new pool's threads once so their start-up is not timed.
-        pool.broadcast(|_| fma_burst(1));
-        let ratios = repeat(budget_s, 3, 64, || {
-            let (t1, _) = time(|| reference.broadcast(|_| fma_burst(iters)));
-            let (tp, _) = time(|| pool.broadcast(|_| fma_burst(iters)));
-            // p times the work in tp against the work in t1.
-            p as f64 * t1 / tp
-        });
-        out.push(ThreadRatio {
-            threads: p,
-            // `repeat` runs at least 3 times, so there is a median.
-            ratio: median(&ratios).unwrap_or(0.0),
-            oversubscribed: p > logical_cpus,
-        });
-    }
-    out
+) -> Result<f64, String> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(p)
+        .build()
+        .map_err(|e| e.to_string())?;
+    // Wake the new pool's threads once so their start-up is not timed.
+    pool.broadcast(|_| fma_burst(1));
+    let ratios = repeat(budget_s, 3, 64, || {
+        let (t1, _) = time(|| reference.broadcast(|_| fma_burst(iters)));
+        let (tp, _) = time(|| pool.broadcast(|_| fma_burst(iters)));
+        // p times the work in tp against the work in t1.
+        p as f64 * t1 / tp
+    });
+    // `repeat` runs at least 3 times, so there is a median.
+    Ok(median(&ratios).unwrap_or(0.0))
 }

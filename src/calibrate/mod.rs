@@ -142,34 +142,60 @@ pub fn calibrate(threads: &[usize]) -> Calibration {
 pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibration {
     let start = Instant::now();
     let ticks_before = cpu_ticks();
-    let budget = opts.budget.as_secs_f64();
     let logical_cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let mut warnings = Vec::new();
-
-    // One repetition of the FMA loop lasts about a tenth of the budget: long enough that timer
-    // resolution, thread wake-up and the ~20 µs fork/join are negligible, short enough for
-    // several repetitions (the median and best need a few) to fit in the budget.
-    let iters = size_iters(budget / 10.0, |n| time(|| fma_burst(n)).0);
-    let fma_gflops_1t = measure_fma(iters, budget);
-
-    let parallel_ceiling = measure_ceiling(threads, iters, budget, logical_cpus, &mut warnings);
-
-    let fork_join_threads = threads.iter().copied().max().unwrap_or(2).max(2);
-    let (fork_join_us, fork_join_hot_us) =
-        measure_fork_join(fork_join_threads, budget, &mut warnings);
-
-    let memory_bandwidth_gbs = measure_bandwidth(opts.memory_bytes, budget, &mut warnings);
-
+    let mut calibration = assemble(&mut Machine::new(opts), threads, logical_cpus);
     let background_cpus = ticks_before
         .zip(cpu_ticks())
         .and_then(|(before, after)| before.background_cpus(&after));
     if let Some(b) = background_cpus.filter(|&b| b >= BACKGROUND_WARNING_CPUS) {
-        warnings.push(format!(
+        calibration.warnings.push(format!(
             "other processes used {b:.2} CPUs during calibration: throughputs and the parallel \
              ceiling are likely understated"
         ));
     }
+    calibration.background_cpus = background_cpus;
+    calibration.duration_s = start.elapsed().as_secs_f64();
+    calibration
+}
 
+/// The four measurements a calibration is made of: [`Machine`] takes them here; the tests
+/// give fixed figures, so that the assembly is tested without timing anything.
+trait Meter {
+    /// Single-thread FMA throughput, GFLOP/s.
+    fn fma_gflops(&mut self) -> f64;
+    /// The throughput ratio of `threads` threads to one, or why it could not be measured.
+    fn ceiling(&mut self, threads: usize) -> Result<f64, String>;
+    /// Fork/join cost `(cold, hot)` in µs on a `threads`-thread pool.
+    fn fork_join_us(&mut self, threads: usize, warnings: &mut Vec<String>) -> (f64, f64);
+    /// Streaming read bandwidth, GB/s (0 with a warning when it cannot be measured).
+    fn bandwidth_gbs(&mut self, warnings: &mut Vec<String>) -> f64;
+}
+
+/// A calibration from `meter`'s figures (its duration and the background load are the
+/// caller's to fill in).
+fn assemble(meter: &mut impl Meter, threads: &[usize], logical_cpus: usize) -> Calibration {
+    let mut warnings = Vec::new();
+    let fma_gflops_1t = meter.fma_gflops();
+    let mut parallel_ceiling = Vec::new();
+    for &p in threads {
+        if p == 0 {
+            warnings.push("parallel ceiling: 0 threads requested, skipped".to_string());
+            continue;
+        }
+        match meter.ceiling(p) {
+            Ok(ratio) => parallel_ceiling.push(ThreadRatio {
+                threads: p,
+                ratio,
+                oversubscribed: p > logical_cpus,
+            }),
+            Err(why) => warnings.push(format!(
+                "parallel ceiling at {p} threads not measured: {why}"
+            )),
+        }
+    }
+    let fork_join_threads = threads.iter().copied().max().unwrap_or(2).max(2);
+    let (fork_join_us, fork_join_hot_us) = meter.fork_join_us(fork_join_threads, &mut warnings);
+    let memory_bandwidth_gbs = meter.bandwidth_gbs(&mut warnings);
     Calibration {
         cpu_model: cpu_model(),
         cpu_signature: cpu_signature(),
@@ -181,9 +207,58 @@ pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibrati
         fork_join_hot_us,
         fork_join_threads,
         memory_bandwidth_gbs,
-        duration_s: start.elapsed().as_secs_f64(),
-        background_cpus,
+        duration_s: 0.0,
+        background_cpus: None,
         warnings,
+    }
+}
+
+/// The measurements taken on this machine, each within the options' budget.
+struct Machine {
+    budget_s: f64,
+    memory_bytes: usize,
+    /// FMA iterations of one repetition, sized once (a tenth of the budget).
+    iters: u64,
+    /// The 1-thread pool each ceiling's reference run uses.
+    reference: Option<rayon::ThreadPool>,
+}
+
+impl Machine {
+    fn new(opts: &CalibrationOptions) -> Machine {
+        let budget_s = opts.budget.as_secs_f64();
+        // One repetition of the FMA loop lasts about a tenth of the budget: long enough that
+        // timer resolution, thread wake-up and the ~20 µs fork/join are negligible, short
+        // enough for several repetitions (the median and best need a few) to fit in the budget.
+        let iters = size_iters(budget_s / 10.0, |n| time(|| fma_burst(n)).0);
+        Machine {
+            budget_s,
+            memory_bytes: opts.memory_bytes,
+            iters,
+            reference: None,
+        }
+    }
+}
+
+impl Meter for Machine {
+    fn fma_gflops(&mut self) -> f64 {
+        measure_fma(self.iters, self.budget_s)
+    }
+
+    fn ceiling(&mut self, threads: usize) -> Result<f64, String> {
+        if self.reference.is_none() {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build();
+            self.reference = Some(pool.map_err(|e| format!("1-thread rayon pool: {e}"))?);
+        }
+        let reference = self.reference.as_ref().expect("built above");
+        measure_ceiling(reference, threads, self.iters, self.budget_s)
+    }
+
+    fn fork_join_us(&mut self, threads: usize, warnings: &mut Vec<String>) -> (f64, f64) {
+        measure_fork_join(threads, self.budget_s, warnings)
+    }
+
+    fn bandwidth_gbs(&mut self, warnings: &mut Vec<String>) -> f64 {
+        measure_bandwidth(self.memory_bytes, self.budget_s, warnings)
     }
 }
 
@@ -191,14 +266,16 @@ pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibrati
 pub fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()
-        .and_then(|text| {
-            text.lines().find_map(|line| {
-                let (key, value) = line.split_once(':')?;
-                (key.trim() == "model name").then(|| value.trim().to_string())
-            })
-        })
-        .filter(|model| !model.is_empty())
+        .and_then(|text| model_of(&text))
         .unwrap_or_else(|| "unknown".to_string())
+}
+
+/// The first non-empty "model name" of a `/proc/cpuinfo` text.
+fn model_of(cpuinfo: &str) -> Option<String> {
+    cpuinfo.lines().find_map(|line| {
+        let (key, value) = line.split_once(':')?;
+        (key.trim() == "model name" && !value.trim().is_empty()).then(|| value.trim().to_string())
+    })
 }
 
 /// Vendor, family, model and stepping of the first processor in `/proc/cpuinfo` (Linux).
@@ -280,56 +357,65 @@ mod tests {
     use super::*;
     use crate::simd::SimdLevel;
 
-    fn tiny() -> CalibrationOptions {
-        CalibrationOptions {
-            budget: Duration::from_millis(5),
-            memory_bytes: 4 << 20,
-        }
+    /// Fixed figures: a ceiling of 0.9·p up to two threads, a pool of more than 8 refused.
+    struct Fixed {
+        asked: Vec<usize>,
     }
 
-    fn finite_positive(x: f64) -> bool {
-        x.is_finite() && x > 0.0
+    impl Meter for Fixed {
+        fn fma_gflops(&mut self) -> f64 {
+            150.0
+        }
+        fn ceiling(&mut self, threads: usize) -> Result<f64, String> {
+            self.asked.push(threads);
+            match threads {
+                t if t > 8 => Err("cannot spawn".to_string()),
+                t => Ok(0.9 * t.min(2) as f64),
+            }
+        }
+        fn fork_join_us(&mut self, threads: usize, _: &mut Vec<String>) -> (f64, f64) {
+            (10.0 * threads as f64, 1.0)
+        }
+        fn bandwidth_gbs(&mut self, warnings: &mut Vec<String>) -> f64 {
+            warnings.push("bandwidth: fixed".to_string());
+            12.5
+        }
     }
 
     #[test]
-    fn tiny_calibration_is_complete_and_sane() {
-        let cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
-        let threads = [1, 2, cpus + 1];
-        let c = calibrate_with(&tiny(), &threads);
-        assert!(!c.cpu_model.is_empty());
-        assert!(c.logical_cpus >= 1);
-        assert_eq!(c.simd, simd::level().name());
-        for x in [
-            c.fma_gflops_1t,
-            c.fork_join_us,
-            c.fork_join_hot_us,
-            c.memory_bandwidth_gbs,
-            c.duration_s,
-        ] {
-            assert!(finite_positive(x), "{x} in {c:?}");
-        }
-        assert_eq!(c.fork_join_threads, cpus + 1);
-        let measured: Vec<usize> = c.parallel_ceiling.iter().map(|r| r.threads).collect();
-        assert_eq!(measured, threads);
-        for r in &c.parallel_ceiling {
-            assert!(finite_positive(r.ratio), "{r:?}");
-            assert_eq!(r.oversubscribed, r.threads > c.logical_cpus, "{r:?}");
-        }
-        assert!(c.parallel_ceiling.last().is_some_and(|r| r.oversubscribed));
-        assert!(
-            c.background_cpus.is_none_or(|b| b.is_finite() && b >= 0.0),
-            "{c:?}"
+    fn the_assembly_keeps_each_figure_and_warns_for_what_it_skips() {
+        let mut meter = Fixed { asked: Vec::new() };
+        let c = assemble(&mut meter, &[0, 1, 2, 3, 16], 2);
+        assert_eq!(meter.asked, [1, 2, 3, 16], "0 threads is never measured");
+        assert_eq!(c.fma_gflops_1t, 150.0);
+        let ceiling: Vec<(usize, f64, bool)> = c
+            .parallel_ceiling
+            .iter()
+            .map(|r| (r.threads, r.ratio, r.oversubscribed))
+            .collect();
+        assert_eq!(ceiling, [(1, 0.9, false), (2, 1.8, false), (3, 1.8, true)]);
+        assert_eq!(c.ceiling(3), Some(1.8));
+        assert_eq!(c.ceiling(16), None);
+        // Fork/join on the largest pool asked for, refused or not.
+        assert_eq!(
+            (c.fork_join_threads, c.fork_join_us, c.fork_join_hot_us),
+            (16, 160.0, 1.0)
         );
-        assert!(c.summary().starts_with(&c.cpu_model));
-    }
-
-    #[test]
-    fn zero_threads_is_skipped_with_a_warning() {
-        let c = calibrate_with(&tiny(), &[0, 1]);
-        let measured: Vec<usize> = c.parallel_ceiling.iter().map(|r| r.threads).collect();
-        assert_eq!(measured, [1]);
-        assert!(c.warnings.iter().any(|w| w.contains("0 threads")));
-        assert_eq!(c.fork_join_threads, 2);
+        assert_eq!(c.memory_bandwidth_gbs, 12.5);
+        assert_eq!(
+            c.warnings,
+            [
+                "parallel ceiling: 0 threads requested, skipped",
+                "parallel ceiling at 16 threads not measured: cannot spawn",
+                "bandwidth: fixed",
+            ]
+        );
+        assert_eq!(c.logical_cpus, 2);
+        assert_eq!(c.simd, simd::level().name());
+        // No thread count at all: fork/join still measured, on two threads.
+        let none = assemble(&mut Fixed { asked: Vec::new() }, &[], 2);
+        assert!(none.parallel_ceiling.is_empty());
+        assert_eq!(none.fork_join_threads, 2);
     }
 
     fn sample() -> Calibration {
@@ -440,8 +526,16 @@ mod tests {
     }
 
     #[test]
-    fn cpu_model_is_never_empty() {
-        assert!(!cpu_model().is_empty());
+    fn model_from_cpuinfo() {
+        let text = "processor\t: 0\nvendor_id\t: AuthenticAMD\nmodel name\t: AMD EPYC 9R14\n\
+                    processor\t: 1\nmodel name\t: AMD EPYC 9R14\n";
+        assert_eq!(model_of(text).as_deref(), Some("AMD EPYC 9R14"));
+        // An ARM kernel's cpuinfo has no model name; an empty one is no model either.
+        assert_eq!(model_of("processor\t: 0\nBogoMIPS\t: 50.00\n"), None);
+        assert_eq!(
+            model_of("model name\t:   \nmodel name\t: B\n").as_deref(),
+            Some("B")
+        );
     }
 
     #[test]
