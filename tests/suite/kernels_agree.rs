@@ -15,12 +15,19 @@ struct Compare {
     kinds: Vec<KernelKind>,
     threads: usize,
     theta: f64,
+    /// Computes with the probe (energy, interacting pairs) on both sides: the path of the first
+    /// kick and of every energy check.
+    probe: bool,
 }
 
 struct Errors {
     kind: KernelKind,
     rounding_ratio: f64,
     median_rel: f64,
+    /// |E − E_naive| / |E_naive|, probe runs only.
+    energy_rel: f64,
+    /// Interacting pairs counted by the kernel and by naive, probe runs only.
+    pairs: (u64, u64),
 }
 
 impl SystemJob for Compare {
@@ -39,10 +46,10 @@ impl SystemJob for Compare {
         // Exact kernels are compared with naive in their own precision (identical pair
         // arithmetic and cutoff decisions); the f64 reference gives the reported error.
         let mut naive = zero_field::<T, D>(n);
-        KernelKind::Naive
+        let naive_report = KernelKind::Naive
             .build::<T, L, D>(sys.law, &params)
             .unwrap()
-            .compute(&sys.state, &mut naive, false);
+            .compute(&sys.state, &mut naive, self.probe);
         let mut out = Vec::new();
         for kind in self
             .kinds
@@ -54,7 +61,19 @@ impl SystemJob for Compare {
             let mut f = zero_field::<T, D>(n);
             // Twice: the second call runs on reused buffers.
             pool.install(|| k.compute(&sys.state, &mut f, false));
-            pool.install(|| k.compute(&sys.state, &mut f, false));
+            let report = pool.install(|| k.compute(&sys.state, &mut f, self.probe));
+            let (energy_rel, pairs) = if self.probe {
+                let (e, e_naive) = (report.energy.unwrap(), naive_report.energy.unwrap());
+                (
+                    (e - e_naive).abs() / (e_naive.abs() + 1e-300),
+                    (
+                        report.work.pairs_interacting,
+                        naive_report.work.pairs_interacting,
+                    ),
+                )
+            } else {
+                (0.0, (0, 0))
+            };
             let mut worst = 0.0f64;
             let mut rel = Vec::new();
             for i in 0..n {
@@ -82,6 +101,8 @@ impl SystemJob for Compare {
                 kind,
                 rounding_ratio: worst,
                 median_rel,
+                energy_rel,
+                pairs,
             });
         }
         (T::EPSILON_F64, out)
@@ -114,6 +135,7 @@ fn exact_kernels_agree_with_the_reference() {
                         kinds: exact.clone(),
                         threads,
                         theta: 0.5,
+                        probe: false,
                     };
                     let (eps, errs) = setup(scenario, n, precision, 7).dispatch(job).unwrap();
                     assert!(errs.len() >= 3);
@@ -131,6 +153,51 @@ fn exact_kernels_agree_with_the_reference() {
     }
 }
 
+/// The probe path (forces with the energy and the interacting pairs, used by the first kick and
+/// every energy check) of each exact kernel against naive's probe: the same forces to
+/// rounding, the same energy to rounding, the same pairs counted.
+#[test]
+fn probe_paths_agree_with_naive() {
+    let exact = vec![
+        KernelKind::Symmetric,
+        KernelKind::PerThread,
+        KernelKind::CellList,
+        KernelKind::Verlet,
+    ];
+    for scenario in ScenarioKind::ALL {
+        for precision in [Precision::F32, Precision::F64] {
+            for n in [2, 7, 1500] {
+                for threads in [1, 2] {
+                    let job = Compare {
+                        kinds: exact.clone(),
+                        threads,
+                        theta: 0.5,
+                        probe: true,
+                    };
+                    let (eps, errs) = setup(scenario, n, precision, 11).dispatch(job).unwrap();
+                    assert!(!errs.is_empty());
+                    for e in errs {
+                        let at =
+                            format!("{scenario:?} {precision:?} n={n} p={threads} {:?}", e.kind);
+                        assert!(
+                            e.rounding_ratio <= EXACT_ULPS * eps,
+                            "{at}: |dF|/sum|F_ij| = {:e}",
+                            e.rounding_ratio
+                        );
+                        // Energies are summed in f64 from pair terms of the run's precision.
+                        assert!(
+                            e.energy_rel <= EXACT_ULPS * eps,
+                            "{at}: energy differs from naive's by {:e} (relative)",
+                            e.energy_rel
+                        );
+                        assert_eq!(e.pairs.0, e.pairs.1, "{at}: interacting pairs");
+                    }
+                }
+            }
+        }
+    }
+}
+
 #[test]
 fn octree_is_exact_at_theta_zero() {
     for scenario in [ScenarioKind::Galaxy, ScenarioKind::Coulomb] {
@@ -140,6 +207,7 @@ fn octree_is_exact_at_theta_zero() {
                     kinds: vec![KernelKind::Octree],
                     threads,
                     theta: 0.0,
+                    probe: false,
                 };
                 let (eps, errs) = setup(scenario, n, Precision::F64, 3).dispatch(job).unwrap();
                 assert!(
@@ -162,6 +230,7 @@ fn octree_error_grows_with_theta_and_meets_the_target() {
                     kinds: vec![KernelKind::Octree],
                     threads: 2,
                     theta,
+                    probe: false,
                 };
                 setup(scenario, 3000, Precision::F64, 5)
                     .dispatch(job)
@@ -179,6 +248,7 @@ fn octree_error_grows_with_theta_and_meets_the_target() {
                 kinds: vec![KernelKind::Octree],
                 threads: 1,
                 theta: 0.5,
+                probe: false,
             };
             setup(scenario, 3000, Precision::F64, 5)
                 .dispatch(job)

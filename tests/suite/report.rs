@@ -104,3 +104,49 @@ fn missing_or_foreign_results_are_refused_with_exit_2() {
     assert!(String::from_utf8_lossy(&out.stderr).contains("schema"));
     assert!(!foreign.path().join("REPORT.md").exists());
 }
+
+/// Copies the files of `from` (recursively) into `to`.
+fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (entry.path(), to.join(entry.file_name()));
+        if src.is_dir() {
+            copy_tree(&src, &dst);
+        } else {
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    }
+}
+
+/// Snapshot: the committed results give exactly the committed REPORT.md, every table and
+/// sentence of it (a copy is regenerated, so the repository's figures are not rewritten). A
+/// change of the renderer or the analysis shows here as a diff to review, then to commit with
+/// `nbody-bench report --results results --out REPORT.md`.
+#[test]
+fn committed_results_give_the_committed_report_byte_for_byte() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = tempfile::tempdir().unwrap();
+    copy_tree(&root.join("results"), &dir.path().join("results"));
+    std::fs::copy(root.join("REPORT.md"), dir.path().join("REPORT.md")).unwrap();
+    let out = report(dir.path());
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let want = std::fs::read_to_string(root.join("REPORT.md")).unwrap();
+    let got = std::fs::read_to_string(dir.path().join("REPORT.md")).unwrap();
+    if got != want {
+        let line = want
+            .lines()
+            .zip(got.lines())
+            .position(|(a, b)| a != b)
+            .unwrap_or(want.lines().count().min(got.lines().count()));
+        panic!(
+            "REPORT.md differs from what the committed results give, from line {}:\ncommitted: {:?}\ngenerated: {:?}",
+            line + 1,
+            want.lines().nth(line),
+            got.lines().nth(line)
+        );
+    }
+}
