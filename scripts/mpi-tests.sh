@@ -108,7 +108,7 @@ echo "--- run --decomp domain --json"
 "${MPIRUN[@]}" -n 2 "$BIN" run --decomp domain --scenario lj-box --kernel cell-list -n 4000 --steps 20 \
     --json "$TMP/run.json" </dev/null >/dev/null || fail "run --decomp domain"
 for field in '"decomposition": "domain"' '"ranks": 2' '"comm_s"' '"wait_s"' '"bytes_sent"' \
-    '"source_004"' '"interactions"' '"per_rank"'; do
+    '"master_summary"' '"interactions"' '"per_rank"'; do
     grep -qF "$field" "$TMP/run.json" || fail "run --json lacks $field"
 done
 echo "--- mpi-bench"

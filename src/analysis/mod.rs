@@ -76,7 +76,7 @@ pub struct StrongAnalysis {
     /// The models, fitted to the cases that had a logical CPU per worker only: an
     /// oversubscribed case measures time-sharing, not parallel speedup.
     pub fit: Fitted<StrongFit>,
-    /// The serial fraction from the one-worker case's phase timers (source 002's method),
+    /// The serial fraction from the one-worker case's phase timers (the Barnes-Hut report's method),
     /// and how it compares with the fitted one.
     pub timed_serial: Option<TimedSerialFraction>,
     pub serial_comparison: Option<SerialFractionComparison>,

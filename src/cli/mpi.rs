@@ -180,7 +180,7 @@ mod with_mpi {
         Ok(0)
     }
 
-    /// The MPI lines of the summary, then source 004's closing lines.
+    /// The MPI lines of the summary, then the Coulomb MPI tutorial's closing lines.
     fn print_mpi(r: &MpiReport) {
         let red = &r.reduced;
         let grid = r
@@ -218,7 +218,7 @@ mod with_mpi {
             red.ghosts_received.mean,
             red.migrated_out.mean
         );
-        let s = &r.source_004;
+        let s = &r.master_summary;
         outln!("Communication time {:8.5} seconds", s.communication_s);
         outln!("Computation time   {:8.5} seconds", s.computation_s);
         outln!("\tEvaluated {} interactions", s.interactions);

@@ -20,7 +20,7 @@ pub const WITHOUT_MPI: &str = "built without the `mpi` feature; rebuild with `--
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Decomposition {
-    /// Replicated data (sources 000 and 004): each rank owns a block of particles, computes
+    /// Replicated data (the LJ-box assignment, the Coulomb MPI tutorial): each rank owns a block of particles, computes
     /// their forces against all particles, and every step an Allgatherv shares the positions.
     Allgather,
     /// Spatial decomposition (cell list and Verlet list): each rank owns a region, exchanges

@@ -2,7 +2,7 @@
 //! of the `run --json` result (documented in `docs/mpi.md`).
 //!
 //! Time is split three ways on every rank: *compute* (everything outside MPI calls: forces,
-//! integration, walls, packing), *communication* (time inside MPI calls, source 004's
+//! integration, walls, packing), *communication* (time inside MPI calls, the Coulomb MPI tutorial's
 //! "communication time"), and, within communication, *waiting*: the time a rank spends in a
 //! call because another rank is still computing. Waiting is not observable inside one call,
 //! so it is derived from the per-step compute times of all ranks: in a step where the slowest
@@ -140,9 +140,9 @@ pub fn attribute_waits(per_rank: &mut [RankStats], compute: &[Vec<f64>]) {
     }
 }
 
-/// Source 004's closing summary, as its master rank prints it.
+/// The Coulomb MPI tutorial's closing summary, as its master rank prints it.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct Source004 {
+pub struct MasterSummary {
     /// Rank 0's seconds inside MPI calls over the timed steps.
     pub communication_s: f64,
     /// Rank 0's wall time of the timed steps minus its communication time.
@@ -169,7 +169,9 @@ pub struct MpiReport {
     pub rebalances: u64,
     pub per_rank: Vec<RankStats>,
     pub reduced: ReducedStats,
-    pub source_004: Source004,
+    /// Older files call it `source_004`; both names are read.
+    #[serde(alias = "source_004")]
+    pub master_summary: MasterSummary,
     /// Wall time of every timed step, nanoseconds: the slowest rank's. Dropped from sweep
     /// results, whose samples carry the same information.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]

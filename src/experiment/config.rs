@@ -33,7 +33,7 @@ pub enum WeakRule {
     Linear,
     /// n = n₀ · √p whatever the kernel.
     Sqrt,
-    /// n fixed, steps × p: the simulated time grows instead (source 002's second study).
+    /// n fixed, steps × p: the simulated time grows instead (the Barnes-Hut report's second study).
     Time,
 }
 

@@ -1,4 +1,4 @@
-//! The serial fraction measured the way source 002 does: time the phases of a one-worker run
+//! The serial fraction measured the way the Barnes-Hut report does: time the phases of a one-worker run
 //! that stay serial, divide by the total, and compare with the serial fraction fitted to the
 //! speedups. The fitted one is usually larger: the gap is the cost of running in parallel
 //! (synchronisation, communication, memory contention) that a one-worker run does not have and
@@ -119,7 +119,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn source_002_table_gives_0_0034_percent() {
+    fn timed_phases_table_gives_0_0034_percent() {
         let serial = [0.0133631, 0.00107666, 0.00932205];
         let total = 690.016;
         let parallel = [total - serial.iter().sum::<f64>()];

@@ -17,7 +17,7 @@ impl Share {
     }
 
     /// This share's block of `0..n`: contiguous blocks whose sizes differ by at most one, the
-    /// first `n % count` blocks one larger (source 000's `partition_problem`). Blocks are empty
+    /// first `n % count` blocks one larger (the LJ-box assignment's `partition_problem`). Blocks are empty
     /// when `n < count`.
     pub fn block(&self, n: usize) -> Range<usize> {
         let (each, left) = (n / self.count, n % self.count);

@@ -1,4 +1,4 @@
-//! Trajectories in the NBView format of source 000, read by its viewer.
+//! Trajectories in the NBView format of the LJ-box assignment, read by its viewer.
 //!
 //! Binary (`NBView01`): the ASCII tag `NBView01`, a line feed, then the header — particle count
 //! as a big-endian u32 and the view-box scale as a big-endian IEEE-754 f32 — then frames

@@ -1,4 +1,4 @@
-//! The report's communication section: source 004's computation/communication split of the
+//! The report's communication section: the Coulomb MPI tutorial's computation/communication split of the
 //! MPI runs, the α-β fit and its prediction beyond this machine.
 
 use super::Sweep;
@@ -97,7 +97,7 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
     for s in &mpi {
         let _ = writeln!(
             md,
-            "From `{}`: per step, the mean over ranks of the time inside MPI calls (source 004's communication \
+            "From `{}`: per step, the mean over ranks of the time inside MPI calls (the Coulomb MPI tutorial's communication \
              time) and of the bytes sent, next to the step time. * = oversubscribed (more ranks than logical CPUs).\n",
             s.analysis.source
         );

@@ -152,7 +152,7 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
             a.source
         );
         md.push_str(&tables::strong(a));
-        md.push_str("\nTimed vs fitted serial fraction (source 002's method next to the fit):\n\n");
+        md.push_str("\nTimed vs fitted serial fraction (the Barnes-Hut report's method next to the fit):\n\n");
         md.push_str(&tables::serial_comparisons(a));
         md.push('\n');
         figure_links(md, s, "speedup-");

@@ -1,4 +1,4 @@
-//! The gravitating test system of source 002: six massive bodies on circular orbits around the
+//! The gravitating test system of the Barnes-Hut report: six massive bodies on circular orbits around the
 //! origin plus a centrally concentrated random cloud of light bodies.
 //!
 //! Units: AU, 10⁻³ solar masses, G = 1 (time unit √(AU³ / (G·10⁻³ M☉))). The cloud is a Plummer

@@ -26,13 +26,13 @@ pub use placement::PlacementError;
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum ScenarioKind {
-    /// 2-D Lennard-Jones gas in a box with reflecting walls and downward gravity (source 000).
+    /// 2-D Lennard-Jones gas in a box with reflecting walls and downward gravity (the LJ-box assignment).
     LjBox,
     /// 2-D Lennard-Jones liquid (reduced density 0.8) in a walled box, no field.
     LjLiquid,
-    /// 3-D charges ±1 at rest in the unit cube, open space (source 004).
+    /// 3-D charges ±1 at rest in the unit cube, open space (the Coulomb MPI tutorial).
     Coulomb,
-    /// 3-D gravitating system: six massive bodies on circular orbits around a Plummer cloud (source 002).
+    /// 3-D gravitating system: six massive bodies on circular orbits around a Plummer cloud (the Barnes-Hut report).
     Galaxy,
 }
 
@@ -101,14 +101,14 @@ impl ScenarioKind {
     pub fn summary(self) -> &'static str {
         match self {
             ScenarioKind::LjBox => {
-                "2-D LJ gas, sigma=0.01, rc=2.5 sigma, walls, g=1, T0=1 (source 000)"
+                "2-D LJ gas, sigma=0.01, rc=2.5 sigma, walls, g=1, T0=1 (the LJ-box assignment)"
             }
             ScenarioKind::LjLiquid => "2-D LJ liquid, reduced density 0.8, walls, no field",
             ScenarioKind::Coulomb => {
-                "3-D charges +-1 at rest in the unit cube, quench 1e-3, open (source 004)"
+                "3-D charges +-1 at rest in the unit cube, quench 1e-3, open (the Coulomb MPI tutorial)"
             }
             ScenarioKind::Galaxy => {
-                "3-D gravity: 6 planets around a Plummer cloud, softening 0.05, open (source 002)"
+                "3-D gravity: 6 planets around a Plummer cloud, softening 0.05, open (the Barnes-Hut report)"
             }
         }
     }
@@ -118,7 +118,7 @@ impl ScenarioKind {
 /// and 2^29 particles already need tens of GB.
 pub const MAX_PARTICLES: usize = 1 << 29;
 
-/// Lennard-Jones parameters shared by the LJ scenarios (source 000's units).
+/// Lennard-Jones parameters shared by the LJ scenarios (the LJ-box assignment's units).
 pub const LJ_EPSILON: f64 = 1.0;
 pub const LJ_SIGMA: f64 = 0.01;
 pub const LJ_CUTOFF: f64 = 2.5 * LJ_SIGMA;

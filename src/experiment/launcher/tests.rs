@@ -1,6 +1,6 @@
 use super::*;
 use crate::decomp::Decomposition;
-use crate::decomp::stats::{RankStats, Source004, reduce};
+use crate::decomp::stats::{MasterSummary, RankStats, reduce};
 use crate::kernels::KernelKind;
 use crate::scenario::{Precision, ScenarioKind};
 
@@ -77,7 +77,7 @@ fn run_json(step_ns: Vec<u64>) -> String {
         rebalances: 0,
         reduced: reduce(&per_rank),
         per_rank,
-        source_004: Source004::default(),
+        master_summary: MasterSummary::default(),
         step_ns,
     };
     serde_json::json!({
