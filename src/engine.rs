@@ -9,10 +9,6 @@ use crate::state::{Field, State, zero_field};
 use serde::Serialize;
 use std::time::Instant;
 
-/// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order), unless
-/// the kernel asks more often ([`ForceKernel::sort_every`]: the Verlet list, at its rebuilds).
-pub const SORT_EVERY: u64 = 20;
-
 /// Seconds spent in each phase of the step, summed over steps.
 #[derive(Clone, Copy, Debug, Default, Serialize, serde::Deserialize, PartialEq)]
 pub struct PhaseTimes {

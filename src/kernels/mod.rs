@@ -25,7 +25,6 @@ pub use share::Share;
 pub use symmetric::Symmetric;
 pub use verlet::Verlet;
 
-use crate::engine::SORT_EVERY;
 use crate::physics::{LawKind, PairLaw};
 use crate::real::Real;
 use crate::state::{Field, State, zero_field};
@@ -230,6 +229,10 @@ pub enum KernelError {
     #[error("{0}")]
     BadParam(String),
 }
+
+/// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order), unless
+/// the kernel asks more often ([`ForceKernel::sort_every`]: the Verlet list, at its rebuilds).
+pub const SORT_EVERY: u64 = 20;
 
 /// Deterministic work done by one force computation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]

@@ -25,3 +25,30 @@ mod report;
 mod runs;
 mod sweep;
 mod verlet;
+
+use std::path::Path;
+
+/// Copies the files of `from` (recursively) into `to`: tests that regenerate analyses or the
+/// report work on a copy of the committed results, never on the repository's own files.
+pub fn copy_tree(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap().flatten() {
+        let (src, dst) = (entry.path(), to.join(entry.file_name()));
+        if src.is_dir() {
+            copy_tree(&src, &dst);
+        } else {
+            std::fs::copy(&src, &dst).unwrap();
+        }
+    }
+}
+
+/// A temporary `results/` holding a copy of the committed quick sweep.
+pub fn quick_results_copy() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    copy_tree(
+        &root.join("results/quick"),
+        &dir.path().join("results/quick"),
+    );
+    dir
+}

@@ -105,19 +105,6 @@ fn missing_or_foreign_results_are_refused_with_exit_2() {
     assert!(!foreign.path().join("REPORT.md").exists());
 }
 
-/// Copies the files of `from` (recursively) into `to`.
-fn copy_tree(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap().flatten() {
-        let (src, dst) = (entry.path(), to.join(entry.file_name()));
-        if src.is_dir() {
-            copy_tree(&src, &dst);
-        } else {
-            std::fs::copy(&src, &dst).unwrap();
-        }
-    }
-}
-
 /// Snapshot: the committed results give exactly the committed REPORT.md, every table and
 /// sentence of it (a copy is regenerated, so the repository's figures are not rewritten). A
 /// change of the renderer or the analysis shows here as a diff to review, then to commit with
@@ -126,7 +113,7 @@ fn copy_tree(from: &Path, to: &Path) {
 fn committed_results_give_the_committed_report_byte_for_byte() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let dir = tempfile::tempdir().unwrap();
-    copy_tree(&root.join("results"), &dir.path().join("results"));
+    crate::copy_tree(&root.join("results"), &dir.path().join("results"));
     std::fs::copy(root.join("REPORT.md"), dir.path().join("REPORT.md")).unwrap();
     let out = report(dir.path());
     assert!(
