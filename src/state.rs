@@ -58,9 +58,13 @@ impl<T: Real, const D: usize> State<T, D> {
     /// `extra` fields (e.g. the current forces) are permuted the same way.
     pub fn permute(&mut self, order: &[u32], extra: &mut [&mut Field<T, D>]) {
         assert_eq!(order.len(), self.len(), "permutation length must equal n");
-        let gather = |v: &mut Vec<T>| {
-            let old = std::mem::take(v);
-            *v = order.iter().map(|&k| old[k as usize]).collect();
+        // One scratch array, swapped with each field in turn: the old field becomes the next
+        // scratch, so a permutation allocates one array, not one per field.
+        let mut scratch: Vec<T> = Vec::with_capacity(order.len());
+        let mut gather = |v: &mut Vec<T>| {
+            scratch.clear();
+            scratch.extend(order.iter().map(|&k| v[k as usize]));
+            std::mem::swap(v, &mut scratch);
         };
         for d in 0..D {
             gather(&mut self.pos[d]);
