@@ -10,6 +10,10 @@
 //! excluded without a scalar tail. (A zero-strength source exerts no force: the law is linear in
 //! the source strength, which the monopole approximation already relies on.) The probe path
 //! instead splits the run around the target, so the interaction counts see only real sources.
+//!
+//! At quadrupole order the walk (monomorphized with `QUAD`) writes the accepted nodes' arena
+//! indices instead, and each group's node list (`nodes::NodeList`) is filled from them; every
+//! target then gathers from both lists.
 
 use super::nodes::NodeList;
 use super::tree::{Group, Tree};
