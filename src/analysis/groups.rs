@@ -1,12 +1,13 @@
 //! Reads the cases of a results file as series: the same code over n (complexity), over p at
 //! fixed n (strong scaling), over p with the work per worker held (weak scaling), and over θ
-//! (octree accuracy). Pure data; the fits and plots are elsewhere.
+//! (octree accuracy, one series per expansion order). Pure data; the fits and plots are
+//! elsewhere.
 
 use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
 use crate::experiment::config::Study;
 use crate::experiment::results::{CaseRecord, ResultsFile};
-use crate::kernels::KernelKind;
+use crate::kernels::{KernelKind, Multipole};
 use crate::scenario::{Precision, ScenarioKind};
 use crate::stats::StepPercentiles;
 use serde::Serialize;
@@ -64,6 +65,9 @@ pub struct SeriesKey {
     pub kernel: KernelKind,
     pub precision: Precision,
     pub theta: Option<f64>,
+    /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
+    #[serde(skip_serializing_if = "crate::experiment::plan::is_monopole")]
+    pub multipole: Multipole,
     pub n: Option<usize>,
     pub threads: Option<usize>,
     pub ranks: Option<usize>,
@@ -76,6 +80,9 @@ impl SeriesKey {
         let mut s = self.kernel.name().to_string();
         if let Some(t) = self.theta {
             s.push_str(&format!(" θ={t}"));
+        }
+        if self.multipole != Multipole::Monopole {
+            s.push_str(&format!(" {}", self.multipole.name()));
         }
         if let Some(d) = self.decomp {
             s.push_str(&format!(" ({})", d.name()));
@@ -123,6 +130,7 @@ pub fn group(results: &ResultsFile) -> Groups {
         kernel: r.case.kernel,
         precision: precision_of(r),
         theta: c.theta,
+        multipole: r.case.multipole,
         n: Some(c.n),
         threads: Some(c.threads),
         ranks: Some(c.ranks),

@@ -2,7 +2,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use nbody_bench::decomp::Decomposition;
-use nbody_bench::kernels::KernelKind;
+use nbody_bench::kernels::{KernelKind, Multipole};
 use nbody_bench::output::nbview::NbviewFormat;
 use nbody_bench::scenario::{Precision, ScenarioKind};
 use std::path::PathBuf;
@@ -104,6 +104,9 @@ pub struct KernelArgs {
     /// when s/d < theta [default: 0.5].
     #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub theta: Option<f64>,
+    /// Expansion order of the tree nodes the octree accepts (octree only) [default: monopole].
+    #[arg(long, value_enum)]
+    pub multipole: Option<Multipole>,
     /// Most particles in a tree leaf (octree only) [default: 8].
     #[arg(long, value_parser = parse_count)]
     pub leaf_size: Option<usize>,

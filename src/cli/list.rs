@@ -16,7 +16,8 @@ pub fn list() -> anyhow::Result<i32> {
                 "bins of side >= cutoff, sorted by bin; O(n); parallel over bins"
             }
             KernelKind::Octree => {
-                "Barnes-Hut tree (quadtree in 2-D), opening angle --theta; O(n log n)"
+                "Barnes-Hut tree (quadtree in 2-D), opening angle --theta, --multipole \
+                 monopole|quadrupole; O(n log n)"
             }
             KernelKind::Verlet => {
                 "half neighbour list, cutoff + --skin, rebuilt when a particle moved skin/2; O(n)"

@@ -67,9 +67,9 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
     }
 }
 
-/// The kernel parameters given, over the defaults; `--theta`, `--leaf-size` and `--skin` are
-/// refused for a kernel that ignores them (as `--density` is for a scenario without a box), so
-/// that nobody believes a setting that changed nothing.
+/// The kernel parameters given, over the defaults; `--theta`, `--multipole`, `--leaf-size` and
+/// `--skin` are refused for a kernel that ignores them (as `--density` is for a scenario
+/// without a box), so that nobody believes a setting that changed nothing.
 fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Result<KernelParams> {
     if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Verlet)
         && args.skin.is_some()
@@ -83,6 +83,7 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
     if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Octree) {
         for (flag, given) in [
             ("--theta", args.theta.is_some()),
+            ("--multipole", args.multipole.is_some()),
             ("--leaf-size", args.leaf_size.is_some()),
         ] {
             if given {
@@ -99,6 +100,7 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
         theta: args.theta.unwrap_or(defaults.theta),
         leaf_size: args.leaf_size.unwrap_or(defaults.leaf_size),
         skin: args.skin.unwrap_or(defaults.skin),
+        multipole: args.multipole.unwrap_or(defaults.multipole),
     })
 }
 

@@ -168,6 +168,9 @@ pub struct SweepConfig {
     /// Barnes-Hut opening angles (octree cases only).
     #[serde(default = "default_theta")]
     pub theta: Vec<f64>,
+    /// Expansion orders of the octree's nodes (octree cases only).
+    #[serde(default = "default_multipole")]
+    pub multipole: Vec<crate::kernels::Multipole>,
     #[serde(default)]
     pub precision: Option<Precision>,
     /// Output directory [default: results].
@@ -233,6 +236,9 @@ fn one_seed() -> Vec<u64> {
 }
 fn default_theta() -> Vec<f64> {
     vec![0.5]
+}
+fn default_multipole() -> Vec<crate::kernels::Multipole> {
+    vec![crate::kernels::Multipole::Monopole]
 }
 fn default_out() -> PathBuf {
     PathBuf::from("results")
@@ -355,6 +361,12 @@ impl SweepConfig {
             return Err(bad(
                 "theta",
                 "must be a non-empty list of finite values >= 0".into(),
+            ));
+        }
+        if self.multipole.is_empty() {
+            return Err(bad(
+                "multipole",
+                "must list at least one of \"monopole\", \"quadrupole\"".into(),
             ));
         }
         match (&self.study, &self.weak) {

@@ -73,6 +73,9 @@ pub fn allowed(key: &str) -> Option<&'static str> {
         "threads" => "a list of thread counts of at least 1, such as threads = [1, 2]",
         "seeds" => "a list of whole numbers of at least 0, such as seeds = [1, 2, 3]",
         "theta" => "a list of opening angles of at least 0, such as theta = [0.5, 0.7]",
+        "multipole" => {
+            "a list of expansion orders, such as multipole = [\"monopole\", \"quadrupole\"]"
+        }
         "precision" => "\"f32\" or \"f64\"",
         "out" => "a directory, as a string, such as out = \"results\"",
         "measure" => {

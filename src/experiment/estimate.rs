@@ -17,7 +17,7 @@ use super::config::{MpiLaunch, SweepConfig};
 use super::plan::Case;
 use super::runner::samples_in_round;
 use crate::engine::Simulation;
-use crate::kernels::{Complexity, KernelKind, KernelParams, MIN_PARALLEL_PAIRS};
+use crate::kernels::{Complexity, KernelKind, KernelParams, MIN_PARALLEL_PAIRS, Multipole};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::run::RunError;
@@ -309,8 +309,17 @@ pub fn run_seconds(case: &Case, steps: u64, logical_cpus: usize) -> Result<f64, 
 }
 
 fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed, ProbeError> {
-    type Key = (ScenarioKind, KernelKind, Option<Precision>, Option<u64>);
-    let key = |c: &Case| (c.scenario, c.kernel, c.precision, c.theta.map(f64::to_bits));
+    type Key = (
+        ScenarioKind,
+        KernelKind,
+        Option<Precision>,
+        Option<u64>,
+        Multipole,
+    );
+    let key = |c: &Case| {
+        let theta = c.theta.map(f64::to_bits);
+        (c.scenario, c.kernel, c.precision, theta, c.multipole)
+    };
     let started = Instant::now();
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -331,6 +340,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         let job = ProbeJob {
             kernel: case.kernel,
             theta: case.theta,
+            multipole: case.multipole,
             error_sample,
             started: Instant::now(),
         };
@@ -362,6 +372,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
 struct ProbeJob {
     kernel: KernelKind,
     theta: Option<f64>,
+    multipole: Multipole,
     error_sample: usize,
     started: Instant,
 }
@@ -372,6 +383,7 @@ impl SystemJob for ProbeJob {
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
         let params = KernelParams {
             theta: self.theta.unwrap_or(KernelParams::default().theta),
+            multipole: self.multipole,
             ..KernelParams::default()
         };
         let law = system.law;

@@ -90,6 +90,9 @@ pub fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> 
     if let Some(theta) = case.theta {
         a.extend(["--theta".to_string(), theta.to_string()]);
     }
+    if case.multipole != crate::kernels::Multipole::Monopole {
+        a.extend(["--multipole".to_string(), case.multipole.name().to_string()]);
+    }
     if let Some(p) = case.precision {
         a.extend(["--precision".to_string(), p.name().to_string()]);
     }

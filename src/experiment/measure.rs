@@ -81,6 +81,7 @@ impl<C: Clock> SystemJob for MeasureJob<'_, C> {
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
         let params = KernelParams {
             theta: self.case.theta.unwrap_or(KernelParams::default().theta),
+            multipole: self.case.multipole,
             ..KernelParams::default()
         };
         let law = system.law;

@@ -2,7 +2,7 @@
 
 use super::config::{Study, SweepConfig, WeakRule};
 use crate::decomp::Decomposition;
-use crate::kernels::KernelKind;
+use crate::kernels::{KernelKind, Multipole};
 use crate::scenario::{Precision, ScenarioKind};
 use serde::{Deserialize, Serialize};
 
@@ -17,6 +17,9 @@ pub struct Case {
     pub ranks: usize,
     /// Opening angle, for the octree only.
     pub theta: Option<f64>,
+    /// Expansion order of the octree's nodes; absent (monopole) in files written before it.
+    #[serde(default, skip_serializing_if = "is_monopole")]
+    pub multipole: Multipole,
     pub seed: u64,
     pub precision: Option<Precision>,
     /// Simulated-time factor of a weak-by-time study (the run stands for this many times the
@@ -42,6 +45,10 @@ impl Case {
         if let Some(t) = self.theta {
             k.push_str(&format!("/theta={t}"));
         }
+        // Only when not the default, so that the keys of earlier results stay valid.
+        if self.multipole != Multipole::Monopole {
+            k.push_str(&format!("/{}", self.multipole.name()));
+        }
         if let Some(p) = self.precision {
             k.push_str(&format!("/{}", p.name()));
         }
@@ -55,16 +62,25 @@ impl Case {
     }
 }
 
-/// The cases of a config, in a fixed order: scenario, kernel, n, threads, seed, θ.
+/// Whether `m` is the default order (left out of case files and keys).
+pub fn is_monopole(m: &Multipole) -> bool {
+    *m == Multipole::Monopole
+}
+
+/// The cases of a config, in a fixed order: scenario, kernel, n, threads, seed, θ, multipole.
 pub fn cases(config: &SweepConfig) -> Vec<Case> {
     let mut out = Vec::new();
     for &scenario in &config.scenarios {
         for &kernel in config.kernels.iter().filter(|k| k.supports(scenario.law())) {
-            let thetas: Vec<Option<f64>> = if kernel == KernelKind::Octree {
-                config.theta.iter().map(|&t| Some(t)).collect()
-            } else {
-                vec![None]
-            };
+            let (thetas, orders): (Vec<Option<f64>>, Vec<Multipole>) =
+                if kernel == KernelKind::Octree {
+                    (
+                        config.theta.iter().map(|&t| Some(t)).collect(),
+                        config.multipole.clone(),
+                    )
+                } else {
+                    (vec![None], vec![Multipole::Monopole])
+                };
             // Without MPI one launch of one rank; under a launcher, every rank count with
             // every decomposition that runs this kernel.
             let launches: Vec<(usize, Option<Decomposition>)> = match &config.mpi {
@@ -100,18 +116,21 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                 for (n, time_factor) in sizes {
                     for &seed in &config.seeds {
                         for &theta in &thetas {
-                            out.push(Case {
-                                scenario,
-                                kernel,
-                                n,
-                                threads,
-                                ranks,
-                                theta,
-                                seed,
-                                precision: config.precision,
-                                time_factor,
-                                decomp,
-                            });
+                            for &multipole in &orders {
+                                out.push(Case {
+                                    scenario,
+                                    kernel,
+                                    n,
+                                    threads,
+                                    ranks,
+                                    theta,
+                                    multipole,
+                                    seed,
+                                    precision: config.precision,
+                                    time_factor,
+                                    decomp,
+                                });
+                            }
                         }
                     }
                 }
@@ -206,5 +225,45 @@ mod tests {
         keys.dedup();
         assert_eq!(keys.len(), cases.len());
         assert!(keys.contains(&"galaxy/octree/n=100/p=2/r=1/seed=1/theta=0.3".to_string()));
+    }
+
+    /// The expansion order multiplies the octree cases only, and only the quadrupole's keys
+    /// (and case files) mention it, so results written before it keep their keys.
+    #[test]
+    fn multipole_is_a_dimension_of_octree_cases() {
+        let text = r#"
+            name = "t"
+            study = "cartesian"
+            scenarios = ["galaxy"]
+            kernels = ["naive", "octree"]
+            n = [100]
+            theta = [0.3, 0.6]
+            multipole = ["monopole", "quadrupole"]
+        "#;
+        let c = SweepConfig::parse(text, std::path::Path::new("t.toml")).unwrap();
+        let cases = cases(&c);
+        assert_eq!(cases.len(), 1 + 2 * 2);
+        let keys: Vec<String> = cases.iter().map(Case::key).collect();
+        for key in [
+            "galaxy/naive/n=100/p=1/r=1/seed=1",
+            "galaxy/octree/n=100/p=1/r=1/seed=1/theta=0.3",
+            "galaxy/octree/n=100/p=1/r=1/seed=1/theta=0.3/quadrupole",
+        ] {
+            assert!(keys.contains(&key.to_string()), "{key} not in {keys:?}");
+        }
+        let mono = cases
+            .iter()
+            .find(|c| c.kernel == KernelKind::Octree)
+            .unwrap();
+        let json = serde_json::to_string(mono).unwrap();
+        assert!(!json.contains("multipole"), "{json}");
+        let quad = cases
+            .iter()
+            .find(|c| c.multipole == Multipole::Quadrupole)
+            .unwrap();
+        let back: Case = serde_json::from_str(&serde_json::to_string(quad).unwrap()).unwrap();
+        assert_eq!(&back, quad);
+        let bad = text.replace(r#"["monopole", "quadrupole"]"#, "[]");
+        assert!(SweepConfig::parse(&bad, std::path::Path::new("t.toml")).is_err());
     }
 }

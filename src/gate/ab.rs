@@ -236,6 +236,7 @@ fn one_case_config(
         Some(theta) => t.insert("theta".into(), list(theta.into())),
         None => t.remove("theta"),
     };
+    t.insert("multipole".into(), list(case.multipole.name().into()));
     if let Some(p) = case.precision {
         t.insert("precision".into(), p.name().into());
     }

@@ -19,7 +19,7 @@ pub mod verlet;
 
 pub use cell_list::CellList;
 pub use naive::Naive;
-pub use octree::Octree;
+pub use octree::{Multipole, Octree};
 pub use per_thread::PerThread;
 pub use share::Share;
 pub use symmetric::Symmetric;
@@ -125,7 +125,12 @@ impl KernelKind {
             KernelKind::Symmetric => Box::new(Symmetric::new(law)),
             KernelKind::PerThread => Box::new(PerThread::new(law)),
             KernelKind::CellList => Box::new(CellList::new(law)?),
-            KernelKind::Octree => Box::new(Octree::new(law, params.theta, params.leaf_size)),
+            KernelKind::Octree => Box::new(Octree::with_multipole(
+                law,
+                params.theta,
+                params.leaf_size,
+                params.multipole,
+            )),
             KernelKind::Verlet => Box::new(Verlet::new(law, params.skin)?),
         })
     }
@@ -176,6 +181,9 @@ pub struct KernelParams {
     /// enter the list, which stays exact until some particle has moved half the skin.
     #[serde(default = "default_skin")]
     pub skin: f64,
+    /// Barnes-Hut expansion order of accepted nodes.
+    #[serde(default)]
+    pub multipole: Multipole,
 }
 
 /// The Verlet skin by default: 0.3σ of the LJ scenarios.
@@ -189,6 +197,7 @@ impl Default for KernelParams {
             theta: 0.5,
             leaf_size: 8,
             skin: default_skin(),
+            multipole: Multipole::Monopole,
         }
     }
 }

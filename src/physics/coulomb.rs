@@ -50,6 +50,10 @@ impl<T: Real> PairLaw<T> for Coulomb<T> {
     fn cutoff(&self) -> Option<T> {
         None
     }
+
+    fn softening2(&self) -> T {
+        T::zero()
+    }
 }
 
 #[cfg(test)]

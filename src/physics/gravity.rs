@@ -51,6 +51,10 @@ impl<T: Real> PairLaw<T> for Gravity<T> {
     fn cutoff(&self) -> Option<T> {
         None
     }
+
+    fn softening2(&self) -> T {
+        self.eps2
+    }
 }
 
 #[cfg(test)]

@@ -73,6 +73,10 @@ impl<T: Real> PairLaw<T> for LennardJones<T> {
     fn cutoff(&self) -> Option<T> {
         Some(self.rc)
     }
+
+    fn softening2(&self) -> T {
+        T::zero()
+    }
 }
 
 #[cfg(test)]

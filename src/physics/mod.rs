@@ -82,6 +82,10 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
 
     /// The cutoff radius, for short-ranged laws.
     fn cutoff(&self) -> Option<T>;
+
+    /// ε² of a Plummer-softened law (`coeff ∝ 1/(r² + ε²)^{3/2}`), 0 for an unsoftened one:
+    /// the tree's quadrupole expansion of a 1/r² law needs it. Unused for short-ranged laws.
+    fn softening2(&self) -> T;
 }
 
 /// The force of source `j` on target `i` given the separation `dx = x_j − x_i`, returned: the

@@ -5,6 +5,7 @@
 
 use crate::analysis::groups::Point;
 use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis};
+use crate::kernels::Multipole;
 use crate::plot::figures::{
     self as fig, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
@@ -291,7 +292,18 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         .theta
         .iter()
         .map(|t| ThetaSweep {
-            name: format!("{} n={}", t.series.scenario.name(), t.series.n.unwrap_or(0)),
+            // One series per expansion order; the monopole's keeps its earlier name.
+            name: match t.series.multipole {
+                Multipole::Monopole => {
+                    format!("{} n={}", t.series.scenario.name(), t.series.n.unwrap_or(0))
+                }
+                m => format!(
+                    "{} n={} {}",
+                    t.series.scenario.name(),
+                    t.series.n.unwrap_or(0),
+                    m.name()
+                ),
+            },
             points: t
                 .points
                 .iter()
@@ -336,6 +348,7 @@ fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
                 && o.threads == c.threads
                 && o.ranks == c.ranks
                 && o.theta == c.theta
+                && o.case.multipole == c.case.multipole
                 && o.decomp == c.decomp
         };
         match out.iter().position(same) {

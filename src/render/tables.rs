@@ -189,7 +189,17 @@ pub fn weak(a: &Analysis) -> String {
     md
 }
 
-/// The octree over θ: time and the force error against an f64 direct sum.
+/// θ of an octree case, with the expansion order when it is not the default monopole.
+fn theta_cell(p: &crate::analysis::groups::Point) -> String {
+    let theta = p.theta.map_or(NONE.to_string(), |t| t.to_string());
+    match p.case.multipole {
+        crate::kernels::Multipole::Monopole => theta,
+        m => format!("{theta} ({})", m.name()),
+    }
+}
+
+/// The octree over θ (one series per expansion order): time and the force error against an
+/// f64 direct sum.
 pub fn theta(a: &Analysis) -> String {
     let mut md = String::from(
         "| scenario | n | θ | time/step | µs/particle-step | median / max relative force error |\n\
@@ -205,7 +215,7 @@ pub fn theta(a: &Analysis) -> String {
                 "| {} | {} | {} | {} | {:.2} | {error} |",
                 t.series.scenario.name(),
                 p.n,
-                p.theta.map_or(NONE.to_string(), |t| t.to_string()),
+                theta_cell(p),
                 Duration(p.median_s),
                 p.ns_per_particle_step * 1e-3,
             );

@@ -255,7 +255,11 @@ fn configs_name_the_key_and_the_allowed_forms() {
 
 #[test]
 fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
-    for flag in [["--theta", "0.7"], ["--leaf-size", "4"]] {
+    for flag in [
+        ["--theta", "0.7"],
+        ["--leaf-size", "4"],
+        ["--multipole", "quadrupole"],
+    ] {
         let o = bin()
             .args([
                 "run",
@@ -285,6 +289,7 @@ fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
             "20",
         ])
         .args(["--theta", "0.7", "--leaf-size", "4", "--steps", "2"])
+        .args(["--multipole", "quadrupole"])
         .output()
         .unwrap();
     assert!(o.status.success(), "{}", text(&o.stderr));

@@ -1,8 +1,9 @@
 //! Every kernel against the naive sum in f64, on every law it supports, for several n
 //! (tiny and odd included), thread counts (2 and 3 oversubscribe a 2-CPU machine) and both
-//! precisions; the octree's error shrinks with θ and is exact at θ = 0.
+//! precisions; the octree's error shrinks with θ and is exact at θ = 0, at both expansion
+//! orders, the quadrupole's below the monopole's.
 
-use nbody_bench::kernels::{KernelKind, KernelParams};
+use nbody_bench::kernels::{KernelKind, KernelParams, Multipole};
 use nbody_bench::physics::PairLaw;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
@@ -15,6 +16,7 @@ struct Compare {
     kinds: Vec<KernelKind>,
     threads: usize,
     theta: f64,
+    multipole: Multipole,
     /// Computes with the probe (energy, interacting pairs) on both sides: the path of the first
     /// kick and of every energy check.
     probe: bool,
@@ -41,6 +43,7 @@ impl SystemJob for Compare {
             .unwrap();
         let params = KernelParams {
             theta: self.theta,
+            multipole: self.multipole,
             ..KernelParams::default()
         };
         // Exact kernels are compared with naive in their own precision (identical pair
@@ -135,6 +138,7 @@ fn exact_kernels_agree_with_the_reference() {
                         kinds: exact.clone(),
                         threads,
                         theta: 0.5,
+                        multipole: Multipole::Monopole,
                         probe: false,
                     };
                     let (eps, errs) = setup(scenario, n, precision, 7).dispatch(job).unwrap();
@@ -172,6 +176,7 @@ fn probe_paths_agree_with_naive() {
                         kinds: exact.clone(),
                         threads,
                         theta: 0.5,
+                        multipole: Multipole::Monopole,
                         probe: true,
                     };
                     let (eps, errs) = setup(scenario, n, precision, 11).dispatch(job).unwrap();
@@ -203,21 +208,40 @@ fn octree_is_exact_at_theta_zero() {
     for scenario in [ScenarioKind::Galaxy, ScenarioKind::Coulomb] {
         for n in [1, 3, 17, 600] {
             for threads in [1, 2] {
-                let job = Compare {
-                    kinds: vec![KernelKind::Octree],
-                    threads,
-                    theta: 0.0,
-                    probe: false,
-                };
-                let (eps, errs) = setup(scenario, n, Precision::F64, 3).dispatch(job).unwrap();
-                assert!(
-                    errs[0].rounding_ratio <= EXACT_ULPS * eps,
-                    "{scenario:?} n={n}: {:e}",
-                    errs[0].rounding_ratio
-                );
+                for multipole in Multipole::ALL {
+                    let job = Compare {
+                        kinds: vec![KernelKind::Octree],
+                        threads,
+                        theta: 0.0,
+                        multipole,
+                        probe: false,
+                    };
+                    let (eps, errs) = setup(scenario, n, Precision::F64, 3).dispatch(job).unwrap();
+                    assert!(
+                        errs[0].rounding_ratio <= EXACT_ULPS * eps,
+                        "{scenario:?} n={n} {multipole:?}: {:e}",
+                        errs[0].rounding_ratio
+                    );
+                }
             }
         }
     }
+}
+
+/// Median relative force error of the octree on a scenario of 3000 particles.
+fn octree_error(scenario: ScenarioKind, theta: f64, multipole: Multipole, threads: usize) -> f64 {
+    let job = Compare {
+        kinds: vec![KernelKind::Octree],
+        threads,
+        theta,
+        multipole,
+        probe: false,
+    };
+    setup(scenario, 3000, Precision::F64, 5)
+        .dispatch(job)
+        .unwrap()
+        .1[0]
+        .median_rel
 }
 
 #[test]
@@ -225,41 +249,33 @@ fn octree_error_grows_with_theta_and_meets_the_target() {
     for scenario in [ScenarioKind::Galaxy, ScenarioKind::Coulomb] {
         let errors: Vec<f64> = [0.2, 0.4, 0.6, 0.9]
             .iter()
-            .map(|&theta| {
-                let job = Compare {
-                    kinds: vec![KernelKind::Octree],
-                    threads: 2,
-                    theta,
-                    probe: false,
-                };
-                setup(scenario, 3000, Precision::F64, 5)
-                    .dispatch(job)
-                    .unwrap()
-                    .1[0]
-                    .median_rel
-            })
+            .map(|&theta| octree_error(scenario, theta, Multipole::Monopole, 2))
             .collect();
         assert!(
             errors.windows(2).all(|w| w[0] < w[1]),
             "{scenario:?}: {errors:?}"
         );
-        let at_half = {
-            let job = Compare {
-                kinds: vec![KernelKind::Octree],
-                threads: 1,
-                theta: 0.5,
-                probe: false,
-            };
-            setup(scenario, 3000, Precision::F64, 5)
-                .dispatch(job)
-                .unwrap()
-                .1[0]
-                .median_rel
-        };
+        let at_half = octree_error(scenario, 0.5, Multipole::Monopole, 1);
         let bound = nbody_bench::validate::octree_tolerance(scenario.law(), 0.5);
         assert!(
             at_half <= bound,
             "{scenario:?}: median error {at_half:e} > {bound:e} at theta 0.5"
         );
+    }
+}
+
+#[test]
+fn quadrupole_octree_error_is_below_the_monopoles() {
+    for scenario in [ScenarioKind::Galaxy, ScenarioKind::Coulomb] {
+        let mut last = 0.0;
+        for theta in [0.3, 0.5, 0.7] {
+            let mono = octree_error(scenario, theta, Multipole::Monopole, 1);
+            let quad = octree_error(scenario, theta, Multipole::Quadrupole, 2);
+            assert!(
+                quad < mono && quad > last,
+                "{scenario:?} theta {theta}: quadrupole {quad:e}, monopole {mono:e}"
+            );
+            last = quad;
+        }
     }
 }

@@ -24,6 +24,7 @@ fn case() -> Case {
         threads: 1,
         ranks: 4,
         theta: None,
+        multipole: Default::default(),
         seed: 3,
         precision: Some(Precision::F64),
         time_factor: 1,

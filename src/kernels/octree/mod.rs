@@ -1,11 +1,13 @@
 //! `octree`: Barnes-Hut with opening angle θ (an octree in 3-D, a quadtree in 2-D), monopoles
-//! at the centre of strength, O(n log n).
+//! at the centre of strength or, as an option ([`Multipole`]), quadrupoles, O(n log n).
 //!
 //! Each step: Morton keys over the current bounding cube, one sort, and a compressed tree in a
 //! flat arena ([`tree`]); then a grouped walk ([`walk`]): each group of up to [`GROUP_SIZE`]
 //! neighbouring particles builds one interaction list (accepted nodes as monopoles, opened
 //! leaves as particles) and each of its particles gathers from it with the shared SIMD pair
-//! loop (`rows::gather`). A node of side `s` is accepted when `s/d < θ`, with `d` the distance
+//! loop (`rows::gather`). At quadrupole order the accepted nodes go to a separate node list
+//! ([`nodes`]) with their second moments ([`moments`], computed at every build), evaluated by
+//! a loop of its own; opened leaves stay in the particle list. A node of side `s` is accepted when `s/d < θ`, with `d` the distance
 //! from its centre of strength to the nearest point of the group's bounding box, so θ = 0 gives
 //! the direct sum. Sources of each sign get their own tree (Coulomb), and every group walks all
 //! trees. Parallel over groups; the forces do not depend on the thread count.
@@ -13,13 +15,16 @@
 //! Counters: `nodes_accepted` and `nodes_opened` count, summed over groups, the nodes whose test
 //! passed and failed (a failed node is split into its children, or its particles are used
 //! directly if it is a leaf or lies inside the group); `pair_checks` counts the particle-
-//! particle and particle-node interactions evaluated, padding excluded.
+//! particle and particle-node interactions evaluated (of either order), padding excluded.
 //!
 //! Memory, all reused from step to step: a sorted copy of positions and strengths, the keys
 //! (16 B per particle), the nodes (fewer than 2n, as every internal node has two children or
 //! more; ~0.43 n on a Plummer sphere at leaf size 8), a sorted force buffer, and one
-//! interaction list per thread (a few thousand entries).
+//! interaction list per thread (a few thousand entries). The quadrupole order adds
+//! D(D+1)/2 + 1 values per node (Q and T) and a node list per thread.
 
+mod moments;
+mod nodes;
 mod tree;
 mod walk;
 
@@ -43,6 +48,39 @@ use walk::{Scratch, Totals, eval_groups, for_group_runs};
 /// other; 8 is 15 % slower (more walks), 64 is 7 % slower (longer lists).
 pub const GROUP_SIZE: usize = 32;
 
+/// The order of the expansion of accepted nodes.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    serde::Serialize,
+    serde::Deserialize,
+    clap::ValueEnum,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum Multipole {
+    /// Total strength at the centre of strength: the node acts as one particle.
+    #[default]
+    Monopole,
+    /// Monopole plus the second moments about the centre (the dipole vanishes there).
+    Quadrupole,
+}
+
+impl Multipole {
+    pub const ALL: [Multipole; 2] = [Multipole::Monopole, Multipole::Quadrupole];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Multipole::Monopole => "monopole",
+            Multipole::Quadrupole => "quadrupole",
+        }
+    }
+}
+
 pub struct Octree<L, T, const D: usize> {
     law: L,
     tree: Tree<T, D>,
@@ -59,9 +97,19 @@ impl<L, T: Real, const D: usize> Octree<L, T, D> {
     /// built by `KernelKind::build`, which checks them first (`KernelParams::validate`); the
     /// module's own tests pass valid values.
     pub fn new(law: L, theta: f64, leaf_size: usize) -> Self {
+        Self::with_multipole(law, theta, leaf_size, Multipole::Monopole)
+    }
+
+    /// [`Octree::new`] at the given expansion order.
+    pub fn with_multipole(law: L, theta: f64, leaf_size: usize, multipole: Multipole) -> Self {
         Octree {
             law,
-            tree: Tree::new(theta, leaf_size, GROUP_SIZE),
+            tree: Tree::new(
+                theta,
+                leaf_size,
+                GROUP_SIZE,
+                multipole == Multipole::Quadrupole,
+            ),
             sorted_forces: std::array::from_fn(|_| Vec::new()),
             lists: Vec::new(),
             last_pairs: None,

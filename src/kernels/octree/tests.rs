@@ -1,5 +1,6 @@
 //! The octree against the naive direct sum: exact at θ = 0, errors ordered by θ and bounded at
-//! θ = 0.5, degenerate configurations, determinism and independence of the particle order.
+//! θ = 0.5, degenerate configurations, determinism and independence of the particle order; the
+//! quadrupole order against an analytic cluster and below the monopole's error.
 
 use super::*;
 use crate::kernels::Naive;
@@ -129,14 +130,29 @@ fn check_exact<T: Real, L: PairLaw<T>, const D: usize>(
     tol: f64,
     what: &str,
 ) {
-    let n = s.len();
     let (want, rw) = forces_of(&mut Naive::new(law), s, true);
-    let mut tree = Octree::new(law, 0.0, 16);
+    for multipole in Multipole::ALL {
+        let what = format!("{what} {}", multipole.name());
+        check_exact_order(law, s, &want, &rw, multipole, tol, &what);
+    }
+}
+
+fn check_exact_order<T: Real, L: PairLaw<T>, const D: usize>(
+    law: L,
+    s: &State<T, D>,
+    want: &Field<T, D>,
+    rw: &ForceReport,
+    multipole: Multipole,
+    tol: f64,
+    what: &str,
+) {
+    let n = s.len();
+    let mut tree = Octree::with_multipole(law, 0.0, 16, multipole);
     let (got, _) = forces_of(&mut tree, s, false);
     let (probed, rg) = forces_of(&mut tree, s, true);
-    let diff = max_rel_diff(&got, &want);
+    let diff = max_rel_diff(&got, want);
     assert!(diff <= tol, "{what}: max diff {diff:e} > {tol:e}");
-    assert!(max_rel_diff(&probed, &want) <= tol, "{what}: probe forces");
+    assert!(max_rel_diff(&probed, want) <= tol, "{what}: probe forces");
     let (ew, eg) = (rw.energy.unwrap_or(f64::NAN), rg.energy.unwrap_or(0.0));
     // The energy is a sum of terms of both signs (Coulomb): compare against their scale.
     let scale = ew.abs().max(1.0);
@@ -171,11 +187,21 @@ fn errors<T: Real, L: PairLaw<T>, const D: usize>(
     s: &State<T, D>,
     thetas: &[f64],
 ) -> Vec<f64> {
+    errors_of_order(law, s, thetas, Multipole::Monopole)
+}
+
+fn errors_of_order<T: Real, L: PairLaw<T>, const D: usize>(
+    law: L,
+    s: &State<T, D>,
+    thetas: &[f64],
+    multipole: Multipole,
+) -> Vec<f64> {
     let (want, _) = forces_of(&mut Naive::new(law), s, false);
     thetas
         .iter()
         .map(|&theta| {
-            let (got, _) = forces_of(&mut Octree::new(law, theta, 16), s, false);
+            let mut k = Octree::with_multipole(law, theta, 16, multipole);
+            let (got, _) = forces_of(&mut k, s, false);
             median_rel_err(&got, &want)
         })
         .collect()
@@ -269,11 +295,21 @@ fn degenerate_configurations_terminate() {
 
 #[test]
 fn serial_parallel_and_permuted_runs_agree() {
-    let s = plummer::<f64, 3>(20_000, SEED_2);
-    let mut k = Octree::new(gravity::<f64>(), 0.5, 16);
+    for multipole in Multipole::ALL {
+        serial_parallel_and_permuted::<f64>(multipole);
+        serial_parallel_and_permuted::<f32>(multipole);
+    }
+}
+
+fn serial_parallel_and_permuted<T: Real>(multipole: Multipole) {
+    let s = plummer::<T, 3>(20_000, SEED_2);
+    let mut k = Octree::with_multipole(gravity::<T>(), 0.5, 16, multipole);
     let (serial, r1) = pool(1).install(|| forces_of(&mut k, &s, false));
     let (par, r2) = pool(2).install(|| forces_of(&mut k, &s, false));
-    assert_eq!(serial, par, "the walk does not depend on the thread count");
+    assert_eq!(
+        serial, par,
+        "{multipole:?}: the walk does not depend on the thread count"
+    );
     assert_eq!(r1.work, r2.work);
     assert!(r1.work.nodes_accepted > 0 && r1.work.pair_checks < 20_000 * 20_000 / 4);
 
@@ -323,4 +359,202 @@ fn quadtree_equals_octree_on_a_plane() {
     assert_eq!(r2.work, r3.work);
     let f3xy: Field<f64, 2> = [f3[0].clone(), f3[1].clone()];
     assert!(max_rel_diff(&f2, &f3xy) < 1e-12);
+}
+
+/// Two equal sources at c ± a·e_x seen by a far target along x and along y: the listed node
+/// must match the direct sum to O((a/r)⁴) (the octupole vanishes by symmetry), the monopole
+/// only to O((a/r)²). Halving a/r divides the quadrupole's error by ~16 and the monopole's by
+/// ~4. Checks the sign convention of the expansion for gravity (softened and not) and Coulomb
+/// (κ < 0), in 3-D and 2-D, for the force and the energy.
+fn cluster_field<L: PairLaw<f64>, const D: usize>(law: L, what: &str) {
+    let (a, c) = (0.1, [0.3; D]);
+    let mut s = State::<f64, D>::new(2);
+    for d in 0..D {
+        s.pos[d][0] = c[d];
+        s.pos[d][1] = c[d];
+    }
+    s.pos[0][0] += a;
+    s.pos[0][1] -= a;
+    s.source.fill(1.5);
+    let mut tree = super::tree::Tree::<f64, D>::new(0.5, 2, GROUP_SIZE, true);
+    tree.build(&s);
+    assert_eq!(tree.nodes.len(), 1, "{what}: one leaf");
+    let mut list = super::nodes::NodeList::<f64, D>::new();
+    list.fill(&tree, &[0]);
+    for axis in [0, 1] {
+        // (force error, energy error) of (monopole, quadrupole) at distance r.
+        let errors = |r: f64| {
+            let mut x = c;
+            x[axis] += r;
+            let t = crate::kernels::rows::Target { x, s: 0.5 };
+            let (mut f, mut e) = ([0.0; D], 0.0);
+            for j in 0..2 {
+                let dx: [f64; D] = std::array::from_fn(|d| s.pos[d][j] - x[d]);
+                let fj = crate::physics::pair_force(&law, dx, t.s, s.source[j]);
+                for d in 0..D {
+                    f[d] += fj[d];
+                }
+                let r2: f64 = dx.iter().map(|v| v * v).sum();
+                e += law.energy(r2, t.s, s.source[j]);
+            }
+            let quad = list.gather::<L, true>(&law, &t);
+            // The monopole: the node as one particle at c.
+            let dc: [f64; D] = std::array::from_fn(|d| c[d] - x[d]);
+            let mono = crate::physics::pair_force(&law, dc, t.s, 3.0);
+            let e_mono = law.energy(r * r, t.s, 3.0);
+            let rel = |g: &[f64; D]| {
+                let err: f64 = (0..D).map(|d| (g[d] - f[d]).powi(2)).sum::<f64>().sqrt();
+                err / f.iter().map(|v| v * v).sum::<f64>().sqrt()
+            };
+            assert_eq!(quad.interacting, 1);
+            (
+                (rel(&mono), rel(&quad.force)),
+                (
+                    (e_mono - e).abs() / e.abs(),
+                    (quad.energy - e).abs() / e.abs(),
+                ),
+            )
+        };
+        let (near, far) = (errors(2.0), errors(4.0));
+        for (kind, (mn, qn), (mf, qf)) in [("force", near.0, far.0), ("energy", near.1, far.1)] {
+            let what = format!("{what}, axis {axis}, {kind}");
+            // (a/r)² = 2.5e-3 at r = 2: the monopole's error is of that order, the
+            // quadrupole's of its square.
+            assert!(
+                mn > 1e-3 && qn < 1e-4,
+                "{what}: errors {mn:e} {qn:e} at r = 2"
+            );
+            let (mono_ratio, quad_ratio) = (mn / mf, qn / qf);
+            assert!(
+                (3.5..4.6).contains(&mono_ratio),
+                "{what}: monopole ratio {mono_ratio}"
+            );
+            assert!(
+                (13.0..19.0).contains(&quad_ratio),
+                "{what}: quadrupole ratio {quad_ratio}"
+            );
+        }
+    }
+}
+
+#[test]
+fn quadrupole_of_a_two_particle_cluster_matches_the_direct_sum() {
+    cluster_field::<_, 3>(Gravity::<f64>::new(1.0, 0.0), "gravity 3-D");
+    cluster_field::<_, 3>(Gravity::<f64>::new(0.7, 0.3), "softened gravity 3-D");
+    cluster_field::<_, 3>(coulomb::<f64>(), "coulomb 3-D");
+    cluster_field::<_, 2>(Gravity::<f64>::new(1.0, 0.05), "gravity 2-D");
+    cluster_field::<_, 2>(coulomb::<f64>(), "coulomb 2-D");
+}
+
+/// At every θ the quadrupole order's median force error is below the monopole's, on the
+/// clustered sphere and disc (gravity, f64 and f32) and on mixed-sign charges (Coulomb).
+#[test]
+fn quadrupole_error_is_below_the_monopoles() {
+    let thetas = [0.3, 0.5, 0.7];
+    fn both<T: Real, L: PairLaw<T>, const D: usize>(
+        law: L,
+        s: &State<T, D>,
+        t: &[f64],
+    ) -> [Vec<f64>; 2] {
+        Multipole::ALL.map(|m| errors_of_order(law, s, t, m))
+    }
+    let cases = [
+        (
+            "sphere f64",
+            both(gravity::<f64>(), &plummer::<f64, 3>(3000, SEED_1), &thetas),
+        ),
+        (
+            "sphere f32",
+            both(gravity::<f32>(), &plummer::<f32, 3>(3000, SEED_1), &thetas),
+        ),
+        (
+            "disc f64",
+            both(gravity::<f64>(), &plummer::<f64, 2>(3000, SEED_2), &thetas),
+        ),
+        (
+            "charges 3-D",
+            both(
+                coulomb::<f64>(),
+                &random_state::<f64, 3>(3000, 10.0, true, SEED_1),
+                &thetas,
+            ),
+        ),
+        (
+            "charges 2-D",
+            both(
+                coulomb::<f64>(),
+                &random_state::<f64, 2>(3000, 10.0, true, SEED_2),
+                &thetas,
+            ),
+        ),
+    ];
+    for (what, [mono, quad]) in &cases {
+        assert!(
+            quad.windows(2).all(|w| w[0] < w[1]),
+            "{what}: quadrupole errors {quad:?} not increasing with θ"
+        );
+        for (i, theta) in thetas.iter().enumerate() {
+            assert!(
+                quad[i] < mono[i],
+                "{what} θ = {theta}: quadrupole {:e} vs monopole {:e}",
+                quad[i],
+                mono[i]
+            );
+        }
+    }
+}
+
+/// The probe path's energy at quadrupole order against the direct sum, and closer to it than
+/// the monopole's; the probe's forces are the timed path's.
+#[test]
+fn quadrupole_energy_matches_the_direct_sum() {
+    fn check<T: Real, L: PairLaw<T>, const D: usize>(
+        law: L,
+        s: &State<T, D>,
+        bound: f64,
+        what: &str,
+    ) {
+        let (_, want) = forces_of(&mut Naive::new(law), s, true);
+        let want = want.energy.expect("probe energy");
+        let [mono, quad] = Multipole::ALL.map(|m| {
+            let mut k = Octree::with_multipole(law, 0.5, 16, m);
+            let (timed, _) = forces_of(&mut k, s, false);
+            let (probed, r) = forces_of(&mut k, s, true);
+            assert!(
+                max_rel_diff(&probed, &timed) < 1e-5,
+                "{what} {m:?}: probe forces"
+            );
+            (r.energy.expect("probe energy") - want).abs() / want.abs()
+        });
+        assert!(
+            quad < mono && quad < bound,
+            "{what}: energy errors {quad:e} (quadrupole) {mono:e}"
+        );
+    }
+    check(
+        gravity::<f64>(),
+        &plummer::<f64, 3>(3000, SEED_1),
+        1e-4,
+        "sphere",
+    );
+    check(
+        gravity::<f32>(),
+        &plummer::<f32, 3>(3000, SEED_1),
+        1e-4,
+        "sphere f32",
+    );
+    check(
+        gravity::<f64>(),
+        &plummer::<f64, 2>(3000, SEED_2),
+        1e-3,
+        "disc",
+    );
+    check(
+        coulomb::<f64>(),
+        &random_state::<f64, 3>(3000, 10.0, true, SEED_2),
+        // The energy of mixed charges is a small sum of terms of both signs: measured 1.8e-3
+        // (quadrupole) and 9.9e-3 (monopole).
+        5e-3,
+        "charges",
+    );
 }

@@ -11,6 +11,7 @@
 //! Sources of both signs (Coulomb) get separate trees: a monopole of mixed-sign charges has no
 //! meaningful centre. The sign is the key's top bit, so the one sort also separates the trees.
 
+use super::moments::Quadrupoles;
 use crate::real::Real;
 use crate::state::State;
 
@@ -86,6 +87,9 @@ pub(super) struct Tree<T, const D: usize> {
     pub groups: Vec<Group>,
     /// A point outside the bounding cube, where zero-strength padding sources sit.
     pub dummy: [T; D],
+    /// Second moments of every node, computed only for the quadrupole order (else empty).
+    pub quad: Quadrupoles<T>,
+    quadrupole: bool,
     theta: f64,
     leaf_size: usize,
     group_size: usize,
@@ -95,7 +99,8 @@ pub(super) struct Tree<T, const D: usize> {
 }
 
 impl<T: Real, const D: usize> Tree<T, D> {
-    pub fn new(theta: f64, leaf_size: usize, group_size: usize) -> Self {
+    /// With `quadrupole`, every build also computes the nodes' second moments.
+    pub fn new(theta: f64, leaf_size: usize, group_size: usize, quadrupole: bool) -> Self {
         Tree {
             keys: Vec::new(),
             order: Vec::new(),
@@ -105,6 +110,8 @@ impl<T: Real, const D: usize> Tree<T, D> {
             roots: Vec::new(),
             groups: Vec::new(),
             dummy: [T::zero(); D],
+            quad: Quadrupoles::new(),
+            quadrupole,
             theta,
             leaf_size: leaf_size.max(1),
             group_size: group_size.max(1),
@@ -186,6 +193,15 @@ impl<T: Real, const D: usize> Tree<T, D> {
             self.make_groups(root);
             lo = hi;
         }
+        if self.quadrupole {
+            self.quad.compute(&self.nodes, &self.pos, &self.src);
+        } else {
+            self.quad.clear();
+        }
+    }
+
+    pub fn quadrupole(&self) -> bool {
+        self.quadrupole
     }
 
     /// Fills node `index` (a placeholder over sorted particles `lo..hi`, all of one sign class)

@@ -10,7 +10,12 @@
 //! excluded without a scalar tail. (A zero-strength source exerts no force: the law is linear in
 //! the source strength, which the monopole approximation already relies on.) The probe path
 //! instead splits the run around the target, so the interaction counts see only real sources.
+//!
+//! At quadrupole order the walk (monomorphized with `QUAD`) writes the accepted nodes' arena
+//! indices instead, and each group's node list (`nodes::NodeList`) is filled from them; every
+//! target then gathers from both lists.
 
+use super::nodes::NodeList;
 use super::tree::{Group, Tree};
 use crate::kernels::WorkCounters;
 use crate::kernels::rows::{LANES, Sources, Target, gather};
@@ -26,6 +31,9 @@ pub(super) struct Scratch<T, const D: usize> {
     src: Vec<T>,
     len: usize,
     stack: Vec<u32>,
+    /// Quadrupole order: the arena indices of the accepted nodes, and their list.
+    accepted: Vec<u32>,
+    nodes: NodeList<T, D>,
 }
 
 impl<T: Real, const D: usize> Scratch<T, D> {
@@ -35,6 +43,8 @@ impl<T: Real, const D: usize> Scratch<T, D> {
             src: Vec::new(),
             len: 0,
             stack: Vec::new(),
+            accepted: Vec::new(),
+            nodes: NodeList::new(),
         }
     }
 
@@ -118,12 +128,12 @@ struct GroupBox<T, const D: usize> {
     hi: [T; D],
 }
 
-/// Tests the nodes `family` against the group: accepted ones go to the list as monopoles,
-/// the others onto the stack to be opened. Branch-free: every node is written to both and
-/// only one of the two lengths advances, so the unpredictable accept/open outcome costs no
-/// mispredicted branches.
+/// Tests the nodes `family` against the group: accepted ones go to the list (as monopoles,
+/// or with `QUAD` as indices for the node list), the others onto the stack to be opened.
+/// Branch-free: every node is written to both and only one of the two lengths advances, so
+/// the unpredictable accept/open outcome costs no mispredicted branches.
 #[inline(always)]
-fn test_family<T: Real, const D: usize>(
+fn test_family<T: Real, const D: usize, const QUAD: bool>(
     tree: &Tree<T, D>,
     family: std::ops::Range<usize>,
     g: &GroupBox<T, D>,
@@ -131,13 +141,17 @@ fn test_family<T: Real, const D: usize>(
     work: &mut WorkCounters,
 ) {
     let count = family.len();
-    list.reserve(count);
-    let (base, sp) = (list.len, list.stack.len());
+    // Monopoles are written to the particle list, quadrupoles' indices to `accepted`.
+    let (mono, quad) = if QUAD { (0, count) } else { (count, 0) };
+    list.reserve(mono);
+    let (base, sp, qp) = (list.len, list.stack.len(), list.accepted.len());
     list.stack.resize(sp + count, 0);
+    list.accepted.resize(qp + quad, 0);
     // Local slices and counters, so that the loop keeps them in registers.
-    let pos = list.pos.each_mut().map(|p| &mut p[base..base + count]);
-    let src = &mut list.src[base..base + count];
+    let pos = list.pos.each_mut().map(|p| &mut p[base..base + mono]);
+    let src = &mut list.src[base..base + mono];
     let stack = &mut list.stack[sp..sp + count];
+    let accepted_nodes = &mut list.accepted[qp..qp + quad];
     let (mut accepted, mut opened) = (0, 0);
     for (c, node) in tree.nodes[family.clone()].iter().enumerate() {
         // Squared distance from the centre of strength to the nearest point of the box.
@@ -151,15 +165,23 @@ fn test_family<T: Real, const D: usize>(
         // them, and the self-pairs, twice); the criterion alone ensures it for θ < 1/√D only.
         let own = (node.start < g.end) & (node.end > g.start);
         let accept = (d2 > node.crit2) & !own;
-        for d in 0..D {
-            pos[d][accepted] = node.com[d];
+        if QUAD {
+            accepted_nodes[accepted] = (family.start + c) as u32;
+        } else {
+            for d in 0..D {
+                pos[d][accepted] = node.com[d];
+            }
+            src[accepted] = node.strength;
         }
-        src[accepted] = node.strength;
         stack[opened] = (family.start + c) as u32;
         accepted += accept as usize;
         opened += !accept as usize;
     }
-    list.len = base + accepted;
+    if QUAD {
+        list.accepted.truncate(qp + accepted);
+    } else {
+        list.len = base + accepted;
+    }
     list.stack.truncate(sp + opened);
     work.nodes_accepted += accepted as u64;
     work.nodes_opened += opened as u64;
@@ -173,8 +195,9 @@ fn max<T: Real>(a: T, b: T) -> T {
 }
 
 /// Builds the interaction list of a group: its own particles first (at slots 0..m, so target
-/// k sits at slot k), then what a walk of every tree from its root accepts or opens.
-fn interaction_list<T: Real, const D: usize>(
+/// k sits at slot k), then what a walk of every tree from its root accepts or opens; with
+/// `QUAD`, the accepted nodes go to the node list instead.
+fn interaction_list<T: Real, const D: usize, const QUAD: bool>(
     tree: &Tree<T, D>,
     g: &GroupBox<T, D>,
     list: &mut Scratch<T, D>,
@@ -182,9 +205,10 @@ fn interaction_list<T: Real, const D: usize>(
 ) {
     list.len = 0;
     list.stack.clear();
+    list.accepted.clear();
     list.push_range(tree, g.start as usize, g.end as usize);
     for &root in &tree.roots {
-        test_family(tree, root as usize..root as usize + 1, g, list, work);
+        test_family::<T, D, QUAD>(tree, root as usize..root as usize + 1, g, list, work);
     }
     // Every node is pushed at most once and the tree is finite, so this ends whatever the
     // values (NaN distances open nodes down to the leaves).
@@ -199,8 +223,11 @@ fn interaction_list<T: Real, const D: usize>(
             list.push_range(tree, node.start as usize, node.end as usize);
         } else {
             let first = node.first as usize;
-            test_family(tree, first..first + node.children as usize, g, list, work);
+            test_family::<T, D, QUAD>(tree, first..first + node.children as usize, g, list, work);
         }
+    }
+    if QUAD {
+        list.nodes.fill(tree, &list.accepted);
     }
 }
 
@@ -211,6 +238,22 @@ fn interaction_list<T: Real, const D: usize>(
 /// `simd::dispatch`. With the walk inlined into the same function as the pair loop, LLVM
 /// scalarized the loop's lane accumulators (1.5× slower pair loop), so they are kept apart.
 pub(super) fn eval_groups<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+    law: &L,
+    tree: &Tree<T, D>,
+    groups: &[Group],
+    offset: usize,
+    out: &mut [&mut [T]; D],
+    list: &mut Scratch<T, D>,
+) -> Totals {
+    if tree.quadrupole() {
+        eval_order::<T, L, D, PROBE, true>(law, tree, groups, offset, out, list)
+    } else {
+        eval_order::<T, L, D, PROBE, false>(law, tree, groups, offset, out, list)
+    }
+}
+
+/// [`eval_groups`] at one multipole order.
+fn eval_order<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const QUAD: bool>(
     law: &L,
     tree: &Tree<T, D>,
     groups: &[Group],
@@ -236,9 +279,10 @@ pub(super) fn eval_groups<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
             lo,
             hi,
         };
-        interaction_list(tree, &group, list, &mut totals.work);
+        interaction_list::<T, D, QUAD>(tree, &group, list, &mut totals.work);
         let real = list.len;
-        totals.work.pair_checks += ((end - start) * (real - 1)) as u64;
+        let nodes = if QUAD { list.nodes.len } else { 0 };
+        totals.work.pair_checks += ((end - start) * (real - 1 + nodes)) as u64;
         if !PROBE {
             let padded = real.next_multiple_of(LANES);
             list.reserve(padded - real);
@@ -249,7 +293,7 @@ pub(super) fn eval_groups<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
         let out = out.each_mut().map(|o| &mut o[start - offset..end - offset]);
         let (energy, interacting) = simd::dispatch(
             #[inline(always)]
-            || group_forces::<T, L, D, PROBE>(law, tree, start, real, list, out),
+            || group_forces::<T, L, D, PROBE, QUAD>(law, tree, start, real, list, out),
         );
         totals.energy += energy;
         totals.interacting += interacting;
@@ -258,10 +302,10 @@ pub(super) fn eval_groups<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
 }
 
 /// Forces on the group's particles (sorted slots `start..start + out.len()`, list slots
-/// `0..out.len()`) from the first `real` entries of its list; returns the energy and the
-/// interacting count when probing.
+/// `0..out.len()`) from the first `real` entries of its list (and with `QUAD` its node list);
+/// returns the energy and the interacting count when probing.
 #[inline(always)]
-fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const QUAD: bool>(
     law: &L,
     tree: &Tree<T, D>,
     start: usize,
@@ -276,7 +320,7 @@ fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
             x: std::array::from_fn(|d| tree.pos[d][i]),
             s: tree.src[i],
         };
-        let sum = if PROBE {
+        let mut sum = if PROBE {
             // Split the run around the target: only real sources are counted.
             let mut sum = gather::<T, L, D, true>(law, &t, &list.sources(0, k));
             sum.add(&gather::<T, L, D, true>(
@@ -292,6 +336,9 @@ fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
             list.swap(k, own.0, own.1);
             sum
         };
+        if QUAD {
+            sum.add(&list.nodes.gather::<L, PROBE>(law, &t));
+        }
         for d in 0..D {
             out[d][k] = sum.force[d];
         }
