@@ -24,6 +24,7 @@
 //! D(D+1)/2 + 1 values per node (Q and T) and a node list per thread.
 
 mod moments;
+mod node;
 mod nodes;
 mod tree;
 mod walk;

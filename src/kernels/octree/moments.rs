@@ -13,7 +13,7 @@
 //! have one sign; a child of zero strength adds nothing). The pass runs only for the quadrupole
 //! order, so monopole runs pay for none of it.
 
-use super::tree::Node;
+use super::node::Node;
 use crate::real::Real;
 
 /// Components of a symmetric D×D tensor: D(D+1)/2 (6 in 3-D, 3 in 2-D).

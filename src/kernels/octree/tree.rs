@@ -12,6 +12,7 @@
 //! meaningful centre. The sign is the key's top bit, so the one sort also separates the trees.
 
 use super::moments::Quadrupoles;
+pub(super) use super::node::Node;
 use crate::real::Real;
 use crate::state::State;
 
@@ -26,24 +27,6 @@ pub(super) const fn max_depth(d: usize) -> u32 {
         Some(_) => 31,
         None => 0,
     }
-}
-
-/// One tree node: a Morton cell and the particles `start..end` (sorted order) inside it.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Node<T, const D: usize> {
-    /// Centre of strength (mass-weighted centre); the mean position if the strength is zero.
-    pub com: [T; D],
-    /// Total source strength.
-    pub strength: T,
-    /// `(side/θ)²`: the node is accepted as a monopole when `d² > crit2` (i.e. `side/d < θ`);
-    /// infinite for θ = 0, so that nothing is ever accepted.
-    pub crit2: T,
-    pub start: u32,
-    pub end: u32,
-    /// Index of the first child; the children are contiguous in the arena.
-    pub first: u32,
-    /// Number of children; 0 for a leaf.
-    pub children: u32,
 }
 
 /// A target group: a run of sibling subtrees whose particles share one interaction list.
