@@ -13,6 +13,7 @@ mod cli;
 mod config_corpus;
 mod conservation;
 mod dry_run;
+mod export;
 mod external;
 mod fit_cli;
 mod gate;
