@@ -23,6 +23,7 @@ mod kernels_agree;
 mod layering;
 mod mpi_cli;
 mod parsers;
+mod peers;
 mod report;
 mod runs;
 mod sweep;
