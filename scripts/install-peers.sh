@@ -24,4 +24,4 @@ if ! "$venv/bin/python" -c "import pytreegrav, numba, numpy" >/dev/null 2>&1; th
     "$venv/bin/pip" install --quiet --upgrade pip
     "$venv/bin/pip" install --quiet pytreegrav numba numpy
 fi
-echo "peers ready: $(lmp -h | head -n 1); pytreegrav in $venv"
+echo "peers ready: $(lmp -h 2>/dev/null | awk 'NF && !done { print; done = 1 }'); pytreegrav in $venv"
