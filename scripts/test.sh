@@ -33,6 +33,18 @@ scripts/ci-gate.sh
 
 step "Open MPI, lints and every test with the mpi feature"
 scripts/install-mpi.sh
+# The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
+# without `lmp`: install it when missing (as root, with apt).
+if ! command -v lmp >/dev/null 2>&1; then
+    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
+        echo "installing lammps"
+        apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps >/dev/null
+    else
+        echo "LAMMPS (lmp) is missing and this is not root: sudo apt-get install -y lammps" >&2
+        exit 2
+    fi
+fi
 cargo clippy --all-targets --release --features mpi -- -D warnings
 # One build of every test target (unit tests, the integration suite, the benches in test
 # mode, the examples, the binary), then the runs: the unit tests; the suite but its timing

@@ -19,6 +19,7 @@ pub mod clock;
 pub mod decomp;
 pub mod engine;
 pub mod experiment;
+pub mod export;
 pub mod fit;
 pub mod gate;
 pub mod input;

@@ -5,6 +5,7 @@
 
 use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
+use crate::experiment::code::Code;
 use crate::experiment::config::Study;
 use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::{KernelKind, Multipole};
@@ -62,7 +63,7 @@ impl Point {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SeriesKey {
     pub scenario: ScenarioKind,
-    pub kernel: KernelKind,
+    pub kernel: Code,
     pub precision: Precision,
     pub theta: Option<f64>,
     /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
@@ -127,7 +128,7 @@ pub fn group(results: &ResultsFile) -> Groups {
     let weak = results.config.study == Study::Weak;
     let base = |c: &Point, r: &CaseRecord| SeriesKey {
         scenario: r.case.scenario,
-        kernel: r.case.kernel,
+        kernel: r.case.kernel.clone(),
         precision: precision_of(r),
         theta: c.theta,
         multipole: r.case.multipole,
@@ -190,7 +191,10 @@ pub fn group(results: &ResultsFile) -> Groups {
     };
     let theta = series(&|k| k.theta = None, &by_theta)
         .into_iter()
-        .filter(|s| s.key.kernel == KernelKind::Octree && distinct(s, &by_theta) >= 2)
+        .filter(|s| {
+            (s.key.kernel == KernelKind::Octree || s.key.kernel.is_external())
+                && distinct(s, &by_theta) >= 2
+        })
         .collect();
     Groups {
         complexity,

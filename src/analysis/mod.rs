@@ -8,6 +8,7 @@ pub mod comm;
 pub mod groups;
 
 use crate::calibrate::Calibration;
+use crate::experiment::code::Code;
 use crate::experiment::config::{Study, WeakRule};
 use crate::experiment::results::{Metadata, ResultsFile};
 use crate::fit::{
@@ -304,9 +305,16 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
             .map(|f| f.points.clone())
             .unwrap_or_default(),
     };
-    let timed_serial = s.points.iter().find(|p| p.p() == 1).and_then(|one| {
+    // An external program has no phase timers: no timed serial fraction.
+    let kernel = s.key.kernel.kernel();
+    let one = s
+        .points
+        .iter()
+        .find(|p| p.p() == 1)
+        .filter(|_| kernel.is_some());
+    let timed_serial = one.and_then(|one| {
         let ph = &one.phases;
-        let (serial, parallel) = if parallel_interaction(s.key.kernel) {
+        let (serial, parallel) = if kernel.is_some_and(parallel_interaction) {
             (
                 vec![ph.force_build, ph.integrate, ph.boundary, ph.output],
                 vec![ph.force_interact],
@@ -340,12 +348,17 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
     }
 }
 
-/// The cost model a kernel's work per worker is held constant under.
-fn cost_class(kernel: KernelKind) -> ComplexityClass {
-    match kernel {
-        KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => ComplexityClass::N2,
-        KernelKind::CellList | KernelKind::Verlet => ComplexityClass::N,
-        KernelKind::Octree => ComplexityClass::NLogN,
+/// The cost model a kernel's work per worker is held constant under; for an external
+/// program, the one of the weak rule its config names (linear or sqrt).
+fn cost_class(kernel: &Code, rule: Option<WeakRule>) -> ComplexityClass {
+    match (kernel.kernel(), rule) {
+        (Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread), _) => {
+            ComplexityClass::N2
+        }
+        (Some(KernelKind::CellList | KernelKind::Verlet), _) => ComplexityClass::N,
+        (Some(KernelKind::Octree), _) => ComplexityClass::NLogN,
+        (None, Some(WeakRule::Sqrt)) => ComplexityClass::N2,
+        (None, _) => ComplexityClass::N,
     }
 }
 
@@ -356,8 +369,8 @@ fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
         .filter(|p| !p.oversubscribed)
         .cloned()
         .collect();
-    let fit = Fitted::of(fit_weak_points(&real, s.key.kernel, rule));
-    let measured = match fit_weak_points(&s.points, s.key.kernel, rule) {
+    let fit = Fitted::of(fit_weak_points(&real, &s.key.kernel, rule));
+    let measured = match fit_weak_points(&s.points, &s.key.kernel, rule) {
         Ok(f) => f.efficiency,
         Err(_) => fit
             .fit
@@ -377,7 +390,7 @@ fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
 
 fn fit_weak_points(
     points: &[Point],
-    kernel: KernelKind,
+    kernel: &Code,
     rule: Option<WeakRule>,
 ) -> Result<WeakFit, fit::FitError> {
     if rule == Some(WeakRule::Time) {
@@ -397,7 +410,7 @@ fn fit_weak_points(
                 }),
             }
         }
-        fit::fit_weak_with_n(&data, cost_class(kernel), fit::DEFAULT_SEED)
+        fit::fit_weak_with_n(&data, cost_class(kernel, rule), fit::DEFAULT_SEED)
     }
 }
 

@@ -51,6 +51,9 @@ pub enum Command {
     /// kernel: same particles, same positions and velocities to rounding (exit 1 if not; needs
     /// the `mpi` feature; run under mpirun).
     MpiCheck(MpiCheckArgs),
+    /// Write a scenario's initial state for another code: a LAMMPS data file (reduced units),
+    /// or a text / .npy table of positions, velocities, masses and strengths.
+    Export(super::export::ExportArgs),
 }
 
 #[derive(Debug, Args)]

@@ -29,7 +29,7 @@ pub fn before_sweep(
     }
     let exists = path.is_some_and(Path::exists);
     let refused = (exists && args.resume.is_none() && !args.fresh)
-        || (config.mpi.is_some() && !cfg!(feature = "mpi"));
+        || (config.mpi.is_some() && !config.kernels.is_empty() && !cfg!(feature = "mpi"));
     if !args.dry_run && refused {
         // The runner refuses this sweep with its own message; no need to estimate it.
         return Ok(None);
@@ -146,6 +146,32 @@ fn print_plan(
             WallTime(c.wall_s)
         );
     }
+    let external: Vec<_> = cases(config)
+        .into_iter()
+        .filter(|c| c.kernel.is_external())
+        .collect();
+    for c in &external {
+        outln!(
+            "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
+            c.key(),
+            c.n,
+            c.threads,
+            c.ranks,
+            c.theta.map_or("-".to_string(), |t| t.to_string()),
+            m.rounds,
+            m.samples,
+            "-",
+            "external"
+        );
+    }
+    if !external.is_empty() {
+        outln!(
+            "\n{} external case{} not in the estimate: each sample runs the program once, for as \
+             long as it takes (up to its timeout_s)",
+            external.len(),
+            if external.len() == 1 { " is" } else { "s are" }
+        );
+    }
     let cases_s = est.total_s - est.calibration_s;
     outln!(
         "\nprobe took {:.2} s ({} kernel set-up{} on one thread at n <= {PROBE_MAX_N}, scaled to \
@@ -207,7 +233,7 @@ pub fn refuse_long_run(
     }
     let case = nbody_bench::experiment::plan::Case {
         scenario: setup.scenario,
-        kernel,
+        kernel: kernel.into(),
         n,
         threads: kernel_args.threads,
         ranks: 1,

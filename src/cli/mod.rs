@@ -6,6 +6,7 @@ pub mod args;
 
 mod analyze;
 mod dry_run;
+mod export;
 mod fit;
 mod fit_tables;
 mod gate;
@@ -34,6 +35,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Gate(args) => gate::gate(args),
         Command::MpiBench(args) => mpi::bench(args),
         Command::MpiCheck(args) => mpi::check(args),
+        Command::Export(args) => export::export(args),
     }
 }
 

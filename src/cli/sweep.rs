@@ -42,6 +42,11 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         run_dir,
         calibrate: !args.no_calibration,
         stop_after: None,
+        config_dir: config_path
+            .parent()
+            .filter(|p| !p.as_os_str().is_empty())
+            .map(Path::to_path_buf),
+        nbody_bench: None,
     };
     let mut observer = progress::for_stderr();
     let report = run_sweep(

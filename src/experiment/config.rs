@@ -156,6 +156,8 @@ pub struct SweepConfig {
     pub name: String,
     pub study: Study,
     pub scenarios: Vec<ScenarioKind>,
+    /// Built-in kernels (may be empty when `external` lists programs).
+    #[serde(default)]
     pub kernels: Vec<KernelKind>,
     /// Particle counts (not used by weak studies, which use `weak.base_n`).
     #[serde(default)]
@@ -183,6 +185,10 @@ pub struct SweepConfig {
     /// Run every case under an MPI launcher (`mpirun -n R nbody-bench run --decomp ...`).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mpi: Option<MpiLaunch>,
+    /// Other programs measured as cases of the sweep (`[[external]]`); a config that lists
+    /// one runs it, so a config is code.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub external: Vec<super::external::External>,
 }
 
 /// How a sweep starts MPI cases (the `[mpi]` table). Each round of a case is one launch; its
@@ -312,15 +318,21 @@ impl SweepConfig {
                 "is empty; list at least one of lj-box, lj-liquid, coulomb, galaxy".into(),
             ));
         }
-        if self.kernels.is_empty() {
+        if self.kernels.is_empty() && self.external.is_empty() {
             return Err(bad(
                 "kernels",
-                "is empty; list at least one of naive, symmetric, per-thread, cell-list, octree"
+                "is empty; list at least one of naive, symmetric, per-thread, cell-list, octree, \
+                 verlet, or declare an [[external]] program"
                     .into(),
             ));
         }
+        self.validate_external(path)?;
         for &s in &self.scenarios {
-            if !self.kernels.iter().any(|k| k.supports(s.law())) {
+            let external = self
+                .external
+                .iter()
+                .any(|e| e.scenarios.as_ref().is_none_or(|list| list.contains(&s)));
+            if !external && !self.kernels.iter().any(|k| k.supports(s.law())) {
                 return Err(bad(
                     "kernels",
                     format!(
@@ -444,6 +456,25 @@ impl SweepConfig {
 }
 
 impl SweepConfig {
+    fn validate_external(&self, path: &Path) -> Result<(), ConfigError> {
+        let around = super::external::config::Around {
+            threads: &self.threads,
+            mpi_ranks: self.mpi.as_ref().map(|m| m.ranks.as_slice()),
+            strong: self.study == Study::Strong,
+            weak_cost_model: self
+                .weak
+                .as_ref()
+                .is_some_and(|w| w.rule == WeakRule::CostModel),
+        };
+        super::external::config::validate_entries(&self.external, &around).map_err(
+            |(key, problem)| ConfigError::Invalid {
+                path: path.into(),
+                key,
+                problem,
+            },
+        )
+    }
+
     fn validate_mpi(&self, mpi: &MpiLaunch, path: &Path) -> Result<(), ConfigError> {
         let bad = |key: &str, problem: String| ConfigError::Invalid {
             path: path.into(),

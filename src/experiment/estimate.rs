@@ -144,17 +144,20 @@ pub fn estimate(
     calibrate: bool,
     logical_cpus: usize,
 ) -> Estimate {
+    // Only the built-in kernels are probed: an external program's time is its own.
     let cases: Vec<CaseEstimate> = probed
         .iter()
-        .map(|(case, probe)| {
+        .filter_map(|(case, probe)| {
+            let kernel = case.kernel.kernel()?;
             let first = done.rounds.get(&case.key()).copied().unwrap_or(0);
-            case_estimate(
+            Some(case_estimate(
                 config,
                 case,
-                &probe.at(case.kernel, case.n),
+                kernel,
+                &probe.at(kernel, case.n),
                 first,
                 logical_cpus,
-            )
+            ))
         })
         .collect();
     let mut threads: Vec<usize> = probed.iter().map(|(c, _)| c.threads).collect();
@@ -186,19 +189,14 @@ pub fn calibration_s(thread_counts: usize) -> f64 {
 fn case_estimate(
     config: &SweepConfig,
     case: &Case,
+    kernel: KernelKind,
     at_n: &Probe,
     first: usize,
     logical_cpus: usize,
 ) -> CaseEstimate {
     let m = &config.measure;
     let ranks = if config.mpi.is_some() { case.ranks } else { 1 };
-    let sp = speedup(
-        case.kernel,
-        case.threads,
-        ranks,
-        at_n.pair_checks,
-        logical_cpus,
-    );
+    let sp = speedup(kernel, case.threads, ranks, at_n.pair_checks, logical_cpus);
     let (step_s, energy_s) = match config.mpi {
         // Every rank integrates its own particles too.
         Some(_) => ((at_n.force_s + at_n.other_s) / sp, at_n.energy_s / sp),
@@ -299,11 +297,11 @@ pub fn probe(config: &SweepConfig, cases: &[Case]) -> Result<Probed, ProbeError>
 /// system's build and energy probes, then the steps, threads counted as in [`speedup`].
 pub fn run_seconds(case: &Case, steps: u64, logical_cpus: usize) -> Result<f64, ProbeError> {
     let probed = probe_with_error_sample(0, std::slice::from_ref(case))?;
-    let Some((_, probe)) = probed.cases.first() else {
+    let (Some((_, probe)), Some(kernel)) = (probed.cases.first(), case.kernel.kernel()) else {
         return Ok(0.0);
     };
-    let at_n = probe.at(case.kernel, case.n);
-    let sp = speedup(case.kernel, case.threads, 1, at_n.pair_checks, logical_cpus);
+    let at_n = probe.at(kernel, case.n);
+    let sp = speedup(kernel, case.threads, 1, at_n.pair_checks, logical_cpus);
     let step_s = at_n.force_s / sp + at_n.other_s;
     Ok(probed.seconds + at_n.build_s + 2.0 * at_n.energy_s / sp + steps as f64 * step_s)
 }
@@ -316,9 +314,15 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         Option<u64>,
         Multipole,
     );
+    // External programs are not probed (`None`).
     let key = |c: &Case| {
-        let theta = c.theta.map(f64::to_bits);
-        (c.scenario, c.kernel, c.precision, theta, c.multipole)
+        Some((
+            c.scenario,
+            c.kernel.kernel()?,
+            c.precision,
+            c.theta.map(f64::to_bits),
+            c.multipole,
+        ))
     };
     let started = Instant::now();
     let pool = rayon::ThreadPoolBuilder::new()
@@ -327,10 +331,13 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         .map_err(ProbeError::Pool)?;
     let mut probes: Vec<(Key, Probe)> = Vec::new();
     for case in cases {
-        if probes.iter().any(|(k, _)| *k == key(case)) {
+        let Some(this) = key(case) else {
+            continue;
+        };
+        if probes.iter().any(|(k, _)| *k == this) {
             continue;
         }
-        let same = cases.iter().filter(|c| key(c) == key(case));
+        let same = cases.iter().filter(|c| key(c) == Some(this));
         let n = same.map(|c| c.n).max().unwrap_or(case.n).min(PROBE_MAX_N);
         let what = format!("{}/{}", case.scenario.name(), case.kernel.name());
         let mut setup = Setup::new(case.scenario);
@@ -338,7 +345,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         setup.seed = case.seed;
         setup.precision = case.precision;
         let job = ProbeJob {
-            kernel: case.kernel,
+            kernel: this.1,
             theta: case.theta,
             multipole: case.multipole,
             error_sample,
@@ -352,12 +359,13 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
                 source,
             })?
             .map_err(|source| ProbeError::Run { what, n, source })?;
-        probes.push((key(case), probe));
+        probes.push((this, probe));
     }
     let cases = cases
         .iter()
         .filter_map(|c| {
-            let (_, p) = probes.iter().find(|(k, _)| *k == key(c))?;
+            let this = key(c)?;
+            let (_, p) = probes.iter().find(|(k, _)| *k == this)?;
             Some((c.clone(), *p))
         })
         .collect();

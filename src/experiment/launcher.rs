@@ -149,6 +149,7 @@ pub fn round_from_json(text: &str, samples: usize, warmup: u64) -> Result<RoundO
         // work are measured by in-process sweeps only.
         reference_s: Vec::new(),
         initial_work: None,
+        external: None,
     })
 }
 

@@ -66,11 +66,17 @@ pub struct RoundOutcome {
     /// Ranks, decomposition and per-rank statistics of a case run under an MPI launcher.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub mpi: Option<crate::decomp::stats::MpiReport>,
+    /// Every run of an external program (`[[external]]`) with its times or its error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub external: Option<super::external::ExternalRound>,
 }
 
 /// Measures a round of `case` on the system it is given.
 pub struct MeasureJob<'a, C: Clock> {
     pub case: &'a Case,
+    /// The case's kernel (a built-in one: external programs are measured by
+    /// `experiment::external`).
+    pub kernel: crate::kernels::KernelKind,
     pub spec: &'a RoundSpec,
     pub clock: &'a C,
 }
@@ -87,7 +93,7 @@ impl<C: Clock> SystemJob for MeasureJob<'_, C> {
         let law = system.law;
         let kernel = TestSlowdown::apply(
             self.spec.slowdown,
-            self.case.kernel.build::<T, L, D>(law, &params)?,
+            self.kernel.build::<T, L, D>(law, &params)?,
         );
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.case.threads)
@@ -179,5 +185,6 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         reference_s: reference,
         initial_work: Some(initial_work),
         mpi: None,
+        external: None,
     })
 }

@@ -1,8 +1,10 @@
 //! The experiment runner: sweep configs → planned cases → measured rounds → results file.
 
+pub mod code;
 pub mod config;
 pub mod config_keys;
 pub mod estimate;
+pub mod external;
 pub mod launcher;
 pub mod locate;
 pub mod measure;

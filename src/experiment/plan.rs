@@ -1,5 +1,6 @@
 //! Expands a sweep config into the list of cases to measure.
 
+use super::code::Code;
 use super::config::{Study, SweepConfig, WeakRule};
 use crate::decomp::Decomposition;
 use crate::kernels::{KernelKind, Multipole};
@@ -10,7 +11,8 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Case {
     pub scenario: ScenarioKind,
-    pub kernel: KernelKind,
+    /// A built-in kernel or an external program, by name.
+    pub kernel: Code,
     pub n: usize,
     pub threads: usize,
     /// MPI ranks (1 without MPI).
@@ -67,9 +69,11 @@ pub fn is_monopole(m: &Multipole) -> bool {
     *m == Multipole::Monopole
 }
 
-/// The cases of a config, in a fixed order: scenario, kernel, n, threads, seed, θ, multipole.
+/// The cases of a config, in a fixed order: the externals' first, then per scenario, kernel,
+/// n, threads, seed, θ, multipole.
 pub fn cases(config: &SweepConfig) -> Vec<Case> {
     let mut out = Vec::new();
+    external_cases(config, &mut out);
     for &scenario in &config.scenarios {
         for &kernel in config.kernels.iter().filter(|k| k.supports(scenario.law())) {
             let (thetas, orders): (Vec<Option<f64>>, Vec<Multipole>) =
@@ -103,15 +107,10 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
             {
                 let workers = threads * ranks;
                 let sizes: Vec<(usize, u64)> = match (&config.study, &config.weak) {
-                    (Study::Weak, Some(w)) => vec![weak_size(kernel, w.rule, w.base_n, workers)],
-                    _ => config
-                        .n
-                        .as_ref()
-                        .map(|n| n.values())
-                        .unwrap_or_default()
-                        .into_iter()
-                        .map(|n| (n, 1))
-                        .collect(),
+                    (Study::Weak, Some(w)) => {
+                        vec![weak_size(Some(kernel), w.rule, w.base_n, workers)]
+                    }
+                    _ => fixed_sizes(config),
                 };
                 for (n, time_factor) in sizes {
                     for &seed in &config.seeds {
@@ -119,7 +118,7 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                             for &multipole in &orders {
                                 out.push(Case {
                                     scenario,
-                                    kernel,
+                                    kernel: Code::Kernel(kernel),
                                     n,
                                     threads,
                                     ranks,
@@ -141,7 +140,7 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
         let decomp = c.decomp.map_or(0, |d| d as u8 + 1);
         (
             c.scenario as u8,
-            c.kernel as u8,
+            c.kernel.order(),
             decomp,
             c.n,
             c.threads,
@@ -152,9 +151,74 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
     out
 }
 
+/// The n list of a study that is not weak, each with time factor 1.
+fn fixed_sizes(config: &SweepConfig) -> Vec<(usize, u64)> {
+    config
+        .n
+        .as_ref()
+        .map(|n| n.values())
+        .unwrap_or_default()
+        .into_iter()
+        .map(|n| (n, 1))
+        .collect()
+}
+
+/// The cases of the `[[external]]` entries: each scenario, thread count, rank count, n and
+/// seed, and each θ when the program is told θ.
+fn external_cases(config: &SweepConfig, out: &mut Vec<Case>) {
+    for ext in &config.external {
+        let scenarios = ext.scenarios.clone().unwrap_or(config.scenarios.clone());
+        let threads = ext.threads.clone().unwrap_or(config.threads.clone());
+        let ranks = ext.ranks.clone().unwrap_or_else(|| match &config.mpi {
+            Some(m) => m.ranks.clone(),
+            None => vec![1],
+        });
+        let thetas: Vec<Option<f64>> = if ext.uses("theta") {
+            config.theta.iter().map(|&t| Some(t)).collect()
+        } else {
+            vec![None]
+        };
+        for &scenario in &scenarios {
+            for &t in &threads {
+                for &r in &ranks {
+                    let sizes = match (&config.study, &config.weak) {
+                        (Study::Weak, Some(w)) => vec![weak_size(None, w.rule, w.base_n, t * r)],
+                        _ => fixed_sizes(config),
+                    };
+                    for &(n, time_factor) in &sizes {
+                        for &seed in &config.seeds {
+                            for &theta in &thetas {
+                                out.push(Case {
+                                    scenario,
+                                    kernel: Code::External(ext.name.clone()),
+                                    n,
+                                    threads: t,
+                                    ranks: r,
+                                    theta,
+                                    multipole: Multipole::Monopole,
+                                    seed,
+                                    precision: config.precision,
+                                    time_factor,
+                                    decomp: None,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// n (and simulated-time factor) at `p` threads so that the work per thread stays that of
-/// `base_n` on one thread.
-pub fn weak_size(kernel: KernelKind, rule: WeakRule, base_n: usize, p: usize) -> (usize, u64) {
+/// `base_n` on one thread. An external program (`None`) has no known cost model: its config
+/// names a rule (validation refuses `cost-model` for it), and `cost-model` reads as linear.
+pub fn weak_size(
+    kernel: Option<KernelKind>,
+    rule: WeakRule,
+    base_n: usize,
+    p: usize,
+) -> (usize, u64) {
     let pf = p as f64;
     let b = base_n as f64;
     let n = match rule {
@@ -162,9 +226,11 @@ pub fn weak_size(kernel: KernelKind, rule: WeakRule, base_n: usize, p: usize) ->
         WeakRule::Linear => b * pf,
         WeakRule::Sqrt => b * pf.sqrt(),
         WeakRule::CostModel => match kernel {
-            KernelKind::CellList | KernelKind::Verlet => b * pf,
-            KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => b * pf.sqrt(),
-            KernelKind::Octree => solve_n_log_n(pf * b * b.max(2.0).ln()),
+            None | Some(KernelKind::CellList | KernelKind::Verlet) => b * pf,
+            Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread) => {
+                b * pf.sqrt()
+            }
+            Some(KernelKind::Octree) => solve_n_log_n(pf * b * b.max(2.0).ln()),
         },
     };
     (n.round().max(1.0) as usize, 1)
@@ -188,18 +254,18 @@ mod tests {
     #[test]
     fn weak_sizes_follow_the_cost_model() {
         assert_eq!(
-            weak_size(KernelKind::CellList, WeakRule::CostModel, 1000, 4),
+            weak_size(Some(KernelKind::CellList), WeakRule::CostModel, 1000, 4),
             (4000, 1)
         );
         assert_eq!(
-            weak_size(KernelKind::Naive, WeakRule::CostModel, 1000, 4),
+            weak_size(Some(KernelKind::Naive), WeakRule::CostModel, 1000, 4),
             (2000, 1)
         );
         assert_eq!(
-            weak_size(KernelKind::Naive, WeakRule::Time, 1000, 4),
+            weak_size(Some(KernelKind::Naive), WeakRule::Time, 1000, 4),
             (1000, 4)
         );
-        let (n, _) = weak_size(KernelKind::Octree, WeakRule::CostModel, 10_000, 2);
+        let (n, _) = weak_size(Some(KernelKind::Octree), WeakRule::CostModel, 10_000, 2);
         let w = |n: f64| n * n.ln();
         assert!((w(n as f64) / w(10_000.0) - 2.0).abs() < 1e-3, "{n}");
         assert!(n > 18_000 && n < 20_000);

@@ -72,6 +72,9 @@ pub struct Metadata {
     /// such timings are deliberately wrong.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub test_slowdown: Option<String>,
+    /// The version line of each external program of the config (`[[external]]`).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub externals: Vec<super::external::ExternalVersion>,
 }
 
 /// One case: what it is, every raw value, and summaries recomputed from them.
@@ -269,7 +272,13 @@ impl CaseRecord {
             ci95_s: bootstrap_median_ci(&samples, BOOTSTRAP_RESAMPLES, 0x5eed)
                 .unwrap_or([med, med]),
             mad_s: mad(&samples).unwrap_or(0.0),
-            min_s: samples.iter().copied().fold(f64::INFINITY, f64::min),
+            // A round can hold no sample (an external program whose every run failed); JSON
+            // has no infinity.
+            min_s: if samples.is_empty() {
+                0.0
+            } else {
+                samples.iter().copied().fold(f64::INFINITY, f64::min)
+            },
             mean_s: samples.iter().sum::<f64>() / samples.len().max(1) as f64,
             samples: samples.len(),
             step_ns: hist.percentiles().unwrap_or_default(),
@@ -332,6 +341,7 @@ impl Metadata {
             os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
             started: utc_now(),
             test_slowdown: None,
+            externals: Vec::new(),
         }
     }
 }

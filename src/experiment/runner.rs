@@ -1,6 +1,7 @@
 //! Runs a sweep: plans the cases, measures them in interleaved rounds, saves the results
 //! file after every round of every case, and resumes an interrupted sweep.
 
+use super::code::Code;
 use super::config::SweepConfig;
 use super::measure::{MeasureJob, RoundSpec};
 use super::plan::{Case, cases};
@@ -28,6 +29,10 @@ pub struct SweepOptions {
     pub calibrate: bool,
     /// Stop after this many measured rounds, as if interrupted (tests).
     pub stop_after: Option<usize>,
+    /// `{config_dir}` of external commands [default: the current directory].
+    pub config_dir: Option<PathBuf>,
+    /// `{nbody_bench}` of external commands [default: this program].
+    pub nbody_bench: Option<PathBuf>,
 }
 
 /// Follows a sweep's progress (terminal bar, log lines, or nothing).
@@ -73,6 +78,10 @@ pub enum SweepError {
         crate::decomp::WITHOUT_MPI
     )]
     WithoutMpi { config: String },
+    #[error(transparent)]
+    External(#[from] super::external::ExternalError),
+    #[error("cannot find this program for {{nbody_bench}}: {0}")]
+    Exe(std::io::Error),
     #[error("cannot create {path}: {source}")]
     Dir {
         path: PathBuf,
@@ -104,7 +113,7 @@ pub fn run_sweep<C: Clock>(
     clock: &C,
     observer: &mut dyn Observer,
 ) -> Result<SweepReport, SweepError> {
-    if config.mpi.is_some() && !cfg!(feature = "mpi") {
+    if config.mpi.is_some() && !config.kernels.is_empty() && !cfg!(feature = "mpi") {
         // The launcher starts this program, which must have the MPI drivers.
         return Err(SweepError::WithoutMpi {
             config: config.name.clone(),
@@ -124,9 +133,10 @@ pub fn run_sweep<C: Clock>(
         let checked = setup
             .validate()
             .map_err(|e| Box::new(e) as Box<dyn std::error::Error + Send + Sync>)
-            .and_then(|()| {
-                crate::run::check_memory(&setup, case.kernel, case.threads, copies)
-                    .map_err(|e| Box::new(e) as _)
+            .and_then(|()| match case.kernel.kernel() {
+                Some(kernel) => crate::run::check_memory(&setup, kernel, case.threads, copies)
+                    .map_err(|e| Box::new(e) as _),
+                None => Ok(()),
             });
         checked.map_err(|source| SweepError::Case {
             key: case.key(),
@@ -137,6 +147,11 @@ pub fn run_sweep<C: Clock>(
         Some(dir) => dir.join("results.json"),
         None => results_path(config, options.out.as_deref()),
     };
+    let context = external_context(options, &path)?;
+    for ext in &config.external {
+        let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
+        super::external::check_programs(ext, launcher, &context)?;
+    }
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     let mut results = open(config, config_text, options, &path)?;
     if let Some(s) = slowdown {
@@ -184,6 +199,13 @@ pub fn run_sweep<C: Clock>(
         observer.message(&cal.summary());
         results.calibration.start = Some(cal);
     }
+    if results.metadata.externals.is_empty() && !config.external.is_empty() {
+        results.metadata.externals = config
+            .external
+            .iter()
+            .map(|e| super::external::version_line(e, &context))
+            .collect();
+    }
     results.save(&path)?;
 
     let total: usize = results.cases.len() * rounds;
@@ -228,12 +250,14 @@ pub fn run_sweep<C: Clock>(
                 reference_s: config.measure.reference_s,
                 slowdown,
             };
-            let outcome = measure_case(&record.case, &spec, clock, config).map_err(|source| {
-                SweepError::Case {
-                    key: record.key.clone(),
-                    source,
-                }
-            })?;
+            let outcome =
+                measure_case(&record.case, &spec, clock, config, &context).map_err(|source| {
+                    SweepError::Case {
+                        key: record.key.clone(),
+                        source,
+                    }
+                })?;
+            report_external(&record.key, &outcome, observer);
             let record = &mut results.cases[i];
             record.add_round(outcome, config.measure.max_energy_drift);
             results.save(&path)?;
@@ -265,11 +289,82 @@ fn measure_case<C: Clock>(
     spec: &RoundSpec,
     clock: &C,
     config: &SweepConfig,
+    context: &super::external::Context,
 ) -> Result<super::measure::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
+    let kernel = match &case.kernel {
+        Code::Kernel(k) => *k,
+        Code::External(name) => {
+            let ext = config
+                .external
+                .iter()
+                .find(|e| &e.name == name)
+                .ok_or_else(|| format!("the config has no [[external]] entry named `{name}`"))?;
+            return Ok(super::external::run::measure_round(
+                ext,
+                case,
+                spec,
+                config.mpi.as_ref(),
+                context,
+            )?);
+        }
+    };
     if let Some(launch) = &config.mpi {
         return Ok(super::launcher::measure_round(launch, case, spec)?);
     }
-    Ok(case_setup(case).dispatch(MeasureJob { case, spec, clock })??)
+    Ok(case_setup(case).dispatch(MeasureJob {
+        case,
+        kernel,
+        spec,
+        clock,
+    })??)
+}
+
+/// Where external programs find the sweep; their work directories go next to the results.
+fn external_context(
+    options: &SweepOptions,
+    path: &Path,
+) -> Result<super::external::Context, SweepError> {
+    let nbody_bench = match &options.nbody_bench {
+        Some(p) => p.clone(),
+        None => std::env::current_exe().map_err(SweepError::Exe)?,
+    };
+    let config_dir = options
+        .config_dir
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("."));
+    // Absolute, so that a program started in its work directory finds them.
+    let absolute = |p: PathBuf| std::path::absolute(&p).unwrap_or(p);
+    Ok(super::external::Context {
+        config_dir: absolute(config_dir),
+        nbody_bench: absolute(nbody_bench),
+        work_root: absolute(path.parent().unwrap_or(Path::new(".")).join("work")),
+    })
+}
+
+/// Tells the observer about an external round's failed samples and warnings.
+fn report_external(key: &str, outcome: &super::measure::RoundOutcome, observer: &mut dyn Observer) {
+    let Some(ext) = &outcome.external else {
+        return;
+    };
+    for w in &ext.warnings {
+        observer.message(&format!("warning: {w}"));
+    }
+    let errors = ext.setup_error.iter().map(|e| ("set-up", e)).chain(
+        ext.runs
+            .iter()
+            .filter_map(|r| Some(("sample", r.error.as_ref()?))),
+    );
+    for (what, e) in errors {
+        observer.message(&format!(
+            "error: {key}: {what} `{}` {}{}",
+            e.command,
+            e.what,
+            e.output_tail
+                .last()
+                .map(|l| format!("; last line: {l}"))
+                .unwrap_or_default()
+        ));
+    }
 }
 
 /// The system a case measures.

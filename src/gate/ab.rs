@@ -228,7 +228,24 @@ fn one_case_config(
     t.remove("weak");
     t.remove("out");
     t.insert("scenarios".into(), list(case.scenario.name().into()));
-    t.insert("kernels".into(), list(case.kernel.name().into()));
+    match &case.kernel {
+        crate::experiment::code::Code::Kernel(k) => {
+            t.insert("kernels".into(), list(k.name().into()));
+            t.remove("external");
+        }
+        crate::experiment::code::Code::External(name) => {
+            // The one `[[external]]` entry of the case, narrowed to its threads and ranks.
+            t.insert("kernels".into(), toml::Value::Array(Vec::new()));
+            if let Some(toml::Value::Array(entries)) = t.get_mut("external") {
+                entries.retain(|e| e.get("name").and_then(|n| n.as_str()) == Some(name));
+                for e in entries.iter_mut().filter_map(toml::Value::as_table_mut) {
+                    e.insert("threads".into(), list((case.threads as i64).into()));
+                    e.insert("ranks".into(), list((case.ranks as i64).into()));
+                    e.remove("scenarios");
+                }
+            }
+        }
+    }
     t.insert("n".into(), list((case.n as i64).into()));
     t.insert("threads".into(), list((case.threads as i64).into()));
     t.insert("seeds".into(), list((case.seed as i64).into()));

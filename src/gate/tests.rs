@@ -81,6 +81,7 @@ fn metadata() -> Metadata {
         os: "linux x86_64".into(),
         started: "2026-11-22T00:00:00Z".into(),
         test_slowdown: None,
+        externals: Vec::new(),
     }
 }
 
@@ -119,6 +120,7 @@ fn results(run: Run) -> ResultsFile {
                     ..Default::default()
                 }),
                 mpi: None,
+                external: None,
             };
             record.add_round(round, 0.05);
         }

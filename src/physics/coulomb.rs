@@ -26,6 +26,12 @@ impl<T: Real> PairLaw<T> for Coulomb<T> {
         Coulomb::new(self.quench)
     }
 
+    fn parameters(&self) -> super::LawParameters {
+        super::LawParameters::Coulomb {
+            quench: self.quench,
+        }
+    }
+
     fn kind(&self) -> LawKind {
         LawKind::Coulomb
     }

@@ -28,6 +28,13 @@ impl<T: Real> PairLaw<T> for Gravity<T> {
         Gravity::new(self.params.0, self.params.1)
     }
 
+    fn parameters(&self) -> super::LawParameters {
+        super::LawParameters::Gravity {
+            g: self.params.0,
+            softening: self.params.1,
+        }
+    }
+
     fn kind(&self) -> LawKind {
         LawKind::Gravity
     }

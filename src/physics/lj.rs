@@ -41,6 +41,11 @@ impl<T: Real> PairLaw<T> for LennardJones<T> {
         LennardJones::new(e, s, rc)
     }
 
+    fn parameters(&self) -> super::LawParameters {
+        let (epsilon, sigma, rc) = self.params;
+        super::LawParameters::LennardJones { epsilon, sigma, rc }
+    }
+
     fn kind(&self) -> LawKind {
         LawKind::LennardJones
     }

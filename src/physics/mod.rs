@@ -56,6 +56,40 @@ impl LawKind {
     }
 }
 
+/// A law's parameters as given, so that another code can recompute every force (export
+/// and dump headers: `law lennard-jones epsilon 1 sigma 0.01 rc 0.025`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "law", rename_all = "kebab-case")]
+pub enum LawParameters {
+    /// Force truncated at `rc`, not shifted.
+    LennardJones { epsilon: f64, sigma: f64, rc: f64 },
+    /// Force zeroed below `quench`.
+    Coulomb { quench: f64 },
+    /// Plummer softening.
+    Gravity { g: f64, softening: f64 },
+}
+
+impl std::fmt::Display for LawParameters {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            LawParameters::LennardJones { epsilon, sigma, rc } => write!(
+                f,
+                "law lennard-jones epsilon {epsilon} sigma {sigma} rc {rc} force truncated"
+            ),
+            LawParameters::Coulomb { quench } => {
+                write!(
+                    f,
+                    "law coulomb quench {quench} force q_i q_j (x_i - x_j) / r^3"
+                )
+            }
+            LawParameters::Gravity { g, softening } => write!(
+                f,
+                "law gravity G {g} softening {softening} force G m_i m_j (x_j - x_i) / (r^2 + softening^2)^1.5"
+            ),
+        }
+    }
+}
+
 /// A central pair interaction.
 ///
 /// The force on particle `i` from particle `j` is `coeff(r², s_i, s_j) · (x_j − x_i)`, where
@@ -66,6 +100,9 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     type Wide: PairLaw<f64>;
 
     fn kind(&self) -> LawKind;
+
+    /// The parameters the law was made with.
+    fn parameters(&self) -> LawParameters;
 
     /// The same law with the same parameters in f64.
     fn widen(&self) -> Self::Wide;

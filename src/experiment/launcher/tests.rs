@@ -19,7 +19,7 @@ fn launch() -> MpiLaunch {
 fn case() -> Case {
     Case {
         scenario: ScenarioKind::LjBox,
-        kernel: KernelKind::CellList,
+        kernel: KernelKind::CellList.into(),
         n: 2000,
         threads: 1,
         ranks: 4,

@@ -1,0 +1,330 @@
+//! The `[[external]]` entries of a sweep config: another program measured next to (or instead
+//! of) the built-in kernels. A config that declares one runs that program: it is code.
+
+use super::placeholders::{self, CASE_PLACEHOLDERS, SWEEP_PLACEHOLDERS};
+use crate::scenario::ScenarioKind;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// One external program.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct External {
+    /// The kernel name of its cases (case keys, tables, plots).
+    pub name: String,
+    /// The program and its arguments, each token with placeholders; never a shell string.
+    pub command: Vec<String>,
+    /// Run (untimed) before each round's samples, e.g. to write the initial state.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub setup: Vec<String>,
+    /// Time steps of one run: a sample's time per step is its time divided by this.
+    pub steps: u64,
+    /// How a run is timed: `"wall"` or `{ regex, unit }` on its output.
+    pub time: TimeSource,
+    /// A regular expression the output must match, else the sample is an error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub check: Option<String>,
+    /// A regular expression whose groups are the median (and optionally the largest)
+    /// relative force error the program reports, kept like the built-in kernels' force error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_error: Option<String>,
+    /// Environment variables set for the program (values with placeholders).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub env: BTreeMap<String, String>,
+    /// A command whose first line of output names the program's version (results metadata).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub version: Vec<String>,
+    /// The empty run whose wall time is the launch overhead of wall timing [default: `true`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub empty: Vec<String>,
+    /// A run taking longer is killed and recorded as an error.
+    #[serde(default = "default_timeout")]
+    pub timeout_s: f64,
+    /// Untimed runs before each round's samples.
+    #[serde(default)]
+    pub warmup_runs: usize,
+    /// Scenarios its cases stand for [default: the config's].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scenarios: Option<Vec<ScenarioKind>>,
+    /// Thread counts [default: the config's].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threads: Option<Vec<usize>>,
+    /// Rank counts [default: the `[mpi]` table's, else 1].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ranks: Option<Vec<usize>>,
+}
+
+fn default_timeout() -> f64 {
+    600.0
+}
+
+/// How an external run is timed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum TimeSource {
+    /// The wall time of the whole process, from start to exit.
+    Wall(WallTag),
+    /// The number the program prints, found by a regular expression's first group.
+    Regex(TimeRegex),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum WallTag {
+    Wall,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeRegex {
+    pub regex: String,
+    pub unit: TimeUnit,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum TimeUnit {
+    S,
+    Ms,
+    Us,
+    Ns,
+}
+
+impl TimeUnit {
+    pub fn seconds(self) -> f64 {
+        match self {
+            TimeUnit::S => 1.0,
+            TimeUnit::Ms => 1e-3,
+            TimeUnit::Us => 1e-6,
+            TimeUnit::Ns => 1e-9,
+        }
+    }
+}
+
+pub const TIME_FORMS: &str =
+    "\"wall\" or { regex = '...([0-9.eE+-]+)...', unit = \"s\" | \"ms\" | \"us\" | \"ns\" }";
+
+impl<'de> Deserialize<'de> for TimeSource {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Form {
+            Wall(WallTag),
+            Regex(TimeRegex),
+        }
+        match Form::deserialize(d) {
+            Ok(Form::Wall(w)) => Ok(TimeSource::Wall(w)),
+            Ok(Form::Regex(r)) => Ok(TimeSource::Regex(r)),
+            Err(_) => Err(serde::de::Error::custom(format!("must be {TIME_FORMS}"))),
+        }
+    }
+}
+
+impl External {
+    /// Whether any command or environment value of a case uses `{name}`.
+    pub fn uses(&self, name: &str) -> bool {
+        let needle = format!("{{{name}}}");
+        self.command
+            .iter()
+            .chain(&self.setup)
+            .chain(self.env.values())
+            .any(|t| t.replace("{{", "").contains(&needle))
+    }
+
+    /// Checks everything that can be checked before a run; `(key, problem)` on failure.
+    pub fn validate(&self) -> Result<(), (String, String)> {
+        let key = |k: &str| format!("external.{}.{k}", self.name);
+        let bad = |k: &str, p: String| Err((key(k), p));
+        if self.name.is_empty()
+            || !self
+                .name
+                .chars()
+                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
+        {
+            return Err((
+                "external.name".into(),
+                format!(
+                    "is `{}`: it must be letters, digits, '-', '_' and '.' (it names the cases)",
+                    self.name
+                ),
+            ));
+        }
+        if crate::kernels::KernelKind::ALL
+            .iter()
+            .any(|k| k.name() == self.name)
+        {
+            return Err((
+                "external.name".into(),
+                format!(
+                    "`{}` is a built-in kernel's name; choose another",
+                    self.name
+                ),
+            ));
+        }
+        let mut case_known: Vec<&str> = CASE_PLACEHOLDERS.to_vec();
+        case_known.extend(SWEEP_PLACEHOLDERS);
+        for (field, tokens, known) in [
+            ("command", &self.command, &case_known[..]),
+            ("setup", &self.setup, &case_known[..]),
+            ("empty", &self.empty, &case_known[..]),
+            ("version", &self.version, &SWEEP_PLACEHOLDERS[..]),
+        ] {
+            if field == "command" && tokens.is_empty() {
+                return bad(
+                    field,
+                    "must name a program: [\"program\", \"arg\", ...]".into(),
+                );
+            }
+            if tokens.first().is_some_and(|p| p.trim().is_empty()) {
+                return bad(field, "starts with an empty program name".into());
+            }
+            for t in tokens {
+                if let Err(e) = placeholders::check(t, known) {
+                    return bad(field, e.to_string());
+                }
+            }
+        }
+        for (name, value) in &self.env {
+            if name.is_empty() || name.contains('=') || name.contains('\0') {
+                return bad("env", format!("has an invalid variable name `{name}`"));
+            }
+            if let Err(e) = placeholders::check(value, &case_known) {
+                return bad(&format!("env.{name}"), e.to_string());
+            }
+        }
+        if self.steps == 0 {
+            return bad("steps", "must be at least 1".into());
+        }
+        if !(self.timeout_s.is_finite() && self.timeout_s > 0.0) {
+            return bad("timeout_s", "must be a finite number of seconds > 0".into());
+        }
+        if let TimeSource::Regex(t) = &self.time {
+            match regex::Regex::new(&t.regex) {
+                Err(e) => return bad("time.regex", format!("is not a regular expression: {e}")),
+                Ok(r) if r.captures_len() < 2 => {
+                    return bad(
+                        "time.regex",
+                        "needs a group around the number, e.g. 'Loop time of ([0-9.eE+-]+)'".into(),
+                    );
+                }
+                Ok(_) => {}
+            }
+        }
+        if let Some(c) = &self.check
+            && let Err(e) = regex::Regex::new(c)
+        {
+            return bad("check", format!("is not a regular expression: {e}"));
+        }
+        if let Some(f) = &self.force_error {
+            match regex::Regex::new(f) {
+                Err(e) => return bad("force_error", format!("is not a regular expression: {e}")),
+                Ok(r) if !(2..=3).contains(&r.captures_len()) => {
+                    return bad(
+                        "force_error",
+                        "needs one group (the median error) or two (median and largest)".into(),
+                    );
+                }
+                Ok(_) => {}
+            }
+        }
+        if let Some(t) = &self.threads
+            && (t.is_empty() || t.iter().any(|&t| t == 0 || t > crate::run::MAX_THREADS))
+        {
+            return bad(
+                "threads",
+                format!(
+                    "must be a non-empty list of thread counts from 1 to {}",
+                    crate::run::MAX_THREADS
+                ),
+            );
+        }
+        if let Some(r) = &self.ranks
+            && (r.is_empty() || r.contains(&0))
+        {
+            return bad(
+                "ranks",
+                "must be a non-empty list of rank counts >= 1".into(),
+            );
+        }
+        if self.scenarios.as_ref().is_some_and(Vec::is_empty) {
+            return bad(
+                "scenarios",
+                "is empty; leave it out to use the config's".into(),
+            );
+        }
+        Ok(())
+    }
+
+    /// Checks that cases differing in threads or ranks differ in what the program is told.
+    pub fn check_told(
+        &self,
+        threads: &[usize],
+        ranks: &[usize],
+        mpi: bool,
+    ) -> Result<(), (String, String)> {
+        let key = |k: &str| format!("external.{}.{k}", self.name);
+        if threads.iter().any(|&t| t != 1) && !self.uses("threads") {
+            return Err((
+                key("threads"),
+                format!(
+                    "are {threads:?} but neither the command nor env uses {{threads}}: every \
+                     thread count would run the same program (e.g. env = {{ OMP_NUM_THREADS = \"{{threads}}\" }})"
+                ),
+            ));
+        }
+        if ranks.iter().any(|&r| r != 1) && !mpi && !self.uses("ranks") {
+            return Err((
+                key("ranks"),
+                format!(
+                    "are {ranks:?} but there is no [mpi] launcher and the command does not use \
+                     {{ranks}}: add an [mpi] table or start the launcher in the command \
+                     ([\"mpirun\", \"-n\", \"{{ranks}}\", ...])"
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// What the rest of a sweep config says that the `[[external]]` entries depend on.
+pub struct Around<'a> {
+    pub threads: &'a [usize],
+    /// The `[mpi]` table's rank counts, if it has one.
+    pub mpi_ranks: Option<&'a [usize]>,
+    pub strong: bool,
+    /// A weak study whose rule is the kernels' cost model.
+    pub weak_cost_model: bool,
+}
+
+/// Checks the `[[external]]` entries against each other and the rest of the config;
+/// `(key, problem)` on failure.
+pub fn validate_entries(entries: &[External], around: &Around) -> Result<(), (String, String)> {
+    for (i, e) in entries.iter().enumerate() {
+        e.validate()?;
+        if entries[..i].iter().any(|o| o.name == e.name) {
+            return Err((
+                "external.name".into(),
+                format!("`{}` names two [[external]] entries", e.name),
+            ));
+        }
+        let threads = e.threads.as_deref().unwrap_or(around.threads);
+        let ranks = e.ranks.as_deref().or(around.mpi_ranks).unwrap_or(&[1]);
+        e.check_told(threads, ranks, around.mpi_ranks.is_some())?;
+        if around.strong && !(threads.contains(&1) && ranks.contains(&1)) {
+            return Err((
+                format!("external.{}.threads", e.name),
+                "must include 1 thread and 1 rank for a strong-scaling study".into(),
+            ));
+        }
+        if around.weak_cost_model {
+            return Err((
+                "weak.rule".into(),
+                format!(
+                    "is cost-model, which external `{}` has none of; use linear, sqrt or time",
+                    e.name
+                ),
+            ));
+        }
+    }
+    Ok(())
+}

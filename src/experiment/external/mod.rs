@@ -1,0 +1,185 @@
+//! External programs in sweeps (`[[external]]`): their config ([`config`]), the placeholders
+//! of their commands ([`placeholders`]), one process ([`process`]) and one measured round
+//! ([`run`]). Each sample is one run of the program; what it measured, or why it failed, is
+//! kept with the round in the results file.
+
+pub mod config;
+pub mod placeholders;
+pub mod process;
+pub mod run;
+
+pub use config::{External, TimeSource};
+
+use serde::{Deserialize, Serialize};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A launch overhead above this share of a sample's wall time is warned about.
+pub const OVERHEAD_WARN: f64 = 0.05;
+/// The version command is killed after this many seconds.
+const VERSION_TIMEOUT_S: f64 = 30.0;
+
+/// What one round of an external case measured, sample by sample (raw values).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct ExternalRound {
+    /// Every timed run, failed ones included, in order.
+    pub runs: Vec<ExternalRun>,
+    /// Median wall time of the empty run (wall timing only), seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub launch_overhead_s: Option<f64>,
+    /// That overhead over the median successful run's wall time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub overhead_share: Option<f64>,
+    /// The set-up command failed: no sample was taken.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub setup_error: Option<SampleError>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub warnings: Vec<String>,
+}
+
+/// One run of the program.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExternalRun {
+    /// Wall time of the process, seconds.
+    pub wall_s: f64,
+    /// The time it printed (regex timing), seconds.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reported_s: Option<f64>,
+    /// The median (and largest) relative force error it printed.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub force_error: Option<[f64; 2]>,
+    /// Why the run is not a sample.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<SampleError>,
+}
+
+/// A failed run: what went wrong and the program's last lines of output.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SampleError {
+    pub what: String,
+    pub command: String,
+    pub output_tail: Vec<String>,
+}
+
+/// An external's version line, in the results metadata.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExternalVersion {
+    pub name: String,
+    pub version: String,
+}
+
+#[derive(Debug, Error)]
+pub enum ExternalError {
+    #[error(
+        "external `{name}`: program `{program}` not found{where_}; install it (for the peers of \
+         configs/vs-*.toml: scripts/install-peers.sh) or fix `command`"
+    )]
+    NotFound {
+        name: String,
+        program: String,
+        where_: String,
+    },
+    #[error("external `{name}`: {source}")]
+    Placeholder {
+        name: String,
+        source: placeholders::PlaceholderError,
+    },
+    #[error("cannot create the work directory {path}: {source}")]
+    Workdir {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+}
+
+/// Where externals find the sweep: the config's directory and this program.
+#[derive(Clone, Debug)]
+pub struct Context {
+    pub config_dir: PathBuf,
+    pub nbody_bench: PathBuf,
+    /// Case work directories are made under this one.
+    pub work_root: PathBuf,
+}
+
+impl Context {
+    pub fn vars(&self) -> placeholders::Vars {
+        placeholders::Vars::sweep(&self.config_dir, &self.nbody_bench)
+    }
+}
+
+/// Checks that every program a case would start exists, before anything runs.
+pub fn check_programs(
+    ext: &External,
+    launcher: Option<&str>,
+    context: &Context,
+) -> Result<(), ExternalError> {
+    let vars = context.vars();
+    let mut programs: Vec<(&str, String)> = Vec::new();
+    for (field, tokens) in [
+        ("command", &ext.command),
+        ("setup", &ext.setup),
+        ("version", &ext.version),
+        ("empty", &ext.empty),
+    ] {
+        let Some(first) = tokens.first() else {
+            continue;
+        };
+        // A program named by a case placeholder ({workdir}/prog) is only known per case.
+        let Ok(program) = vars.substitute(first) else {
+            continue;
+        };
+        programs.push((field, program));
+    }
+    if let Some(l) = launcher {
+        programs.push(("[mpi] launcher", l.to_string()));
+    }
+    for (field, program) in programs {
+        if process::find_program(&program).is_none() {
+            return Err(ExternalError::NotFound {
+                name: ext.name.clone(),
+                program,
+                where_: if field == "command" {
+                    String::new()
+                } else {
+                    format!(" (its `{field}`)")
+                },
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The first line the version command prints (standard output, else standard error), or why
+/// there is none.
+pub fn version_line(ext: &External, context: &Context) -> ExternalVersion {
+    let version = if ext.version.is_empty() {
+        "(no version command)".to_string()
+    } else {
+        match context.vars().substitute_all(&ext.version) {
+            Err(e) => format!("(version command: {e})"),
+            Ok(argv) => {
+                let dir = context.work_root.join(format!("version-{}", ext.name));
+                let launch = process::Launch { argv, env: vec![] };
+                match std::fs::create_dir_all(&dir)
+                    .and_then(|()| process::run(&launch, &dir, VERSION_TIMEOUT_S))
+                {
+                    Err(e) => format!("(`{}` failed: {e})", launch.display()),
+                    Ok(done) => (done.stdout + &done.stderr)
+                        .lines()
+                        .map(str::trim)
+                        .find(|l| !l.is_empty())
+                        .unwrap_or("(no output)")
+                        .to_string(),
+                }
+            }
+        }
+    };
+    ExternalVersion {
+        name: ext.name.clone(),
+        version,
+    }
+}
+
+/// The work directory of a case: `<work_root>/<key with '/' as '_'>`.
+pub fn workdir(root: &Path, key: &str) -> PathBuf {
+    root.join(key.replace('/', "_"))
+}
