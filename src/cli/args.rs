@@ -2,6 +2,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use nbody_bench::decomp::Decomposition;
+use nbody_bench::export::ExportFormat;
 use nbody_bench::kernels::{KernelKind, Multipole};
 use nbody_bench::output::nbview::NbviewFormat;
 use nbody_bench::scenario::{Precision, ScenarioKind};
@@ -53,7 +54,7 @@ pub enum Command {
     MpiCheck(MpiCheckArgs),
     /// Write a scenario's initial state for another code: a LAMMPS data file (reduced units),
     /// or a text / .npy table of positions, velocities, masses and strengths.
-    Export(super::export::ExportArgs),
+    Export(ExportArgs),
 }
 
 #[derive(Debug, Args)]
@@ -483,4 +484,21 @@ pub struct GateArgs {
     /// Also fail (exit 1) when a deterministic work counter changed.
     #[arg(long)]
     pub fail_on_work_change: bool,
+}
+
+#[derive(Debug, Args)]
+pub struct ExportArgs {
+    /// Scenario whose initial state is written.
+    #[arg(long, value_enum)]
+    pub scenario: ScenarioKind,
+    #[command(flatten)]
+    pub system: SystemArgs,
+    /// lammps-data: a LAMMPS data file in LJ reduced units (atom style atomic, the walls as the
+    /// box; Lennard-Jones scenarios only); text: positions, velocities, mass and strength per
+    /// particle with the law's parameters in the header; npy: the same columns as float64.
+    #[arg(long, value_enum)]
+    pub format: ExportFormat,
+    /// The file to write (atomically).
+    #[arg(long, value_name = "FILE")]
+    pub out: PathBuf,
 }
