@@ -13,11 +13,9 @@
 //! bin width, so at least the cutoff, away along axis 0) or sentinels, which contribute zero.
 
 use super::grid::{Grid, bounding_box, sentinel};
-use crate::kernels::par::chunk_len;
 use crate::kernels::rows::LANES;
 use crate::real::Real;
 use crate::state::State;
-use rayon::prelude::*;
 
 /// Sentinels after each strip: enough to round any run up to a multiple of `LANES`.
 const PAD: usize = LANES - 1;
@@ -45,8 +43,6 @@ pub struct Strips<T, const D: usize> {
     /// Per particle in state order: its bin, and its bin coordinate along axis 1.
     bin: Vec<u32>,
     row_y: Vec<u32>,
-    /// Per sorted slot: the particle (state index) there.
-    sorted: Vec<u32>,
     /// A position at least `rc` from every particle (for the padding), if representable.
     far: Option<[T; D]>,
 }
@@ -64,7 +60,6 @@ impl<T: Real, const D: usize> Strips<T, D> {
             start: Vec::new(),
             bin: Vec::new(),
             row_y: Vec::new(),
-            sorted: Vec::new(),
             far: None,
         }
     }
@@ -73,7 +68,7 @@ impl<T: Real, const D: usize> Strips<T, D> {
     /// of equal size allocates nothing after the first. Inline so that it is compiled inside
     /// `simd::dispatch` with the wide instruction set, like `fill`.
     #[inline(always)]
-    pub fn sort(&mut self, state: &State<T, D>, rc: f64, parallel: bool) {
+    pub fn sort(&mut self, state: &State<T, D>, rc: f64) {
         let n = state.len();
         assert!(
             n <= MAX_PARTICLES,
@@ -82,13 +77,12 @@ impl<T: Real, const D: usize> Strips<T, D> {
         let (lo, hi) = bounding_box(state);
         self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), rc, n);
         self.far = sentinel(lo, hi, rc);
-        self.count(state, parallel);
+        self.count(state);
     }
 
-    /// Fills the strips with the particles sorted by `sort`; strip by strip on the current
-    /// rayon pool with `parallel` (the same slots either way).
+    /// Fills the strips with the particles sorted by `sort`.
     #[inline(always)]
-    pub fn fill(&mut self, state: &State<T, D>, parallel: bool) {
+    pub fn fill(&mut self, state: &State<T, D>) {
         // Padding costs `PAD` slots per strip; when strips are nearly empty (a line-like
         // configuration) that would dwarf the particles, so runs are left as they are.
         let n = state.len();
@@ -98,7 +92,10 @@ impl<T: Real, const D: usize> Strips<T, D> {
             0
         };
         self.columns();
-        self.place(state, parallel);
+        self.place(state);
+        if let Some(far) = self.far.filter(|_| self.pad > 0) {
+            self.fill_padding(far);
+        }
     }
 
     /// Expected candidate pairs of a step: each particle sees 3^D bins of mean occupancy.
@@ -108,11 +105,10 @@ impl<T: Real, const D: usize> Strips<T, D> {
         (n * (n * 3f64.powi(D as i32) / bins as f64).min(n)) as u64
     }
 
-    /// Bin of every particle (a vectorizable pass, split over the pool with `parallel`), its
-    /// rank inside the bin while counting (a histogram), the first sorted slot of each bin, and
-    /// the particle at each sorted slot.
+    /// Bin of every particle (a vectorizable pass), its rank inside the bin while counting
+    /// (a histogram), then the first sorted slot of each bin.
     #[inline(always)]
-    fn count(&mut self, state: &State<T, D>, parallel: bool) {
+    fn count(&mut self, state: &State<T, D>) {
         let (g, n) = (&self.grid, state.len());
         self.bin.resize(n, 0);
         self.row_y.resize(n, 0);
@@ -120,22 +116,11 @@ impl<T: Real, const D: usize> Strips<T, D> {
         self.start.clear();
         self.start.resize(g.bins(), 0);
         let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
-        let bin_of = |first: usize, bin: &mut [u32], row_y: &mut [u32]| {
-            for (k, (b, y)) in bin.iter_mut().zip(row_y.iter_mut()).enumerate() {
-                let c = g.cell(position(&pos, first + k));
-                *b = g.bin(&c) as u32;
-                *y = c.get(1).copied().unwrap_or(0) as u32;
-            }
-        };
         let (bin, row_y) = (&mut self.bin[..n], &mut self.row_y[..n]);
-        if parallel {
-            let chunk = chunk_len(n);
-            bin.par_chunks_mut(chunk)
-                .zip(row_y.par_chunks_mut(chunk))
-                .enumerate()
-                .for_each(|(c, (b, y))| bin_of(c * chunk, b, y));
-        } else {
-            bin_of(0, bin, row_y);
+        for i in 0..n {
+            let c = g.cell(position(&pos, i));
+            bin[i] = g.bin(&c) as u32;
+            row_y[i] = c.get(1).copied().unwrap_or(0) as u32;
         }
         for (&b, rank) in bin.iter().zip(self.rank.iter_mut()) {
             let count = &mut self.start[b as usize];
@@ -147,10 +132,6 @@ impl<T: Real, const D: usize> Strips<T, D> {
             let count = *s;
             *s = next;
             next += count;
-        }
-        self.sorted.resize(n, 0);
-        for (i, (&b, &k)) in self.bin.iter().zip(&self.rank).enumerate() {
-            self.sorted[(self.start[b as usize] + k) as usize] = i as u32;
         }
     }
 
@@ -182,92 +163,71 @@ impl<T: Real, const D: usize> Strips<T, D> {
         self.src.resize(len, T::zero());
     }
 
-    /// Copies every particle into the strips of its own row and of the rows above and below,
-    /// then the sentinels after each strip. Inside a column the particles are ordered by row,
-    /// then by rank. Each strip is one run of slots written by one task (in parallel with
-    /// `parallel`), reading its three rows' particles in sorted order.
+    /// Copies every particle into the strips of its own row and of the rows above and below.
+    /// Inside a column the particles are ordered by row, then by rank.
     #[inline(always)]
-    fn place(&mut self, state: &State<T, D>, parallel: bool) {
+    fn place(&mut self, state: &State<T, D>) {
         let n = state.len();
         let g = &self.grid;
         let (row_len, ny) = (g.row_len, g.extent(1));
-        let (start, column, sorted) = (&self.start, &self.column, &self.sorted);
-        // Own slots: the particles of the row below in the same column come first.
         self.own.resize(n, 0);
-        let (bin, rank, row_y) = (&self.bin[..n], &self.rank[..n], &self.row_y[..n]);
-        let own_slot = |i: usize| {
-            let b = bin[i] as usize;
-            let below = if row_y[i] >= 1 {
-                count(start, b - row_len)
+        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
+        let (start, column) = (&self.start, &self.column);
+        // Slices, not `Vec`s: stores through a `Vec` make LLVM reload its header.
+        let mut out_pos: [&mut [T]; D] = self.pos.each_mut().map(|v| v.as_mut_slice());
+        let out_src = self.src.as_mut_slice();
+        let (bin, rank, row_y, own) = (
+            &self.bin[..n],
+            &self.rank[..n],
+            &self.row_y[..n],
+            &mut self.own[..n],
+        );
+        for i in 0..n {
+            let x = position(&pos, i);
+            let s = state.source[i];
+            let y = row_y[i] as usize;
+            let (b, k) = (bin[i] as usize, rank[i]);
+            // Particles of the rows below in the same column of the same strip.
+            let below1 = if y >= 1 { count(start, b - row_len) } else { 0 };
+            let below2 = if y >= 2 {
+                count(start, b - 2 * row_len)
             } else {
                 0
             };
-            column[b] + below + rank[i]
-        };
-        if parallel {
-            let own = &mut self.own[..n];
-            own.par_iter_mut()
-                .enumerate()
-                .for_each(|(i, o)| *o = own_slot(i));
-        } else {
-            for (i, o) in self.own[..n].iter_mut().enumerate() {
-                *o = own_slot(i);
+            let slot = column[b] + below1 + k;
+            own[i] = slot;
+            put(&mut out_pos, out_src, slot, &x, s);
+            if y + 1 < ny {
+                // The lowest row of strip y + 1.
+                put(&mut out_pos, out_src, column[b + row_len] + k, &x, s);
+            }
+            if y >= 1 {
+                // The highest row of strip y − 1.
+                let slot = column[b - row_len] + below1 + below2 + k;
+                put(&mut out_pos, out_src, slot, &x, s);
             }
         }
-        // The strips' slot runs, split off one after another.
-        let far = self.far.filter(|_| self.pad > 0);
-        let pad = if far.is_some() { self.pad } else { 0 };
-        let mut rest_pos: [&mut [T]; D] = self.pos.each_mut().map(|v| v.as_mut_slice());
-        let mut rest_src = self.src.as_mut_slice();
-        let mut runs = Vec::with_capacity(g.rows);
-        let mut at = 0usize;
-        for s in 0..g.rows {
-            let end = column[s * row_len + row_len - 1] as usize + pad;
-            let (run_src, tail_src) = std::mem::take(&mut rest_src).split_at_mut(end - at);
-            let mut run_pos: [&mut [T]; D] = std::array::from_fn(|_| Default::default());
+    }
+
+    /// Writes sentinels after every strip.
+    fn fill_padding(&mut self, far: [T; D]) {
+        let row_len = self.grid.row_len;
+        for s in 0..self.grid.rows {
+            let end = self.column[s * row_len + row_len - 1] as usize;
             for d in 0..D {
-                let (head, tail) = std::mem::take(&mut rest_pos[d]).split_at_mut(end - at);
-                run_pos[d] = head;
-                rest_pos[d] = tail;
+                self.pos[d][end..end + self.pad].fill(far[d]);
             }
-            rest_src = tail_src;
-            runs.push((s, run_pos, run_src));
-            at = end;
-        }
-        let fill = |(s, pos, src): &mut (usize, [&mut [T]; D], &mut [T])| {
-            let y = *s % ny;
-            let rows = (*s - y + y.saturating_sub(1))..=(*s - y + (y + 1).min(ny - 1));
-            let mut k = 0;
-            for x in 0..row_len - 1 {
-                for r in rows.clone() {
-                    let b = r * row_len + x;
-                    for &i in &sorted[start[b] as usize..start[b + 1] as usize] {
-                        let i = i as usize;
-                        for d in 0..D {
-                            pos[d][k] = state.pos[d][i];
-                        }
-                        src[k] = state.source[i];
-                        k += 1;
-                    }
-                }
-            }
-            if let Some(far) = far {
-                for d in 0..D {
-                    pos[d][k..].fill(far[d]);
-                }
-                src[k..].fill(T::zero());
-            }
-        };
-        if parallel {
-            runs.par_iter_mut().with_min_len(4).for_each(fill);
-        } else {
-            runs.iter_mut().for_each(fill);
+            self.src[end..end + self.pad].fill(T::zero());
         }
     }
 
     /// The particles in bin order, as `order[new_slot] = old_slot` (valid after `sort`).
     pub fn order(&self) -> Vec<u32> {
-        self.sorted.clone()
+        let mut order = vec![0u32; self.bin.len()];
+        for (i, (&b, &k)) in self.bin.iter().zip(&self.rank).enumerate() {
+            order[(self.start[b as usize] + k) as usize] = i as u32;
+        }
+        order
     }
 }
 
@@ -275,6 +235,22 @@ impl<T: Real, const D: usize> Strips<T, D> {
 #[inline(always)]
 fn count(start: &[u32], b: usize) -> u32 {
     start[b + 1] - start[b]
+}
+
+/// Stores a particle in strip slot `slot`.
+#[inline(always)]
+fn put<T: Real, const D: usize>(
+    pos: &mut [&mut [T]; D],
+    src: &mut [T],
+    slot: u32,
+    x: &[T; D],
+    s: T,
+) {
+    let slot = slot as usize;
+    for d in 0..D {
+        pos[d][slot] = x[d];
+    }
+    src[slot] = s;
 }
 
 /// Position of particle `i` (a loop rather than `State::position`'s `array::from_fn`, whose

@@ -277,49 +277,6 @@ fn unspaced_random_state_is_finite() {
     agrees_with(&mut kernel, &state, law);
 }
 
-/// The strips built strip by strip on two threads are the serial ones, slot for slot.
-fn parallel_layout_is_the_serial_one<T: Real, const D: usize>() {
-    for n in [1, 5, 700, 5000] {
-        let side = (n as f64 / if D == 2 { 500.0 } else { 1.2e4 }).powf(1.0 / D as f64);
-        let state = spaced_state::<T, D>(n, side, 0.8 * SIGMA, SEED_1);
-        let rc = 2.5 * SIGMA;
-        let build = |parallel: bool| {
-            on_threads(2, || {
-                let mut s = Strips::<T, D>::new();
-                s.sort(&state, rc, parallel);
-                s.fill(&state, parallel);
-                s
-            })
-        };
-        let (a, b) = (build(false), build(true));
-        assert_eq!(a.pos, b.pos, "{} D={D} n={n}: positions", T::NAME);
-        assert_eq!(a.src, b.src, "n={n}: strengths");
-        assert_eq!(
-            (&a.column, &a.own, &a.rank),
-            (&b.column, &b.own, &b.rank),
-            "n={n}"
-        );
-        assert_eq!(a.order(), b.order(), "n={n}: order");
-        // Every particle sits at its own slot of its own strip.
-        for i in 0..n {
-            let slot = a.own[i] as usize;
-            for d in 0..D {
-                assert_eq!(a.pos[d][slot], state.pos[d][i], "n={n}: particle {i}");
-            }
-        }
-    }
-}
-
-#[test]
-fn parallel_layout_2d_f32() {
-    parallel_layout_is_the_serial_one::<f32, 2>();
-}
-
-#[test]
-fn parallel_layout_3d_f64() {
-    parallel_layout_is_the_serial_one::<f64, 3>();
-}
-
 /// The fork decision weighs the particles, not only the pairs: a dilute gas of 1e5 particles
 /// with ~2.7 candidates each forks, a few hundred particles do not.
 #[test]
