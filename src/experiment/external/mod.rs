@@ -84,6 +84,12 @@ pub enum ExternalError {
         name: String,
         source: placeholders::PlaceholderError,
     },
+    #[error("external `{name}`: the regular expression `{regex}` does not compile: {source}")]
+    Regex {
+        name: String,
+        regex: String,
+        source: regex::Error,
+    },
     #[error("cannot create the work directory {path}: {source}")]
     Workdir {
         path: PathBuf,

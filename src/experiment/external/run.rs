@@ -117,12 +117,19 @@ pub fn measure_round(
             ));
         }
     }
-    let check = ext.check.as_deref().map(compile);
+    let compile = |re: &str| {
+        Regex::new(re).map_err(|source| ExternalError::Regex {
+            name: ext.name.clone(),
+            regex: re.to_string(),
+            source,
+        })
+    };
+    let check = ext.check.as_deref().map(compile).transpose()?;
     let time = match &ext.time {
-        TimeSource::Regex(t) => Some((compile(&t.regex), t.unit.seconds())),
+        TimeSource::Regex(t) => Some((compile(&t.regex)?, t.unit.seconds())),
         TimeSource::Wall(_) => None,
     };
-    let error = ext.force_error.as_deref().map(compile);
+    let error = ext.force_error.as_deref().map(compile).transpose()?;
     for _ in 0..spec.samples {
         let run = match checked_run(&main, &dir, ext.timeout_s, check.as_ref()) {
             Err(e) => ExternalRun {
@@ -157,11 +164,6 @@ pub fn measure_round(
         }
     }
     Ok(outcome(ext, case, round, steps))
-}
-
-/// A regular expression that `External::validate` already compiled once.
-fn compile(re: &str) -> Regex {
-    Regex::new(re).expect("validated with the config")
 }
 
 struct Failed {
