@@ -55,6 +55,14 @@ pub struct ScenarioCheck {
     pub dump: Option<String>,
 }
 
+/// `job` on the system of `setup` (not generic: see [`crate::run::run_setup`]).
+pub fn validate_setup(
+    setup: &crate::scenario::Setup,
+    job: ValidateJob,
+) -> Result<Result<ScenarioCheck, crate::run::RunError>, crate::scenario::SetupError> {
+    setup.dispatch(job)
+}
+
 /// Runs every kernel that applies to the system's law and compares it to the reference.
 pub struct ValidateJob {
     pub params: KernelParams,
@@ -113,7 +121,8 @@ impl SystemJob for ValidateJob {
                 system.info.seed,
                 self.params.theta
             );
-            crate::output::dump::force_dump(&header, state, &reference, &dumped)
+            let law = system.law.parameters();
+            crate::output::dump::force_dump(&header, &law, state, &reference, &dumped)
         });
         Ok(ScenarioCheck {
             scenario: system.info.scenario.name(),

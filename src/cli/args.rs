@@ -157,7 +157,8 @@ pub struct RunArgs {
     /// Write a trajectory frame every K steps.
     #[arg(long, default_value_t = 10, value_parser = parse_count, requires = "trajectory")]
     pub every: usize,
-    /// Write the final positions, velocities and forces (text, id order, nothing run-dependent).
+    /// Write the final positions, velocities, masses, strengths and forces, with the law's
+    /// parameters in the header (text, id order, nothing run-dependent).
     #[arg(long, value_name = "FILE")]
     pub dump_state: Option<PathBuf>,
     /// Start a run estimated at more than an hour (a probe at small n carried to -n, --steps
@@ -259,7 +260,8 @@ pub struct ValidateArgs {
     pub system: SystemArgs,
     #[command(flatten)]
     pub kernel_args: KernelArgs,
-    /// Write positions, reference forces and every kernel's forces (text) to this file;
+    /// Write positions, strengths, reference forces and every kernel's forces, with the law's
+    /// parameters in the header (text) to this file;
     /// with several scenarios, one file per scenario named FILE.<scenario>.
     #[arg(long, value_name = "FILE")]
     pub dump: Option<PathBuf>,

@@ -3,14 +3,14 @@
 //! `mpi-check`) integrates the same system serially to compare.
 
 use super::allgather::Allgather;
-use super::check::{CheckReport, compare};
 use super::comm::{Comm, Lent};
 use super::domain::{Domain, DomainOptions};
 use super::driver::{Driver, Timeline, drive, pack_owned};
 use super::error::MpiError;
-use super::wire::{bytes_of, floats_of, particle_values};
 use crate::decomp::Decomposition;
+use crate::decomp::check::{CheckReport, compare};
 use crate::decomp::stats::{MasterSummary, MpiReport, RankStats, attribute_waits, reduce};
+use crate::decomp::wire::{bytes_of, floats_of, particle_values};
 use crate::engine::{PhaseTimes, Simulation};
 use crate::kernels::{KernelKind, KernelParams, WorkCounters};
 use crate::output::dump;
@@ -289,14 +289,10 @@ fn finish<T: Real, L: PairLaw<T>, const D: usize>(
     let e1 = end.probe().finite_after(steps_done)?;
     let info = &reference.info;
     if let Some(path) = &spec.dump_state {
-        let header = format!(
-            "scenario {} dim {D} precision {} n {n} seed {} steps {steps_done} dt {}",
-            info.scenario.name(),
-            T::NAME,
-            info.seed,
-            info.dt
-        );
-        crate::output::write_atomic(path, dump::state_dump(&header, &state, &forces).as_bytes())?;
+        let header = dump::run_header::<T, D>(info, n, steps_done);
+        let law = reference.law.parameters();
+        let text = dump::state_dump(&header, &law, &state, &forces);
+        crate::output::write_atomic(path, text.as_bytes())?;
     }
     let check = if spec.check {
         let mut serial = Simulation::new(reference.clone(), serial_kernel()?);

@@ -57,6 +57,18 @@ pub enum RunError {
 /// steps timed by the clock.
 pub struct RunJob<'a, C: Clock>(pub &'a RunSpec, pub &'a C);
 
+/// `spec` on the system of `setup`, timed by the wall clock: what `nbody-bench run` does.
+///
+/// Not generic on purpose: the system types are instantiated here, once, in this crate, and
+/// not again in each crate that runs a simulation (the binary, tests), which keeps them quick
+/// to compile.
+pub fn run_setup(
+    setup: &crate::scenario::Setup,
+    spec: &RunSpec,
+) -> Result<Result<RunOutcome, RunError>, crate::scenario::SetupError> {
+    setup.dispatch(RunJob(spec, &crate::clock::WallClock::new()))
+}
+
 impl<C: Clock> SystemJob for RunJob<'_, C> {
     type Output = Result<RunOutcome, RunError>;
 
@@ -72,8 +84,12 @@ impl<C: Clock> SystemJob for RunJob<'_, C> {
             })?;
         let info = system.info.clone();
         let law = system.law.kind().name();
+        let parameters = system.law.parameters();
         let clock = self.1;
-        pool.install(|| measure(spec, clock, &info, law, Simulation::new(system, kernel)))
+        pool.install(|| {
+            let sim = Simulation::new(system, kernel);
+            measure(spec, clock, &info, (law, &parameters), sim)
+        })
     }
 }
 
@@ -81,7 +97,7 @@ fn measure<T: Real, const D: usize, C: Clock>(
     spec: &RunSpec,
     clock: &C,
     info: &SystemInfo,
-    law: &'static str,
+    (law, parameters): (&'static str, &crate::physics::LawParameters),
     mut sim: Simulation<T, D>,
 ) -> Result<RunOutcome, RunError> {
     let n = sim.state.len();
@@ -118,17 +134,10 @@ fn measure<T: Real, const D: usize, C: Clock>(
         tr.file.commit()?;
     }
     if let Some(path) = &spec.dump_state {
-        let header = format!(
-            "scenario {} dim {D} precision {} n {n} seed {} steps {} dt {}",
-            info.scenario.name(),
-            T::NAME,
-            info.seed,
-            sim.step,
-            info.dt
-        );
+        let header = dump::run_header::<T, D>(info, n, sim.step);
         crate::output::write_atomic(
             path,
-            dump::state_dump(&header, &sim.state, &sim.forces).as_bytes(),
+            dump::state_dump(&header, parameters, &sim.state, &sim.forces).as_bytes(),
         )?;
     }
     Ok(RunOutcome::new::<T, D>(Measured {

@@ -336,17 +336,21 @@ fn state_dumps_are_reproducible_and_documented() {
         "naive computes each row the same way on any thread count"
     );
     let lines: Vec<&str> = a.lines().collect();
-    assert_eq!(lines[0], "# nbody-bench state v1");
+    assert_eq!(lines[0], "# nbody-bench state v2");
     assert_eq!(
         lines[1],
         "# scenario galaxy dim 3 precision f64 n 300 seed 1 steps 20 dt 0.001"
     );
-    assert_eq!(lines[2], "# columns: id x y z vx vy vz fx fy fz");
-    assert_eq!(lines.len(), 303);
-    assert!(lines[3].starts_with("0 ") && lines[302].starts_with("299 "));
+    assert!(lines[2].starts_with("# law gravity G "), "{}", lines[2]);
+    assert_eq!(
+        lines[3],
+        "# columns: id x y z vx vy vz mass strength fx fy fz"
+    );
+    assert_eq!(lines.len(), 304);
+    assert!(lines[4].starts_with("0 ") && lines[303].starts_with("299 "));
     // Another kernel differs by rounding only.
     let c = dump(dir.path(), "c.txt", &["--kernel", "symmetric"]);
-    for (la, lc) in a.lines().zip(c.lines()).skip(3) {
+    for (la, lc) in a.lines().zip(c.lines()).skip(4) {
         let xa: Vec<f64> = la.split(' ').map(|x| x.parse().unwrap()).collect();
         let xc: Vec<f64> = lc.split(' ').map(|x| x.parse().unwrap()).collect();
         for (p, q) in xa.iter().zip(&xc).take(7) {
@@ -399,9 +403,75 @@ fn validate_passes_for_every_scenario_and_dumps_forces() {
     let text = std::fs::read_to_string(dir.path().join("f.txt.coulomb")).unwrap();
     assert!(
         text.lines()
-            .nth(2)
+            .nth(3)
             .unwrap()
-            .starts_with("# columns: id x y z fx_ref fy_ref fz_ref fx_naive")
+            .starts_with("# columns: id x y z strength fx_ref fy_ref fz_ref fx_naive")
     );
-    assert_eq!(text.lines().count(), 703);
+    assert_eq!(text.lines().count(), 704);
+    for scenario in ["coulomb", "galaxy"] {
+        let path = dir.path().join(format!("f.txt.{scenario}"));
+        recomputes_from_the_dump(&std::fs::read_to_string(path).unwrap());
+    }
+}
+
+/// The value after `word` on a header line.
+fn header_value(line: &str, word: &str) -> f64 {
+    let mut it = line.split(' ');
+    it.find(|w| *w == word)
+        .and_then(|_| it.next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no `{word} <number>` in {line}"))
+}
+
+/// Another code's check of a force dump: from the positions, the strengths and the law line
+/// alone, a direct sum (written here, independently of the crate's laws) gives the reference
+/// forces of the dump.
+fn recomputes_from_the_dump(text: &str) {
+    let law = text.lines().nth(2).unwrap();
+    let rows: Vec<Vec<f64>> = text
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .map(|l| l.split(' ').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    // id x y z strength fx_ref fy_ref fz_ref ...
+    let pos = |r: &Vec<f64>| [r[1], r[2], r[3]];
+    for i in (0..rows.len()).step_by(37) {
+        let xi = pos(&rows[i]);
+        let mut f = [0.0f64; 3];
+        for (j, row) in rows.iter().enumerate() {
+            if j == i {
+                continue;
+            }
+            let xj = pos(row);
+            let d = [xj[0] - xi[0], xj[1] - xi[1], xj[2] - xi[2]];
+            let r2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            let (qi, qj) = (rows[i][4], row[4]);
+            let coeff = if law.starts_with("# law coulomb") {
+                let quench = header_value(law, "quench");
+                if r2 < quench * quench {
+                    0.0
+                } else {
+                    -qi * qj / (r2 * r2.sqrt())
+                }
+            } else {
+                assert!(law.starts_with("# law gravity"), "{law}");
+                let g = header_value(law, "G");
+                let eps = header_value(law, "softening");
+                g * qi * qj / (r2 + eps * eps).powf(1.5)
+            };
+            for a in 0..3 {
+                f[a] += coeff * d[a];
+            }
+        }
+        let want = &rows[i][5..8];
+        let scale = want.iter().map(|x| x.abs()).fold(1e-300, f64::max);
+        for a in 0..3 {
+            assert!(
+                (f[a] - want[a]).abs() <= 1e-9 * scale,
+                "particle {i} axis {a}: recomputed {} vs dumped {} ({law})",
+                f[a],
+                want[a]
+            );
+        }
+    }
 }
