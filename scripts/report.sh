@@ -12,10 +12,15 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-CONFIGS=(complexity complexity-large strong weak weak-time octree-accuracy)
+CONFIGS=(complexity complexity-large strong weak weak-time octree-accuracy
+    vs-lammps vs-lammps-liquid vs-pytreegrav)
 mode="${1:-}"
 cargo build --release --quiet
 bin=target/release/nbody-bench
+if [[ "$mode" != "--report" ]]; then
+    # The vs-*.toml sweeps run LAMMPS and pytreegrav next to our kernels.
+    scripts/install-peers.sh
+fi
 
 if [[ "$mode" != "--report" ]]; then
     for name in "${CONFIGS[@]}"; do

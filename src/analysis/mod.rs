@@ -6,6 +6,7 @@
 
 pub mod comm;
 pub mod groups;
+pub mod peers;
 
 use crate::calibrate::Calibration;
 use crate::experiment::code::Code;
@@ -116,6 +117,12 @@ pub struct Analysis {
     pub strong: Vec<StrongAnalysis>,
     pub weak: Vec<WeakAnalysis>,
     pub theta: Vec<ThetaAnalysis>,
+    /// Our kernels next to the external programs of the same sweep.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub peers: Vec<peers::PeerRatio>,
+    /// Tree codes at equal median force error ([`peers::EQUAL_ERROR`]).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub peers_equal_error: Vec<peers::EqualErrorCost>,
     /// Every complete case, with its summary figures and physics checks.
     pub cases: Vec<Point>,
     /// Cases of the file still unmeasured or partly measured (left out of the analysis).
@@ -177,7 +184,8 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
             label: s.key.label(),
             points: s.points.clone(),
         })
-        .collect();
+        .collect::<Vec<_>>();
+    let peers_equal_error = peers::equal_error(&theta);
     Ok(Analysis {
         schema: FITS_SCHEMA.into(),
         source: source.display().to_string(),
@@ -190,6 +198,8 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
         strong,
         weak,
         theta,
+        peers: peers::ratios(&groups.cases),
+        peers_equal_error,
         incomplete: results
             .cases
             .iter()

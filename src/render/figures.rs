@@ -292,17 +292,22 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         .theta
         .iter()
         .map(|t| ThetaSweep {
-            // One series per expansion order; the monopole's keeps its earlier name.
-            name: match t.series.multipole {
-                Multipole::Monopole => {
-                    format!("{} n={}", t.series.scenario.name(), t.series.n.unwrap_or(0))
-                }
-                m => format!(
-                    "{} n={} {}",
+            // One series per code and expansion order; our octree's monopole keeps its
+            // earlier name.
+            name: {
+                let mut name = match t.series.kernel.kernel() {
+                    Some(crate::kernels::KernelKind::Octree) => String::new(),
+                    _ => format!("{} ", t.series.kernel.name()),
+                };
+                name.push_str(&format!(
+                    "{} n={}",
                     t.series.scenario.name(),
-                    t.series.n.unwrap_or(0),
-                    m.name()
-                ),
+                    t.series.n.unwrap_or(0)
+                ));
+                if t.series.multipole != Multipole::Monopole {
+                    name.push_str(&format!(" {}", t.series.multipole.name()));
+                }
+                name
             },
             points: t
                 .points

@@ -56,6 +56,14 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.theta.is_empty() {
         let _ = writeln!(md, "## Octree accuracy vs cost\n\n{}", tables::theta(a));
     }
+    if !a.peers.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Against the external programs\n\n{}\n{}",
+            tables::peers(a),
+            tables::peers_equal_error(a)
+        );
+    }
     if !a.cases.is_empty() {
         let _ = writeln!(
             md,

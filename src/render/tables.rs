@@ -202,8 +202,8 @@ fn theta_cell(p: &crate::analysis::groups::Point) -> String {
 /// f64 direct sum.
 pub fn theta(a: &Analysis) -> String {
     let mut md = String::from(
-        "| scenario | n | θ | time/step | µs/particle-step | median / max relative force error |\n\
-         |---|---|---|---|---|---|\n",
+        "| scenario | code | n | θ | time/step | µs/particle-step | median / max relative force error |\n\
+         |---|---|---|---|---|---|---|\n",
     );
     for t in &a.theta {
         for p in &t.points {
@@ -212,8 +212,9 @@ pub fn theta(a: &Analysis) -> String {
             });
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {:.2} | {error} |",
+                "| {} | {} | {} | {} | {} | {:.2} | {error} |",
                 t.series.scenario.name(),
+                t.series.kernel.name(),
                 p.n,
                 theta_cell(p),
                 Duration(p.median_s),
@@ -261,4 +262,97 @@ pub fn sanity_header(with_sweep: bool) -> &'static str {
     } else {
         "| scenario | kernel | cases | largest drift | flagged |\n|---|---|---|---|---|\n"
     }
+}
+
+fn with_ci(estimate: f64, ci: [f64; 2]) -> WithCi<Plain> {
+    WithCi {
+        estimate: Plain(estimate),
+        low: Plain(ci[0]),
+        high: Plain(ci[1]),
+    }
+}
+
+fn error_cell(e: Option<f64>) -> String {
+    e.map_or(NONE.to_string(), |e| format!("{e:.2e}"))
+}
+
+/// Our kernels next to the external programs of the sweep: time per particle-step of each with
+/// its CI, the ratio theirs ÷ ours with its CI (above 1: ours is faster), and the force errors
+/// where measured. Empty when the sweep ran no external program next to a kernel.
+pub fn peers(a: &Analysis) -> String {
+    if a.peers.is_empty() {
+        return String::new();
+    }
+    let errors = a
+        .peers
+        .iter()
+        .any(|r| r.ours_error.is_some() || r.theirs_error.is_some());
+    let mut md = String::from(
+        "| scenario | n | workers | ours | ns/particle-step [95% CI] | theirs | ns/particle-step [95% CI] | theirs ÷ ours [95% CI] |",
+    );
+    md.push_str(if errors {
+        " median force error (ours / theirs) |\n|---|---|---|---|---|---|---|---|---|\n"
+    } else {
+        "\n|---|---|---|---|---|---|---|---|\n"
+    });
+    for r in &a.peers {
+        let ratio = match r.speedup_ci {
+            Some(ci) => format!("{:.2}", with_ci(r.speedup, ci)),
+            None => format!("{:.2}", r.speedup),
+        };
+        let _ = write!(
+            md,
+            "| {} | {} | {}{} | {} | {:.1} | {} | {:.1} | {ratio} |",
+            r.scenario,
+            r.n,
+            r.workers,
+            over(r.oversubscribed),
+            r.ours,
+            with_ci(r.ours_ns, r.ours_ci_ns),
+            r.theirs,
+            with_ci(r.theirs_ns, r.theirs_ci_ns),
+        );
+        if errors {
+            let _ = write!(
+                md,
+                " {} / {} |",
+                error_cell(r.ours_error),
+                error_cell(r.theirs_error)
+            );
+        }
+        md.push('\n');
+    }
+    md
+}
+
+/// Tree codes at equal median force error: each code's time per step interpolated to it on
+/// its sweep over θ, and the ratio. Empty when the sweep has no such pair of series.
+pub fn peers_equal_error(a: &Analysis) -> String {
+    if a.peers_equal_error.is_empty() {
+        return String::new();
+    }
+    let mut md = String::from(
+        "| scenario | n | workers | median error | ours | time/step | theirs | time/step | theirs ÷ ours |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    let cost = |s: Option<f64>, range: [f64; 2]| match s {
+        Some(s) => Duration(s).to_string(),
+        None => format!("outside the measured {:.1e}–{:.1e}", range[0], range[1]),
+    };
+    for r in &a.peers_equal_error {
+        let _ = writeln!(
+            md,
+            "| {} | {} | {} | {:.0e} | {} | {} | {} | {} | {} |",
+            r.scenario,
+            r.n,
+            r.workers,
+            r.error,
+            r.ours,
+            cost(r.ours_s, r.ours_errors),
+            r.theirs,
+            cost(r.theirs_s, r.theirs_errors),
+            r.speedup.map_or(NONE.to_string(), |s| format!("{s:.2}")),
+        );
+    }
+    md
 }

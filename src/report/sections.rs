@@ -30,6 +30,7 @@ pub fn document(sweeps: &[Sweep], comm: Option<&Comm>, results_dir: &Path) -> St
     weak(&mut md, sweeps);
     super::comm_section::section(&mut md, sweeps, comm, NO_NOTES);
     octree(&mut md, sweeps);
+    peers(&mut md, sweeps);
     sanity(&mut md, sweeps);
     md.push_str("\n## Comparison with the source documents\n\n");
     md.push_str(&region("sources", NO_NOTES));
@@ -189,9 +190,10 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
 
 fn octree(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Octree accuracy vs cost over θ\n\n");
+    // A sweep against another tree code is shown in its own section.
     let with: Vec<&Sweep> = sweeps
         .iter()
-        .filter(|s| !s.analysis.theta.is_empty())
+        .filter(|s| !s.analysis.theta.is_empty() && s.analysis.peers.is_empty())
         .collect();
     if with.is_empty() {
         md.push_str("No sweep over θ (configs/octree-accuracy.toml).\n\n");
@@ -207,6 +209,56 @@ fn octree(md: &mut String, sweeps: &[Sweep]) {
         figure_links(md, s, "octree-accuracy");
     }
     md.push_str(&region("octree", NO_NOTES));
+}
+
+fn peers(md: &mut String, sweeps: &[Sweep]) {
+    md.push_str("\n## Against established codes\n\n");
+    let with: Vec<&Sweep> = sweeps
+        .iter()
+        .filter(|s| !s.analysis.peers.is_empty())
+        .collect();
+    if with.is_empty() {
+        md.push_str(
+            "No sweep ran an external program next to our kernels (configs/vs-lammps.toml, \
+             configs/vs-pytreegrav.toml, after scripts/install-peers.sh).\n\n",
+        );
+    } else {
+        md.push_str(
+            "Each program ran in the same sweep as our kernels, in the same interleaved rounds, from the \
+             same particles (`nbody-bench export`). \"theirs ÷ ours\" is the ratio of the median times per \
+             particle-step (above 1: ours is faster) with a bootstrap 95% CI over both codes' samples; \
+             workers are threads for our kernels and MPI ranks or threads for the other code. * = \
+             oversubscribed.\n\n",
+        );
+    }
+    for s in with {
+        let a = &s.analysis;
+        let versions: Vec<String> = a
+            .metadata
+            .externals
+            .iter()
+            .map(|v| format!("{}: {}", v.name, v.version))
+            .collect();
+        let _ = writeln!(md, "From `{}` ({}).\n", a.source, versions.join("; "));
+        md.push_str(&tables::peers(a));
+        md.push('\n');
+        let equal = tables::peers_equal_error(a);
+        if !equal.is_empty() {
+            md.push_str(
+                "At equal accuracy: each code's time per step interpolated (log-log) to the same median \
+                 relative force error on its sweep over θ.\n\n",
+            );
+            md.push_str(&equal);
+            md.push('\n');
+        }
+        if !a.strong.is_empty() {
+            md.push_str("Scaling of each code from 1 to 2 workers (speedup with 95% CI, ÷ the calibrated ceiling):\n\n");
+            md.push_str(&tables::strong(a));
+            md.push('\n');
+        }
+        figure_links(md, s, "octree-accuracy");
+    }
+    md.push_str(&region("peers", NO_NOTES));
 }
 
 fn sanity(md: &mut String, sweeps: &[Sweep]) {

@@ -151,6 +151,27 @@ time = "wall"
             ("walled", "(no version command)")
         ]
     );
+    // The analysis sets each program next to the kernel of the same case, with the ratio of
+    // the medians and an interval around it.
+    let a = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
+    let naive = record(&r, "lj-box/naive/n=50/p=1/r=1/seed=1")
+        .summary
+        .as_ref()
+        .unwrap()
+        .median_s;
+    let pairs: Vec<(&str, &str)> = a
+        .peers
+        .iter()
+        .map(|p| (p.ours.as_str(), p.theirs.as_str()))
+        .collect();
+    assert_eq!(pairs, vec![("naive", "printed"), ("naive", "walled")]);
+    let row = &a.peers[0];
+    assert!((row.speedup - 1.5e-3 / naive).abs() <= 1e-12 * row.speedup);
+    let ci = row.speedup_ci.unwrap();
+    assert!(ci[0] <= row.speedup && row.speedup <= ci[1], "{ci:?}");
+    assert!((row.theirs_ns - 1.5e-3 * 1e9 / 50.0).abs() < 1e-6);
+    let table = nbody_bench::render::tables::peers(&a);
+    assert!(table.contains("| lj-box | 50 | 1 | naive |"), "{table}");
 }
 
 #[test]
