@@ -6,8 +6,9 @@
 # neighbouring regions and rebalancing; then the error paths, the JSON outputs, `mpi-bench` and
 # a sweep under the launcher.
 #
-# Open MPI and libclang (for the bindings) are installed by scripts/install-mpi.sh. The unit and
-# CLI tests built with the feature run in scripts/test.sh. It never skips a test.
+# Open MPI and libclang (for the bindings) are installed by scripts/install-mpi.sh. Everything
+# MPI-free (regions, statistics, byte counts, the wire format, the state comparison) is in
+# `crate::decomp` and tested by `cargo test` without the feature. It never skips a test.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -17,9 +18,8 @@ fail() {
 }
 
 scripts/install-mpi.sh
-# scripts/test.sh passes the binary its `cargo test --features mpi` built (NBODY_BENCH_BIN): a
-# `cargo build` would compile the crate again, since the tests' dev-dependencies change the
-# features of shared dependencies. Run alone, this builds it.
+# scripts/test.sh passes the binary it built with the feature (NBODY_BENCH_BIN). Run alone,
+# this builds it.
 if [ -n "${NBODY_BENCH_BIN:-}" ]; then
     BIN=$NBODY_BENCH_BIN
 else
@@ -104,6 +104,14 @@ refuses 2 "not of the form AxB" run --decomp domain --scenario lj-box --kernel c
 [ ! -e "$TMP/bench.json" ] || fail "a refused mpi-bench left a file"
 
 # Outputs.
+echo "--- one rank without mpirun: run --decomp domain --json"
+"$BIN" run --decomp domain --scenario lj-box --kernel cell-list -n 500 --steps 5 \
+    --json "$TMP/single.json" </dev/null >/dev/null || fail "a single rank without mpirun"
+for field in '"ranks": 1' '"decomposition": "domain"'; do
+    grep -qF "$field" "$TMP/single.json" || fail "run --json of a single rank lacks $field"
+done
+python3 -c 'import json, sys; assert len(json.load(open(sys.argv[1]))["mpi"]["step_ns"]) == 5' \
+    "$TMP/single.json" || fail "a single rank's run --json does not time its 5 steps"
 echo "--- run --decomp domain --json"
 "${MPIRUN[@]}" -n 2 "$BIN" run --decomp domain --scenario lj-box --kernel cell-list -n 4000 --steps 20 \
     --json "$TMP/run.json" </dev/null >/dev/null || fail "run --decomp domain"

@@ -4,10 +4,12 @@
 # Works on a fresh machine with a Rust toolchain (Open MPI and libclang are installed with apt
 # when missing and this runs as root).
 #
-# Compile time is most of the run, so the tests are built once, with one feature set: the
-# default build (what users run) is built and checked first, and judged by the gate; then,
-# with MPI installed, one `cargo test --features mpi --all-targets` builds the unit tests, the
-# integration suite (one binary), the benches and the MPI binary together.
+# Compile time is most of the run, so the crate is built twice only: once with the default
+# features (what users run), tests, benches and binary together, which runs every test; once
+# more, the binary alone, with the `mpi` feature for the drivers under mpirun. Everything
+# MPI-free of the MPI drivers lives in `crate::decomp` and is tested in the first build. The
+# binary reaches the simulation through the library's non-generic entry points, so the system
+# types are compiled in the library, not again in the binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -20,19 +22,26 @@ step() {
     echo "== $* ($(date -u +%H:%M:%S))" >&2
 }
 
-step "format and lints of the default build"
+step "format and lints, without and with the mpi feature"
+scripts/install-mpi.sh
 cargo fmt --all -- --check
 cargo clippy --all-targets --release -- -D warnings
+cargo clippy --all-targets --release --features mpi -- -D warnings
 
-step "the default build: validation, the entry points that need MPI, the performance gate"
-cargo build --release
-target/release/nbody-bench validate --threads 2
-scripts/no-mpi-check.sh target/release/nbody-bench
+step "the default build: tests, benches and binary"
+# One build of every test target (unit tests, the integration suite, the benches in test
+# mode, the examples, the binary). The binary it makes is the one judged below: a `cargo build`
+# would compile the crate again (the tests' dev-dependencies change the features of shared
+# dependencies).
+cargo test --release --all-targets --no-run
+bin=target/release/nbody-bench
+
+step "validation and the performance gate"
+"$bin" validate --threads 2
 # The gate measures timings: nothing else runs meanwhile.
-scripts/ci-gate.sh
+NBODY_BENCH_BIN="$bin" scripts/ci-gate.sh
 
-step "Open MPI, lints and every test with the mpi feature"
-scripts/install-mpi.sh
+step "every test"
 # The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
 # without `lmp`: install it when missing (as root, with apt).
 if ! command -v lmp >/dev/null 2>&1; then
@@ -45,18 +54,14 @@ if ! command -v lmp >/dev/null 2>&1; then
         exit 2
     fi
 fi
-cargo clippy --all-targets --release --features mpi -- -D warnings
-# One build of every test target (unit tests, the integration suite, the benches in test
-# mode, the examples, the binary), then the runs: the unit tests; the suite but its timing
-# tests; those alone on one test thread (tests/suite/main.rs); each bench once (criterion's
-# test mode, so that they cannot rot).
-features=(--release --features mpi)
-cargo test "${features[@]}" --all-targets --no-run
-cargo test "${features[@]}" --lib --bins
-cargo test "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
-cargo test "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
-cargo test "${features[@]}" --benches
+# The unit tests; the suite but its timing tests; those alone on one test thread
+# (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
+cargo test --release --lib --bins
+cargo test --release --test suite -- --skip gate:: --skip dry_run::
+cargo test --release --test suite -- --test-threads=1 gate:: dry_run::
+cargo test --release --benches
 
 step "the MPI drivers under mpirun"
+cargo build --release --features mpi
 NBODY_BENCH_BIN=target/release/nbody-bench scripts/mpi-tests.sh
 step "all checks passed"

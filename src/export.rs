@@ -34,6 +34,14 @@ pub enum ExportError {
     Masses(usize),
 }
 
+/// The initial state of `setup` in `format` (not generic: see [`crate::run::run_setup`]).
+pub fn export_setup(
+    setup: &crate::scenario::Setup,
+    format: ExportFormat,
+) -> Result<Result<Vec<u8>, ExportError>, crate::scenario::SetupError> {
+    setup.dispatch(ExportJob { format })
+}
+
 /// Writes the system's state in `format`.
 pub struct ExportJob {
     pub format: ExportFormat,

@@ -54,6 +54,23 @@ impl<T: Real, const D: usize> State<T, D> {
         std::array::from_fn(|d| self.pos[d][i])
     }
 
+    /// Keeps the particles whose `keep` entry is true, in order (the rest leave the state,
+    /// e.g. for another rank).
+    pub fn retain(&mut self, keep: &[bool]) {
+        fn keep_in<V: Copy>(v: &mut Vec<V>, keep: &[bool]) {
+            let mut k = keep.iter();
+            v.retain(|_| *k.next().expect("one flag per particle"));
+        }
+        assert_eq!(keep.len(), self.len(), "one flag per particle");
+        for d in 0..D {
+            keep_in(&mut self.pos[d], keep);
+            keep_in(&mut self.vel[d], keep);
+        }
+        keep_in(&mut self.mass, keep);
+        keep_in(&mut self.source, keep);
+        keep_in(&mut self.id, keep);
+    }
+
     /// Reorders every per-particle array so that new slot `k` holds old particle `order[k]`.
     /// `extra` fields (e.g. the current forces) are permuted the same way.
     pub fn permute(&mut self, order: &[u32], extra: &mut [&mut Field<T, D>]) {
@@ -136,6 +153,18 @@ impl<T: Real, const D: usize> State<T, D> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn retain_keeps_particles_together() {
+        let mut s = State::<f32, 2>::new(4);
+        s.pos[0] = vec![0.0, 1.0, 2.0, 3.0];
+        s.vel[1] = vec![5.0, 6.0, 7.0, 8.0];
+        s.retain(&[true, false, true, false]);
+        assert_eq!(s.id, vec![0, 2]);
+        assert_eq!(s.pos[0], vec![0.0, 2.0]);
+        assert_eq!(s.vel[1], vec![5.0, 7.0]);
+        assert_eq!(s.len(), 2);
+    }
 
     #[test]
     fn permute_keeps_particles_together() {

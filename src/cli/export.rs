@@ -1,15 +1,13 @@
 //! `nbody-bench export`: a scenario's initial state for another code (see `nbody_bench::export`).
 
 use crate::cli::args::ExportArgs;
-use nbody_bench::export::ExportJob;
+use nbody_bench::export::export_setup;
 
 pub fn export(args: ExportArgs) -> anyhow::Result<i32> {
     nbody_bench::output::check_outputs(&[("--out", args.out.as_path())], &[])?;
     let setup = super::setup(args.scenario, &args.system);
     setup.validate()?;
-    let bytes = setup.dispatch(ExportJob {
-        format: args.format,
-    })??;
+    let bytes = export_setup(&setup, args.format)??;
     nbody_bench::output::write_atomic(&args.out, &bytes)?;
     eprintln!(
         "wrote {} ({} particles of {})",

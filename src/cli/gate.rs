@@ -2,11 +2,10 @@
 //! baseline file on its machine class, else A/B against the baseline's revision).
 
 use crate::cli::args::GateArgs;
-use nbody_bench::clock::WallClock;
 use nbody_bench::experiment::config::SweepConfig;
 use nbody_bench::experiment::locate;
 use nbody_bench::experiment::results::{ResultsFile, utc_now};
-use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
+use nbody_bench::experiment::runner::{SweepOptions, run_sweep_wall};
 use nbody_bench::gate::ab::{self, AbPlan};
 use nbody_bench::gate::{
     AB_THRESHOLD, FILE_THRESHOLD, GateOptions, GateReport, RunInfo, base_build, compare, render,
@@ -177,7 +176,7 @@ fn fast_path(
         ..Default::default()
     };
     let mut quiet = nbody_bench::experiment::runner::Silent;
-    let report = run_sweep(config, text, &sweep, &WallClock::new(), &mut quiet)?;
+    let report = run_sweep_wall(config, text, &sweep, &mut quiet)?;
     let current = ResultsFile::load(&report.path)?;
     let judged = compare(baseline, &current, &options(args, FILE_THRESHOLD))?;
     eprintln!("gate: results kept in {}", out.display());

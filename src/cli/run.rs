@@ -3,7 +3,7 @@ use super::summary::print_summary;
 use super::{kernel_params, setup};
 use crate::cli::args::RunArgs;
 use anyhow::Context;
-use nbody_bench::run::{RunJob, RunSpec, TrajectorySpec, logical_cpus};
+use nbody_bench::run::{RunSpec, TrajectorySpec, logical_cpus, run_setup};
 
 pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     // Every output is checked before the run starts: a result is never lost at the end.
@@ -44,7 +44,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
             logical_cpus()
         );
     }
-    let outcome = setup.dispatch(RunJob(&spec, &nbody_bench::clock::WallClock::new()))??;
+    let outcome = run_setup(&setup, &spec)??;
     print_summary(&outcome);
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;

@@ -1,10 +1,9 @@
 use crate::cli::args::SweepArgs;
-use nbody_bench::clock::WallClock;
 use nbody_bench::experiment::config::SweepConfig;
 use nbody_bench::experiment::locate;
 use nbody_bench::experiment::progress;
 use nbody_bench::experiment::results::{ResultsFile, utc_now};
-use nbody_bench::experiment::runner::{SweepOptions, run_sweep};
+use nbody_bench::experiment::runner::{SweepOptions, run_sweep_wall};
 use nbody_bench::units::Duration;
 use std::path::{Path, PathBuf};
 
@@ -49,14 +48,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         nbody_bench: None,
     };
     let mut observer = progress::for_stderr();
-    let report = run_sweep(
-        &config,
-        &text,
-        &options,
-        &WallClock::new(),
-        observer.as_mut(),
-    )
-    .inspect_err(|_| {
+    let report = run_sweep_wall(&config, &text, &options, observer.as_mut()).inspect_err(|_| {
         // A new run directory that never received results is not a run: leave nothing.
         if let Some(dir) = &options.run_dir
             && !resume

@@ -3,7 +3,7 @@ use crate::cli::args::ValidateArgs;
 use nbody_bench::kernels::KernelKind;
 use nbody_bench::scenario::ScenarioKind;
 use nbody_bench::units::WallTime;
-use nbody_bench::validate::{ScenarioCheck, ValidateJob};
+use nbody_bench::validate::{ScenarioCheck, ValidateJob, validate_setup};
 use std::path::PathBuf;
 
 pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
@@ -46,7 +46,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
             threads: args.kernel_args.threads,
             want_dump: args.dump.is_some(),
         };
-        let check = s.dispatch(job)??;
+        let check = validate_setup(&s, job)??;
         if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
             let path = dump_file(path, scenarios.len(), scenario);
             nbody_bench::output::write_atomic(&path, text.as_bytes())?;
@@ -100,7 +100,7 @@ fn refuse_long_check(
         want_dump: false,
     };
     let started = std::time::Instant::now();
-    probe.dispatch(job)??;
+    validate_setup(&probe, job)??;
     let ratio = n as f64 / PROBE_N as f64;
     let wall_s = started.elapsed().as_secs_f64() * ratio * ratio;
     let limit = super::dry_run::LONG_SWEEP_S;

@@ -1,13 +1,16 @@
 //! Decompositions of a simulation over processes, without MPI itself: the spatial regions of
 //! the domain decomposition and their rebalancing ([`regions`]), the per-rank statistics and
-//! their reduction ([`stats`]), the bytes each decomposition moves ([`model`]) and the
-//! `mpi-bench` results file ([`bench_file`]). The drivers that use them with MPI are in
+//! their reduction ([`stats`]), the bytes each decomposition moves ([`model`]), the
+//! `mpi-bench` results file ([`bench_file`]), particles as message bytes ([`wire`]) and the
+//! comparison of a distributed run with a serial one ([`check`]). The drivers that use them with MPI are in
 //! `crate::mpi` (feature `mpi`); everything here builds and is tested without an MPI library.
 
 pub mod bench_file;
+pub mod check;
 pub mod model;
 pub mod regions;
 pub mod stats;
+pub mod wire;
 
 use crate::kernels::KernelKind;
 use serde::{Deserialize, Serialize};

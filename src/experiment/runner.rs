@@ -106,6 +106,24 @@ pub fn results_path(config: &SweepConfig, out: Option<&Path>) -> PathBuf {
         .join("results.json")
 }
 
+/// [`run_sweep`] timed by the wall clock, as `nbody-bench sweep` and `gate` run it. Not generic
+/// on purpose: the measurement of every system type is instantiated here, once, and not again
+/// in each crate that runs a sweep.
+pub fn run_sweep_wall(
+    config: &SweepConfig,
+    config_text: &str,
+    options: &SweepOptions,
+    observer: &mut dyn Observer,
+) -> Result<SweepReport, SweepError> {
+    run_sweep(
+        config,
+        config_text,
+        options,
+        &crate::clock::WallClock::new(),
+        observer,
+    )
+}
+
 pub fn run_sweep<C: Clock>(
     config: &SweepConfig,
     config_text: &str,

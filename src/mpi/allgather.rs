@@ -15,8 +15,8 @@
 use super::comm::Comm;
 use super::driver::{Driver, Tally};
 use super::error::MpiError;
-use super::wire::{bytes_of, bytes_of_mut};
 use crate::boundary::{Boundary, BoundaryError};
+use crate::decomp::wire::{bytes_of, bytes_of_mut};
 use crate::integrator::{drift, kick};
 use crate::kernels::{ForceKernel, KernelKind, Share};
 use crate::real::Real;

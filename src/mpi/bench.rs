@@ -4,7 +4,9 @@
 
 use super::comm::Comm;
 use super::error::MpiError;
-use crate::decomp::bench_file::{MPI_BENCH_SCHEMA, MpiBenchFile, Series, SizeTimings};
+use crate::decomp::bench_file::{
+    MPI_BENCH_SCHEMA, MpiBenchFile, Series, SizeTimings, reps_at, sizes,
+};
 use crate::experiment::results::{git_state, utc_now};
 use std::time::Instant;
 
@@ -19,23 +21,7 @@ pub struct BenchOptions {
     pub warmup: usize,
 }
 
-/// Messages up to this size get the full repetition count.
-const FULL_REPS_UP_TO: u64 = 64 * 1024;
-
 const TAG_PING: i32 = 90;
-
-/// 1, 4, 16, … up to `max`.
-pub fn sizes(max: u64) -> Vec<u64> {
-    std::iter::successors(Some(1u64), |s| s.checked_mul(4))
-        .take_while(|&s| s <= max.max(1))
-        .collect()
-}
-
-/// Timed repetitions at message size `bytes`.
-pub fn reps_at(bytes: u64, reps: usize) -> usize {
-    let scaled = reps as u64 * FULL_REPS_UP_TO / bytes.max(FULL_REPS_UP_TO);
-    (scaled as usize).max(10.min(reps)).max(1)
-}
 
 pub fn run(comm: &mut Comm, o: &BenchOptions) -> Result<Option<MpiBenchFile>, MpiError> {
     if comm.size() < 2 {
@@ -157,20 +143,4 @@ fn gather(
     });
     assert!(ok, "Allgatherv delivered wrong data");
     Ok(comm.reduce_max_to_root(&times))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn sizes_and_repetitions() {
-        assert_eq!(sizes(64), vec![1, 4, 16, 64]);
-        assert_eq!(sizes(100), vec![1, 4, 16, 64]);
-        assert_eq!(sizes(0), vec![1]);
-        assert_eq!(reps_at(8, 200), 200);
-        assert_eq!(reps_at(256 * 1024, 200), 50);
-        assert_eq!(reps_at(64 << 20, 200), 10);
-        assert_eq!(reps_at(64 << 20, 3), 3);
-    }
 }

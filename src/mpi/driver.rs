@@ -3,7 +3,7 @@
 
 use super::comm::{Comm, CommCounters};
 use super::error::MpiError;
-use super::wire::pack_particle;
+use crate::decomp::wire::pack_particle;
 use crate::kernels::WorkCounters;
 use crate::real::Real;
 use crate::state::{Field, State};
@@ -55,7 +55,7 @@ pub trait Driver<T: Real, const D: usize> {
 /// The owned particles and their forces as f64 records (a particle, then its force), for
 /// gathering the final state.
 pub fn pack_owned<T: Real, const D: usize>(state: &State<T, D>, forces: &Field<T, D>) -> Vec<f64> {
-    let mut out = Vec::with_capacity(state.len() * (super::wire::particle_values(D) + D));
+    let mut out = Vec::with_capacity(state.len() * (crate::decomp::wire::particle_values(D) + D));
     for i in 0..state.len() {
         pack_particle(state, i, &mut out);
         for f in forces.iter() {

@@ -6,16 +6,14 @@
 
 mod allgather;
 mod bench;
-mod check;
 mod comm;
 mod domain;
 mod driver;
 mod error;
 mod job;
-mod wire;
 
+pub use crate::decomp::check::CheckReport;
 pub use bench::BenchOptions;
-pub use check::CheckReport;
 pub use domain::DomainOptions;
 pub use error::MpiError;
 pub use job::{MpiSpec, RootResult};

@@ -1,7 +1,7 @@
 //! The MPI entry points on the command line. In a build without the `mpi` feature they are
-//! listed in `--help` and refuse with exit code 2 and the rebuild hint; with the feature (run
-//! without mpirun, as a single rank) they work. The distributed runs themselves are tested
-//! under mpirun by `scripts/mpi-tests.sh`.
+//! listed in `--help` and refuse with exit code 2 and the rebuild hint. With the feature (a
+//! single rank without mpirun, and the distributed runs under mpirun) they are tested by
+//! `scripts/mpi-tests.sh`.
 
 use std::process::{Command, Output};
 
@@ -109,32 +109,4 @@ fn without_the_feature_mpi_entry_points_exit_2_with_the_rebuild_hint() {
     }
     assert!(!out.exists(), "no output file");
     assert!(!dir.path().join("m").exists(), "no results directory");
-}
-
-#[cfg(feature = "mpi")]
-#[test]
-fn with_the_feature_a_single_rank_runs_without_mpirun() {
-    let dir = tempfile::tempdir().unwrap();
-    let json = dir.path().join("r.json");
-    let o = bin(&[
-        "run",
-        "--scenario",
-        "lj-box",
-        "--kernel",
-        "cell-list",
-        "--decomp",
-        "domain",
-        "-n",
-        "500",
-        "--steps",
-        "5",
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", text(&o).1);
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
-    assert_eq!(v["mpi"]["ranks"], 1);
-    assert_eq!(v["mpi"]["decomposition"], "domain");
-    assert_eq!(v["mpi"]["step_ns"].as_array().unwrap().len(), 5);
 }

@@ -10,10 +10,10 @@
 
 use super::Domain;
 use crate::decomp::regions::point_box_distance2;
+use crate::decomp::wire::{bytes_of, floats_of};
 use crate::mpi::comm::Comm;
 use crate::mpi::driver::TAG_GHOSTS;
 use crate::mpi::error::MpiError;
-use crate::mpi::wire::{bytes_of, floats_of};
 use crate::real::Real;
 use crate::state::{State, zero_field};
 use std::time::Instant;

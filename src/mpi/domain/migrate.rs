@@ -3,12 +3,12 @@
 
 use super::{BINS_PER_REGION, Domain};
 use crate::boundary::BoundaryError;
+use crate::decomp::wire::{bytes_of, pack_particle, unpack_particles};
 use crate::mpi::comm::Comm;
 use crate::mpi::driver::TAG_MIGRATE;
 use crate::mpi::error::MpiError;
-use crate::mpi::wire::{bytes_of, pack_particle, unpack_particles};
 use crate::real::Real;
-use crate::state::{State, zero_field};
+use crate::state::zero_field;
 
 /// Values of the per-step status every rank shares: error flag, far migrants, owned count.
 const STATUS: usize = 3;
@@ -115,7 +115,7 @@ impl<T: Real, const D: usize> Domain<T, D> {
             for &i in leaving {
                 keep[i] = false;
             }
-            retain(&mut self.owned, &keep);
+            self.owned.retain(&keep);
         }
         for bytes in arrived {
             unpack_particles(bytes, &mut self.owned);
@@ -123,37 +123,5 @@ impl<T: Real, const D: usize> Domain<T, D> {
         if self.forces[0].len() != self.owned.len() {
             self.forces = zero_field(self.owned.len());
         }
-    }
-}
-
-/// Keeps the particles whose `keep` entry is true, in order.
-fn retain<T: Real, const D: usize>(state: &mut State<T, D>, keep: &[bool]) {
-    fn keep_in<V: Copy>(v: &mut Vec<V>, keep: &[bool]) {
-        let mut k = keep.iter();
-        v.retain(|_| *k.next().expect("one flag per particle"));
-    }
-    for d in 0..D {
-        keep_in(&mut state.pos[d], keep);
-        keep_in(&mut state.vel[d], keep);
-    }
-    keep_in(&mut state.mass, keep);
-    keep_in(&mut state.source, keep);
-    keep_in(&mut state.id, keep);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn retain_keeps_particles_together() {
-        let mut s = State::<f32, 2>::new(4);
-        s.pos[0] = vec![0.0, 1.0, 2.0, 3.0];
-        s.vel[1] = vec![5.0, 6.0, 7.0, 8.0];
-        retain(&mut s, &[true, false, true, false]);
-        assert_eq!(s.id, vec![0, 2]);
-        assert_eq!(s.pos[0], vec![0.0, 2.0]);
-        assert_eq!(s.vel[1], vec![5.0, 7.0]);
-        assert_eq!(s.len(), 2);
     }
 }
