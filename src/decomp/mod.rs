@@ -2,17 +2,28 @@
 //! the domain decomposition and their rebalancing ([`regions`]), the per-rank statistics and
 //! their reduction ([`stats`]), the bytes each decomposition moves ([`model`]), the
 //! `mpi-bench` results file ([`bench_file`]), particles as message bytes ([`wire`]) and the
-//! comparison of a distributed run with a serial one ([`check`]). The drivers that use them with MPI are in
-//! `crate::mpi` (feature `mpi`); everything here builds and is tested without an MPI library.
+//! comparison of a distributed run with a serial one ([`check`]). The drivers that use them
+//! with MPI are in `crate::mpi` (feature `mpi`); everything here builds and is tested without
+//! an MPI library.
+//!
+//! The geometry of a distributed Barnes-Hut, also MPI-free: the domains of the ranks, either
+//! the octants of the root cube in Morton order ([`octants`], the gravity source's scheme) or a
+//! weighted orthogonal recursive bisection for any rank count ([`orb`]), both behind
+//! [`Domains`]; and the locally essential tree ([`essential`]): the nodes and bodies of one
+//! rank's octree that another rank's domain needs, selected with the octree's own opening test.
 
 pub mod bench_file;
 pub mod check;
+pub mod essential;
 pub mod model;
+pub mod octants;
+pub mod orb;
 pub mod regions;
 pub mod stats;
 pub mod wire;
 
 use crate::kernels::KernelKind;
+use crate::real::Real;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -66,6 +77,53 @@ impl Decomposition {
             Err(DecompError::DomainKernel(kernel.name()))
         }
     }
+}
+
+/// A half-open box `[lo, hi)`.
+pub type Aabb<const D: usize> = ([f64; D], [f64; D]);
+
+/// The spatial domains of the ranks of a tree decomposition: who owns a point, and the boxes
+/// that make up each rank's domain (what the locally essential tree is selected against).
+pub trait Domains<const D: usize> {
+    fn ranks(&self) -> usize;
+
+    /// The rank that owns `x`; points outside the root box go to a rank whose domain touches
+    /// the nearest wall.
+    fn owner(&self, x: [f64; D]) -> usize;
+
+    /// Disjoint half-open boxes whose union is the domain of `rank` (the root box's top walls
+    /// belong to the boxes that touch them); empty when the rank owns no space.
+    fn boxes(&self, rank: usize) -> Vec<Aabb<D>>;
+
+    /// The rank of every body of `pos` (one array per coordinate, as in `State::pos`).
+    fn assign<T: Real>(&self, pos: &[Vec<T>; D]) -> Vec<usize> {
+        let n = pos.first().map_or(0, Vec::len);
+        (0..n)
+            .map(|i| self.owner(std::array::from_fn(|d| pos[d][i].as_f64())))
+            .collect()
+    }
+
+    /// Bodies per rank.
+    fn counts<T: Real>(&self, pos: &[Vec<T>; D]) -> Vec<usize> {
+        let mut counts = vec![0; self.ranks()];
+        for r in self.assign(pos) {
+            counts[r] += 1;
+        }
+        counts
+    }
+}
+
+/// Why a tree decomposition could not be built.
+#[derive(Debug, Error, PartialEq)]
+pub enum DomainError {
+    #[error("a decomposition needs at least one rank")]
+    NoRanks,
+    #[error("the root box must be finite with hi >= lo (got [{lo:?}, {hi:?}])")]
+    BadBox { lo: Vec<f64>, hi: Vec<f64> },
+    #[error("{weights} weights for {bodies} bodies; give one weight per body")]
+    WeightCount { weights: usize, bodies: usize },
+    #[error("weight {value} of body {body} is not a finite number >= 0")]
+    BadWeight { body: usize, value: f64 },
 }
 
 #[cfg(test)]

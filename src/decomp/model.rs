@@ -2,9 +2,20 @@
 //! the cutoff: the inputs of an α-β (latency-bandwidth) prediction of communication time,
 //! `T(p) = messages · α + bytes · β`, fitted on `mpi-bench` timings (see `docs/mpi.md`).
 //!
+//! The tree decompositions of a Barnes-Hut run: the gravity source's octants, which replicate
+//! the bodies (bytes grow like n), and the locally essential tree, whose size grows like the
+//! surface of a domain; modelled on a uniform cloud, or counted on a given one.
+//!
 //! Counts are for the busiest rank and one step, ignoring migration (a small fraction of the
 //! ghosts at the time steps the scenarios use) and the per-step status exchange (one small
 //! collective, `log2 p` latencies).
+
+use super::Domains;
+use super::essential::{self, body_entry_values, node_entry_values};
+use super::regions::grid_dims;
+use crate::kernels::{Multipole, Octree};
+use crate::real::Real;
+use crate::state::State;
 
 /// Bytes per particle of a ghost: its coordinates and its source strength.
 pub fn ghost_bytes(dim: usize, value_bytes: usize) -> usize {
@@ -31,15 +42,23 @@ pub fn allgather_messages_per_rank(ranks: usize) -> f64 {
 pub fn domain_ghosts_per_rank(n: usize, density: f64, rc: f64, dims: &[usize]) -> f64 {
     let d = dims.len() as i32;
     let side = (n as f64 / density).powf(1.0 / d as f64);
+    density * shell_volume(side, rc, dims)
+}
+
+/// Volume within distance `r` (per axis) of the busiest region of the grid `dims` over a box
+/// of side `side`, outside the region and inside the box: `Π_a (e_a + m_a) − Π_a e_a`, with
+/// `e_a = side / dims[a]` and `m_a` = 0, `r` or `2r` as the region has 0, 1 or 2 neighbours
+/// along axis a, clipped to the box.
+fn shell_volume(side: f64, r: f64, dims: &[usize]) -> f64 {
     let mut outer = 1.0;
     let mut inner = 1.0;
     for &k in dims {
         let e = side / k.max(1) as f64;
-        let margin = rc * (k.saturating_sub(1).min(2)) as f64;
+        let margin = r * (k.saturating_sub(1).min(2)) as f64;
         outer *= e + margin.min(side - e);
         inner *= e;
     }
-    density * (outer - inner)
+    outer - inner
 }
 
 /// Spatial decomposition: ghost bytes the busiest rank receives per step.
@@ -69,9 +88,136 @@ pub fn domain_messages_per_rank(dims: &[usize]) -> f64 {
     4.0 * neighbours as f64
 }
 
+/// The octant scheme of the gravity source, as modelled here: each rank owns octants of the
+/// root cube (`decomp::octants`) but builds the whole tree, so every step it receives every
+/// other rank's bodies as (position, mass) records — masses travel because bodies migrate
+/// between octants. Bytes of the busiest receiver, the rank that owns fewest bodies, when the
+/// ranks own `counts` bodies: `(n − min counts) · (D + 1) · w`. Grows like n, as allgather.
+pub fn octants_bytes_per_rank(counts: &[usize], dim: usize, value_bytes: usize) -> f64 {
+    let n: usize = counts.iter().sum();
+    let own = counts.iter().copied().min().unwrap_or(0);
+    (n - own) as f64 * (body_entry_values(dim) * value_bytes) as f64
+}
+
+/// The octant scheme on a uniform cloud of `n` bodies and `ranks = 8^k` ranks (equal counts).
+pub fn octants_uniform_bytes_per_rank(
+    n: usize,
+    ranks: usize,
+    dim: usize,
+    value_bytes: usize,
+) -> f64 {
+    let ranks = ranks.max(1);
+    (n - n / ranks) as f64 * (body_entry_values(dim) * value_bytes) as f64
+}
+
+/// The locally essential tree the busiest rank receives per step on a uniform cloud of `n`
+/// bodies over `ranks` compact domains (the grid of `regions::grid_dims`, as ORB gives on a
+/// uniform cloud), at opening angle `theta` and leaf size `leaf_size`: (bodies, nodes).
+///
+/// At unit density a leaf has side `s = leaf^(1/D)`. The receiver gets the bodies of the
+/// leaves whose centres lie within `s/θ` of its domain, and the nodes of side `s·2^j`
+/// (j = 0, 1, … up to the cloud) that lie between `s·2^j/θ` and `s·2^(j+1)/θ` (a node is
+/// exported where it passes and its parent does not), each shell clipped to the cloud as in
+/// `domain_ghosts_per_rank`. Close to the domain the shells are thin, so both counts grow like
+/// the domain's surface, `(n/p)^((D−1)/D)`, and not like n: doubling n at fixed p multiplies
+/// them by about `2^((D−1)/D)` (1.59 in 3-D) plus a logarithmic far-field term; at θ = 0 the
+/// shells cover the cloud and the receiver gets every other body.
+pub fn tree_entries_per_rank(
+    n: usize,
+    ranks: usize,
+    dim: usize,
+    theta: f64,
+    leaf_size: usize,
+) -> (f64, f64) {
+    let side = (n as f64).powf(1.0 / dim as f64);
+    let dims = grid_dims_of(ranks, dim, side);
+    let leaf = (leaf_size.max(1) as f64).powf(1.0 / dim as f64);
+    let reach = |s: f64| {
+        if theta > 0.0 {
+            s / theta
+        } else {
+            f64::INFINITY
+        }
+    };
+    let bodies = shell_volume(side, reach(leaf), &dims);
+    let mut nodes = 0.0;
+    let mut s = leaf;
+    while theta > 0.0 && s < side {
+        let band = shell_volume(side, reach(2.0 * s), &dims) - shell_volume(side, reach(s), &dims);
+        nodes += band / s.powi(dim as i32);
+        s *= 2.0;
+    }
+    (bodies, nodes)
+}
+
+/// [`tree_entries_per_rank`] in bytes: bodies with their strength, nodes with their strength
+/// and `moment_values` second moments (0 for monopoles, `D(D+1)/2 + 1` for quadrupoles).
+pub fn tree_bytes_per_rank(
+    n: usize,
+    ranks: usize,
+    dim: usize,
+    theta: f64,
+    leaf_size: usize,
+    moment_values: usize,
+    value_bytes: usize,
+) -> f64 {
+    let (bodies, nodes) = tree_entries_per_rank(n, ranks, dim, theta, leaf_size);
+    (bodies * body_entry_values(dim) as f64 + nodes * node_entry_values(dim, moment_values) as f64)
+        * value_bytes as f64
+}
+
+/// The locally essential tree of a given cloud, counted rather than modelled: every rank
+/// builds the octree of the bodies it owns under `domains` and selects the essential set of
+/// every other rank's domain (`essential::select`); returns the bytes each rank receives.
+pub fn tree_bytes_of_cloud<T: Real, const D: usize>(
+    cloud: &State<T, D>,
+    domains: &impl Domains<D>,
+    theta: f64,
+    leaf_size: usize,
+    multipole: Multipole,
+) -> Vec<f64> {
+    let owners = domains.assign(&cloud.pos);
+    let ranks = domains.ranks();
+    let boxes: Vec<_> = (0..ranks).map(|r| domains.boxes(r)).collect();
+    let mut received = vec![0.0; ranks];
+    for sender in 0..ranks {
+        let mine: Vec<usize> = (0..cloud.len()).filter(|&i| owners[i] == sender).collect();
+        let mut own = State::new(mine.len());
+        for (k, &i) in mine.iter().enumerate() {
+            for d in 0..D {
+                own.pos[d][k] = cloud.pos[d][i];
+            }
+            own.source[k] = cloud.source[i];
+        }
+        // The tree needs no force law to be built.
+        let mut tree = Octree::with_multipole((), theta, leaf_size, multipole);
+        tree.build(&own);
+        for (r, domain) in boxes.iter().enumerate().filter(|&(r, _)| r != sender) {
+            let set = essential::select(&tree.view(), domain);
+            received[r] += set.bytes(D, std::mem::size_of::<T>()) as f64;
+        }
+    }
+    received
+}
+
+fn grid_dims_of(ranks: usize, dim: usize, side: f64) -> Vec<usize> {
+    match dim {
+        2 => grid_dims::<2>(ranks, [side; 2]).to_vec(),
+        3 => grid_dims::<3>(ranks, [side; 3]).to_vec(),
+        _ => {
+            let mut dims = vec![1; dim.max(1)];
+            dims[0] = ranks.max(1);
+            dims
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::decomp::octants::{Octants, root_cube};
+    use crate::decomp::orb::Orb;
+    use crate::testing::{SEED_1, random_state};
 
     #[test]
     fn allgather_moves_all_but_the_own_block() {
@@ -101,5 +247,76 @@ mod tests {
         assert!(b > a && b < 2.5 * a, "{a} {b}");
         assert_eq!(domain_messages_per_rank(&[2, 1]), 4.0);
         assert_eq!(domain_messages_per_rank(&[3, 3]), 32.0);
+    }
+
+    #[test]
+    fn octants_replicate_the_bodies() {
+        assert_eq!(octants_bytes_per_rank(&[10, 20, 30], 3, 8), 50.0 * 32.0);
+        assert_eq!(octants_bytes_per_rank(&[], 3, 8), 0.0);
+        assert_eq!(octants_uniform_bytes_per_rank(8000, 8, 3, 8), 7000.0 * 32.0);
+        // Counted on a uniform cloud with the octant domains: close to the model.
+        let s = random_state::<f64, 3>(8000, 1.0, false, SEED_1);
+        let (lo, side) = root_cube(&s.pos);
+        let counts = Octants::new(lo, side, 8, &s.pos)
+            .expect("octants")
+            .counts(&s.pos);
+        let counted = octants_bytes_per_rank(&counts, 3, 8);
+        let modelled = octants_uniform_bytes_per_rank(8000, 8, 3, 8);
+        assert!(
+            (counted / modelled - 1.0).abs() < 0.02,
+            "{counted} vs {modelled}"
+        );
+    }
+
+    #[test]
+    fn tree_bytes_grow_like_the_surface_and_allgather_like_n() {
+        for dim in [2, 3] {
+            let surface = 2f64.powf((dim - 1) as f64 / dim as f64);
+            for p in [2, 8, 64] {
+                let tree = |n| tree_bytes_per_rank(n, p, dim, 0.5, 8, 0, 8);
+                let ratio = tree(2_000_000) / tree(1_000_000);
+                // Thick shells around small domains (p = 64) grow slower than the surface.
+                assert!(
+                    ratio > 1.2 && ratio < surface * 1.1,
+                    "{dim}-D, p = {p}: ×{ratio} for 2× n (surface ×{surface})"
+                );
+                let all = |n| allgather_bytes_per_rank(n, p, dim, 8);
+                assert!((all(2_000_000) / all(1_000_000) - 2.0).abs() < 1e-6);
+                let oct = |n| octants_uniform_bytes_per_rank(n, p, dim, 8);
+                assert!((oct(2_000_000) / oct(1_000_000) - 2.0).abs() < 1e-6);
+                assert!(tree(1_000_000) < 0.5 * all(1_000_000), "{dim}-D, p = {p}");
+            }
+        }
+        // θ = 0: every other body, nothing else.
+        let (bodies, nodes) = tree_entries_per_rank(8000, 8, 3, 0.0, 8);
+        assert!(
+            (bodies - 7000.0).abs() < 1e-6 && nodes == 0.0,
+            "{bodies} {nodes}"
+        );
+        // Quadrupoles make the nodes, not the bodies, dearer.
+        let mono = tree_bytes_per_rank(100_000, 8, 3, 0.5, 8, 0, 8);
+        let quad = tree_bytes_per_rank(100_000, 8, 3, 0.5, 8, 7, 8);
+        let (_, nodes) = tree_entries_per_rank(100_000, 8, 3, 0.5, 8);
+        assert!((quad - mono - nodes * 7.0 * 8.0).abs() < 1e-6 * quad);
+    }
+
+    #[test]
+    fn counted_tree_bytes_follow_the_model() {
+        // Two slabs of a uniform cloud: the counted LET grows like the cut face, and the
+        // model is within a factor 2 of the count.
+        let counted = |n: usize| {
+            let s = random_state::<f64, 3>(n, 1.0, false, SEED_1);
+            let orb = Orb::over(2, &s.pos, &vec![1.0; n]).expect("orb");
+            let bytes = tree_bytes_of_cloud(&s, &orb, 0.5, 8, Multipole::Monopole);
+            bytes.into_iter().fold(0.0, f64::max)
+        };
+        let (a, b) = (counted(8000), counted(16_000));
+        assert!(b / a < 1.8, "counted: ×{} for 2× n", b / a);
+        let modelled = tree_bytes_per_rank(16_000, 2, 3, 0.5, 8, 0, 8);
+        assert!(
+            modelled / b > 0.5 && modelled / b < 2.0,
+            "model {modelled} vs count {b}"
+        );
+        assert!(b < allgather_bytes_per_rank(16_000, 2, 3, 8));
     }
 }

@@ -19,7 +19,8 @@ pub mod verlet;
 
 pub use cell_list::CellList;
 pub use naive::Naive;
-pub use octree::{Multipole, Octree};
+pub(crate) use octree::interleave;
+pub use octree::{Multipole, Octree, TreeView};
 pub use per_thread::PerThread;
 pub use share::Share;
 pub use symmetric::Symmetric;

@@ -11,6 +11,8 @@
 //! from its centre of strength to the nearest point of the group's bounding box, so θ = 0 gives
 //! the direct sum. Sources of each sign get their own tree (Coulomb), and every group walks all
 //! trees. Parallel over groups; the forces do not depend on the thread count.
+//! The opening test is `Node::far_from_box`; [`TreeView`] exposes a built tree, with that same
+//! test, to the locally essential tree of `decomp::essential`.
 //!
 //! Counters: `nodes_accepted` and `nodes_opened` count, summed over groups, the nodes whose test
 //! passed and failed (a failed node is split into its children, or its particles are used
@@ -27,6 +29,7 @@ mod moments;
 mod node;
 mod nodes;
 mod tree;
+mod view;
 mod walk;
 
 #[cfg(test)]
@@ -40,7 +43,10 @@ use crate::state::{Field, State};
 use std::ops::Range;
 use std::sync::Mutex;
 use std::time::Instant;
+/// Morton keys, for domains that follow the tree's order (`decomp::octants`).
+pub(crate) use tree::interleave;
 use tree::{Group, Tree};
+pub use view::TreeView;
 use walk::{Scratch, Totals, eval_groups, for_group_runs};
 
 /// Most particles in a target group sharing one interaction list. Larger groups walk the

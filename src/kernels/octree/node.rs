@@ -1,4 +1,8 @@
-//! One node of the tree: what the build writes, the walk tests and the moments read.
+//! One node of the tree: what the build writes, the walk tests and the moments read, and the
+//! opening test itself ([`Node::far_from_box`]), written once for the grouped walk and for the
+//! locally essential tree of `decomp::essential`.
+
+use crate::real::Real;
 
 /// One tree node: a Morton cell and the particles `start..end` (sorted order) inside it.
 #[derive(Clone, Copy, Debug)]
@@ -16,4 +20,28 @@ pub(super) struct Node<T, const D: usize> {
     pub first: u32,
     /// Number of children; 0 for a leaf.
     pub children: u32,
+}
+
+impl<T: Real, const D: usize> Node<T, D> {
+    /// The opening test: whether the node may act as a multipole on every point of the box
+    /// `[lo, hi]`, i.e. `side/d < θ` with `d` the distance from its centre of strength to the
+    /// nearest point of the box (`d² > crit2`). A point is the box `[x, x]`. Branch-free, as the
+    /// walk tests whole families with it; a NaN distance fails the test, so the node is opened.
+    #[inline(always)]
+    pub fn far_from_box(&self, lo: &[T; D], hi: &[T; D]) -> bool {
+        let mut d2 = T::zero();
+        for d in 0..D {
+            let x = self.com[d];
+            let e = max(max(lo[d] - x, x - hi[d]), T::zero());
+            d2 += e * e;
+        }
+        d2 > self.crit2
+    }
+}
+
+/// The larger of two values as a plain compare-and-select (a NaN gives `b`): `Float::max`
+/// adds NaN fix-ups that double the cost of the node test.
+#[inline(always)]
+fn max<T: Real>(a: T, b: T) -> T {
+    if a > b { a } else { b }
 }

@@ -6,9 +6,7 @@ use super::*;
 use crate::kernels::Naive;
 use crate::physics::{Coulomb, Gravity};
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, random_state};
-use rand::{Rng, SeedableRng};
-use rand_pcg::Pcg64Mcg;
+use crate::testing::{SEED_1, SEED_2, plummer_state as plummer, random_state};
 
 fn pool(p: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
@@ -60,41 +58,6 @@ fn median_rel_err<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> 
         .collect();
     errs.sort_by(f64::total_cmp);
     errs[n / 2]
-}
-
-/// A Plummer sphere (scale radius 1, total mass 1), clustered: the centre is ~10⁴× denser than
-/// r = 5. In 2-D, the projected Plummer disc (surface density ∝ (1 + R²)⁻²), which is as
-/// centrally concentrated; radii of the 3-D profile with 2-D directions would leave a hole.
-fn plummer<T: Real, const D: usize>(n: usize, seed: u64) -> State<T, D> {
-    let mut rng = Pcg64Mcg::seed_from_u64(seed);
-    let mut s = State::new(n);
-    for i in 0..n {
-        let r = loop {
-            let u: f64 = rng.random_range(1e-9..1.0);
-            // Inverse of the enclosed-mass fraction: m(r) = r³/(1+r²)^{3/2}, m(R) = R²/(1+R²).
-            let r = if D == 3 {
-                1.0 / (u.powf(-2.0 / 3.0) - 1.0).sqrt()
-            } else {
-                (u / (1.0 - u)).sqrt()
-            };
-            if r < 50.0 {
-                break r;
-            }
-        };
-        let dir: [f64; D] = loop {
-            let v: [f64; D] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
-            let l2: f64 = v.iter().map(|x| x * x).sum();
-            if l2 > 1e-6 && l2 <= 1.0 {
-                break v.map(|x| x / l2.sqrt());
-            }
-        };
-        for d in 0..D {
-            s.pos[d][i] = T::of(r * dir[d]);
-        }
-        s.source[i] = T::of(1.0 / n as f64);
-        s.mass[i] = s.source[i];
-    }
-    s
 }
 
 fn gravity<T: Real>() -> Gravity<T> {

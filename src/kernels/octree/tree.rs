@@ -325,7 +325,7 @@ fn common_level<const D: usize>(a: u64, b: u64) -> u32 {
 /// Interleaves the cell coordinates into a Morton key: bit `b` of dimension `d` goes to bit
 /// `D·b + d`, so that the top `D` bits are the root's child index.
 #[inline(always)]
-fn interleave<const D: usize>(cell: [u64; D]) -> u64 {
+pub(crate) fn interleave<const D: usize>(cell: [u64; D]) -> u64 {
     match D {
         2 => spread2(cell[0]) | spread2(cell[1]) << 1,
         3 => spread3(cell[0]) | spread3(cell[1]) << 1 | spread3(cell[2]) << 2,

@@ -154,17 +154,10 @@ fn test_family<T: Real, const D: usize, const QUAD: bool>(
     let accepted_nodes = &mut list.accepted[qp..qp + quad];
     let (mut accepted, mut opened) = (0, 0);
     for (c, node) in tree.nodes[family.clone()].iter().enumerate() {
-        // Squared distance from the centre of strength to the nearest point of the box.
-        let mut d2 = T::zero();
-        for d in 0..D {
-            let x = node.com[d];
-            let e = max(max(g.lo[d] - x, x - g.hi[d]), T::zero());
-            d2 += e * e;
-        }
         // A node holding some of the group's own particles is never accepted (it would count
         // them, and the self-pairs, twice); the criterion alone ensures it for θ < 1/√D only.
         let own = (node.start < g.end) & (node.end > g.start);
-        let accept = (d2 > node.crit2) & !own;
+        let accept = node.far_from_box(&g.lo, &g.hi) & !own;
         if QUAD {
             accepted_nodes[accepted] = (family.start + c) as u32;
         } else {
@@ -185,13 +178,6 @@ fn test_family<T: Real, const D: usize, const QUAD: bool>(
     list.stack.truncate(sp + opened);
     work.nodes_accepted += accepted as u64;
     work.nodes_opened += opened as u64;
-}
-
-/// The larger of two values as a plain compare-and-select (a NaN gives `b`): `Float::max`
-/// adds NaN fix-ups that double the cost of the node test.
-#[inline(always)]
-fn max<T: Real>(a: T, b: T) -> T {
-    if a > b { a } else { b }
 }
 
 /// Builds the interaction list of a group: its own particles first (at slots 0..m, so target
