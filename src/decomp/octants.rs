@@ -40,14 +40,7 @@ pub struct Octants<const D: usize> {
 /// The bounding cube of the bodies as the octree computes it: the lower corner of their
 /// bounding box and its longest side (1 when the bodies coincide or there are none).
 pub fn root_cube<T: Real, const D: usize>(pos: &[Vec<T>; D]) -> ([f64; D], f64) {
-    let mut lo = [f64::INFINITY; D];
-    let mut hi = [f64::NEG_INFINITY; D];
-    for d in 0..D {
-        for &x in &pos[d] {
-            lo[d] = lo[d].min(x.as_f64());
-            hi[d] = hi[d].max(x.as_f64());
-        }
-    }
+    let (lo, hi) = super::orb::bounding_box(pos);
     let side = (0..D).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
     if !lo.iter().all(|x| x.is_finite()) {
         return ([0.0; D], 1.0);
