@@ -7,8 +7,9 @@
 #   scripts/report.sh --fresh    measure everything again (old results kept as .bak copies)
 #   scripts/report.sh --report   only regenerate REPORT.md from the committed results
 #
-# About 10 minutes on a 2-vCPU AMD EPYC (2026-12-01). Run it on a quiet machine: the sweeps
-# record the background load they saw, and the report shows it.
+# About 35 minutes on a 2-vCPU Intel Xeon (2026-12-02), 9 of them the pytreegrav comparison
+# (numba compiles in every run). Run it on a quiet machine: the sweeps record the background
+# load they saw, and the report shows it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
