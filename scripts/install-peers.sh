@@ -6,16 +6,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
-if ! command -v lmp >/dev/null 2>&1; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "installing lammps"
-        apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps >/dev/null
-    else
-        echo "LAMMPS (lmp) is missing; install it with: sudo apt-get install -y lammps" >&2
-        exit 2
-    fi
-fi
+scripts/install-lammps.sh
 
 venv=.peers/venv
 if ! "$venv/bin/python" -c "import pytreegrav, numba, numpy" >/dev/null 2>&1; then

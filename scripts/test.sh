@@ -43,17 +43,8 @@ NBODY_BENCH_BIN="$bin" scripts/ci-gate.sh
 
 step "every test"
 # The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
-# without `lmp`: install it when missing (as root, with apt).
-if ! command -v lmp >/dev/null 2>&1; then
-    if [ "$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then
-        echo "installing lammps"
-        apt-get update -qq
-        DEBIAN_FRONTEND=noninteractive apt-get install -y -qq lammps >/dev/null
-    else
-        echo "LAMMPS (lmp) is missing and this is not root: sudo apt-get install -y lammps" >&2
-        exit 2
-    fi
-fi
+# without `lmp`: install it when missing (as root, with apt; scripts/install-lammps.sh).
+scripts/install-lammps.sh
 # The unit tests; the suite but its timing tests; those alone on one test thread
 # (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
 cargo test --release --lib --bins

@@ -74,9 +74,16 @@ pub fn run(launch: &Launch, dir: &Path, timeout_s: f64) -> std::io::Result<Finis
     let err_path = dir.join("stderr.txt");
     let stdout = std::fs::File::create(&out_path)?;
     let stderr = std::fs::File::create(&err_path)?;
-    let mut command = Command::new(&launch.argv[0]);
+    // The config refuses an empty command; a launch built otherwise is an error, not a panic.
+    let Some((program, args)) = launch.argv.split_first() else {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            "an external command needs at least the program to run",
+        ));
+    };
+    let mut command = Command::new(program);
     command
-        .args(&launch.argv[1..])
+        .args(args)
         .envs(launch.env.iter().map(|(k, v)| (k, v)))
         .current_dir(dir)
         .stdin(Stdio::null())
