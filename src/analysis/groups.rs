@@ -88,15 +88,21 @@ impl SeriesKey {
         if let Some(d) = self.decomp {
             s.push_str(&format!(" ({})", d.name()));
         }
-        match (self.threads, self.ranks) {
-            (Some(t), Some(1)) if t > 1 => s.push_str(&format!(", {t} threads")),
-            (Some(1), Some(r)) if r > 1 => s.push_str(&format!(", {r} ranks")),
-            (Some(t), Some(r)) if t > 1 || r > 1 => {
-                s.push_str(&format!(", {t} threads × {r} ranks"))
-            }
-            _ => {}
+        if let (Some(t), Some(r)) = (self.threads, self.ranks) {
+            s.push_str(&workers_suffix(t, r));
         }
         s
+    }
+}
+
+/// The workers of a label: nothing for one, else ", 2 threads", ", 2 ranks" or
+/// ", 2 threads × 2 ranks".
+pub fn workers_suffix(threads: usize, ranks: usize) -> String {
+    match (threads, ranks) {
+        (1, 1) => String::new(),
+        (t, 1) => format!(", {t} threads"),
+        (1, r) => format!(", {r} ranks"),
+        (t, r) => format!(", {t} threads × {r} ranks"),
     }
 }
 
@@ -254,4 +260,17 @@ fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64)
         .filter_map(|round| Some(f(round.mpi.as_ref()?) / round.steps.max(1) as f64))
         .collect();
     (!per_step.is_empty()).then(|| per_step.iter().sum::<f64>() / per_step.len() as f64)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::workers_suffix;
+
+    #[test]
+    fn workers_are_named_in_labels() {
+        assert_eq!(workers_suffix(1, 1), "");
+        assert_eq!(workers_suffix(2, 1), ", 2 threads");
+        assert_eq!(workers_suffix(1, 2), ", 2 ranks");
+        assert_eq!(workers_suffix(2, 2), ", 2 threads × 2 ranks");
+    }
 }

@@ -5,7 +5,7 @@
 //! is compared at equal accuracy.
 
 use super::ThetaAnalysis;
-use super::groups::Point;
+use super::groups::{Point, workers_suffix};
 use crate::stats::{BOOTSTRAP_RESAMPLES, bootstrap_ratio_ci};
 use serde::Serialize;
 
@@ -73,15 +73,6 @@ pub fn case_label(p: &Point) -> String {
     s
 }
 
-fn workers_suffix(threads: usize, ranks: usize) -> String {
-    match (threads, ranks) {
-        (1, 1) => String::new(),
-        (t, 1) => format!(", {t} threads"),
-        (1, r) => format!(", {r} ranks"),
-        (t, r) => format!(", {t} threads × {r} ranks"),
-    }
-}
-
 fn ns_per_particle(p: &Point, seconds: f64) -> f64 {
     seconds * 1e9 / p.n.max(1) as f64
 }
@@ -143,19 +134,6 @@ pub fn cost_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
     })
 }
 
-/// The series label of a sweep over θ, without θ.
-fn theta_label(t: &ThetaAnalysis) -> String {
-    let mut s = t.series.kernel.name().to_string();
-    if t.series.multipole != crate::kernels::Multipole::Monopole {
-        s.push_str(&format!(" {}", t.series.multipole.name()));
-    }
-    s.push_str(&workers_suffix(
-        t.series.threads.unwrap_or(1),
-        t.series.ranks.unwrap_or(1),
-    ));
-    s
-}
-
 fn error_points(t: &ThetaAnalysis) -> Vec<(f64, f64)> {
     t.points
         .iter()
@@ -193,8 +171,8 @@ pub fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
                 n: o.series.n.unwrap_or(0),
                 workers: workers(o),
                 error: EQUAL_ERROR,
-                ours: theta_label(o),
-                theirs: theta_label(t),
+                ours: o.label.clone(),
+                theirs: t.label.clone(),
                 ours_s,
                 theirs_s,
                 speedup: ours_s.zip(theirs_s).map(|(o, t)| t / o),
@@ -230,13 +208,5 @@ mod tests {
         assert!(cost_at_error(&rev, 1e-3).is_some());
         // Points without an error or a time do not count.
         assert_eq!(cost_at_error(&[(0.0, 1.0), (f64::NAN, 1.0)], 1e-3), None);
-    }
-
-    #[test]
-    fn workers_are_named_as_in_the_series_labels() {
-        assert_eq!(workers_suffix(1, 1), "");
-        assert_eq!(workers_suffix(2, 1), ", 2 threads");
-        assert_eq!(workers_suffix(1, 2), ", 2 ranks");
-        assert_eq!(workers_suffix(2, 2), ", 2 threads × 2 ranks");
     }
 }
