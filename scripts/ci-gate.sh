@@ -3,11 +3,13 @@
 # runs on. Exit 0 when no case regressed, 1 when one did, 2 when it cannot judge (bad input, a
 # base revision that is missing or does not build) — it never passes without judging.
 #
-# - If results/baseline/ci.json was measured on this machine class (CPU model, CPU signature,
-#   logical CPUs), the gate sweeps configs/ci.toml with this build and compares with it (the
-#   fast path, about 25 s; threshold 0.25).
-# - Otherwise it builds the baseline's commit in a git worktree (cached in target/gate-base/)
-#   and measures both builds here, interleaved case by case (A/B; threshold 0.10).
+# - results/baseline/ holds one baseline per machine class (CPU model, CPU signature, logical
+#   CPUs). If one was measured on this machine class, the gate sweeps its config
+#   (configs/ci.toml) with this build and compares with it (the fast path, about 25 s;
+#   threshold 0.25).
+# - Otherwise it builds the newest baseline's commit in a git worktree (cached in
+#   target/gate-base/) and measures both builds here, interleaved case by case (A/B; threshold
+#   0.10). scripts/refresh-baseline.sh on such a machine adds its class's file.
 #
 # NBODY_BENCH_GATE_AGAINST=REV always runs A/B against REV: a pull-request job sets it to the
 # pull request's base commit (for example NBODY_BENCH_GATE_AGAINST="$GITHUB_BASE_SHA" after a
@@ -26,7 +28,7 @@ if [ -z "$bin" ]; then
     cargo build --release --quiet
     bin=target/release/nbody-bench
 fi
-args=(--baseline results/baseline/ci.json)
+args=(--baseline results/baseline)
 if [ -n "${NBODY_BENCH_GATE_THRESHOLD:-}" ]; then
     args+=(--threshold "$NBODY_BENCH_GATE_THRESHOLD")
 fi

@@ -7,6 +7,7 @@ use nbody_bench::experiment::locate;
 use nbody_bench::experiment::results::{ResultsFile, utc_now};
 use nbody_bench::experiment::runner::{SweepOptions, run_sweep_wall};
 use nbody_bench::gate::ab::{self, AbPlan};
+use nbody_bench::gate::baselines;
 use nbody_bench::gate::{
     AB_THRESHOLD, FILE_THRESHOLD, GateOptions, GateReport, RunInfo, base_build, compare, render,
 };
@@ -21,8 +22,12 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     match &args.current {
         Some(current) => {
             let root = Path::new("results");
-            let baseline = ResultsFile::load(&locate::find_results(&args.baseline, root)?)?;
             let current = ResultsFile::load(&locate::find_results(current, root)?)?;
+            let baseline = if is_baseline_folder(&args.baseline) {
+                baselines::choose(&args.baseline, &RunInfo::of(&current))?.file
+            } else {
+                ResultsFile::load(&locate::find_results(&args.baseline, root)?)?
+            };
             let report = compare(&baseline, &current, &options(&args, 0.10))?;
             Ok(finish(&report, &args, None)?)
         }
@@ -77,9 +82,59 @@ fn this_machine() -> RunInfo {
     }
 }
 
+/// A folder of per-machine-class baselines (`results/baseline/`), not one results file or a
+/// run directory.
+fn is_baseline_folder(path: &Path) -> bool {
+    path.is_dir() && !path.join("results.json").is_file()
+}
+
+/// `--save-baseline RESULTS`: keeps RESULTS in the baseline folder under its machine class's
+/// name, replacing that class's earlier file, once it compares cleanly with itself (schema,
+/// calibration, config); the other classes' files stay.
+fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<i32> {
+    let source = locate::find_results(results, Path::new("results"))?;
+    let file = ResultsFile::load(&source)?;
+    if file.calibration.start.is_none() && file.calibration.end.is_none() {
+        anyhow::bail!(
+            "{} was swept without calibration, so its machine class is unknown; sweep \
+             configs/ci.toml again with calibration",
+            source.display()
+        );
+    }
+    compare(&file, &file, &GateOptions::default())?;
+    if folder.is_file() {
+        anyhow::bail!(
+            "--baseline {} is a file; --save-baseline needs the folder of baselines \
+             (results/baseline)",
+            folder.display()
+        );
+    }
+    std::fs::create_dir_all(folder)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", folder.display()))?;
+    let info = RunInfo::of(&file);
+    let target = folder.join(baselines::file_name(&info));
+    let text = nbody_bench::input::read_text(&source)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", source.display()))?;
+    nbody_bench::output::write_atomic(&target, text.as_bytes())?;
+    eprintln!(
+        "gate: {} kept as the baseline of {} ({} logical CPUs): {}",
+        source.display(),
+        info.cpu_signature.as_deref().unwrap_or("an unknown CPU"),
+        info.logical_cpus.map_or("?".into(), |n| n.to_string()),
+        target.display()
+    );
+    Ok(0)
+}
+
 fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
-    let baseline = if args.baseline.is_file() || args.against.is_none() {
-        Some(ResultsFile::load(&args.baseline)?)
+    if let Some(results) = &args.save_baseline {
+        return save_baseline(&args.baseline, results);
+    }
+    let baseline = if is_baseline_folder(&args.baseline) {
+        let chosen = baselines::choose(&args.baseline, &this_machine())?;
+        Some((chosen.path, chosen.file))
+    } else if args.baseline.is_file() || args.against.is_none() {
+        Some((args.baseline.clone(), ResultsFile::load(&args.baseline)?))
     } else {
         None
     };
@@ -90,7 +145,7 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
                 .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
             (path, text)
         }
-        (None, Some(b)) => (args.baseline.clone(), b.config_text.clone()),
+        (None, Some((path, b))) => (path.clone(), b.config_text.clone()),
         (None, None) => {
             let path = locate::find_config(Path::new("ci"))?;
             let text = nbody_bench::input::read_text(&path)
@@ -119,7 +174,8 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
         }
         None => locate::new_run_dir(Path::new("results"), "gate", &utc_now())?,
     };
-    let judged = judge(args, baseline.as_ref(), &config, &config_text, &out);
+    let baseline = baseline.as_ref().map(|(path, file)| (path.as_path(), file));
+    let judged = judge(args, baseline, &config, &config_text, &out);
     if judged.is_err() {
         // A gate that failed before measuring leaves no empty run directory behind.
         let _ = std::fs::remove_dir(&out);
@@ -130,20 +186,21 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
 /// Chooses the fast path or A/B, and runs it.
 fn judge(
     args: &GateArgs,
-    baseline: Option<&ResultsFile>,
+    baseline: Option<(&Path, &ResultsFile)>,
     config: &SweepConfig,
     config_text: &str,
     out: &Path,
 ) -> anyhow::Result<i32> {
     let against = match (&args.against, baseline) {
         (Some(rev), _) => rev.clone(),
-        (None, Some(b)) => match RunInfo::of(b).machine_class_differs(&this_machine()) {
-            None => return fast_path(args, b, config, config_text, out),
+        (None, Some((path, b))) => match RunInfo::of(b).machine_class_differs(&this_machine()) {
+            None => return fast_path(args, path, b, config, config_text, out),
             Some(why) => {
                 eprintln!(
                     "gate: the baseline {} comes from another machine class ({why}); measuring \
-                     its revision {} and this build side by side here (A/B)",
-                    args.baseline.display(),
+                     its revision {} and this build side by side here (A/B); \
+                     `gate --save-baseline` on this machine's own sweep gives it the fast path",
+                    path.display(),
                     short(&b.metadata.git_commit)
                 );
                 b.metadata.git_commit.clone()
@@ -160,6 +217,7 @@ fn judge(
 /// The baseline file comes from this machine class: sweep this build and compare.
 fn fast_path(
     args: &GateArgs,
+    path: &Path,
     baseline: &ResultsFile,
     config: &SweepConfig,
     text: &str,
@@ -168,7 +226,7 @@ fn fast_path(
     eprintln!(
         "gate: sweeping {} with this build, to compare with {} (same machine class)",
         config.name,
-        args.baseline.display()
+        path.display()
     );
     let sweep = SweepOptions {
         run_dir: Some(out.to_path_buf()),

@@ -18,6 +18,7 @@
 
 pub mod ab;
 pub mod base_build;
+pub mod baselines;
 mod checks;
 mod compare;
 mod render;

@@ -43,7 +43,7 @@ fn a_closed_pipe_ends_the_output_quietly() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("s.csv");
     std::fs::write(&csv, CSV).unwrap();
-    let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/ci.json");
+    let baseline = crate::committed_baseline();
     let quick = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/quick/results.json");
     let config = dir.path().join("tiny.toml");
     std::fs::write(
@@ -125,7 +125,7 @@ fn a_closed_pipe_ends_the_output_quietly() {
 
 #[test]
 fn a_full_stdout_is_an_error_with_exit_2() {
-    let baseline = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/ci.json");
+    let baseline = crate::committed_baseline();
     let b = baseline.to_str().unwrap();
     let dir = tempfile::tempdir().unwrap();
     // A copy: `report` regenerates the analyses of the sweeps it reads.

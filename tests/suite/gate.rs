@@ -157,9 +157,9 @@ fn same_code_passes_and_a_slower_kernel_is_flagged_alone() {
     );
 }
 
-/// The committed baseline: a real results file of this machine class.
+/// A committed baseline: a real results file of some machine class.
 fn committed_baseline() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline/ci.json")
+    crate::committed_baseline()
 }
 
 fn edited(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {
@@ -423,4 +423,65 @@ fn a_base_revision_is_built_once_and_a_broken_one_is_refused() {
     // No worktree is left behind either way.
     let worktrees = git(repo, &["worktree", "list"]);
     assert_eq!(worktrees.lines().count(), 1, "{worktrees}");
+}
+
+/// A folder of baselines: the gate takes the file of the current run's machine class, whatever
+/// its name; `--save-baseline` files a run under its class's name; an empty folder or a corrupt
+/// file in it is an error.
+#[test]
+fn a_folder_of_baselines_gives_each_machine_class_its_own() {
+    let _serial = serial();
+    let dir = tempfile::tempdir().unwrap();
+    let folder = dir.path().join("baseline");
+    std::fs::create_dir(&folder).unwrap();
+    let base = committed_baseline();
+    let signature = |path: &Path| {
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        v["calibration"]["start"]["cpu_signature"]
+            .as_str()
+            .unwrap()
+            .to_string()
+    };
+    let here = signature(&base);
+    // Another class's baseline, and newer: chosen, the gate would refuse it (another machine).
+    let other = edited(dir.path(), "other.json", |v| {
+        for side in ["start", "end"] {
+            v["calibration"][side]["cpu_signature"] = "OtherVendor 1/2/3".into();
+        }
+        v["metadata"]["started"] = "2999-01-01T00:00:00Z".into();
+    });
+    std::fs::copy(&other, folder.join("a-other.json")).unwrap();
+    std::fs::copy(&base, folder.join("z-mine.json")).unwrap();
+    let o = gate(&folder, &base, &["--format", "json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let report: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(report["baseline"]["cpu_signature"], here.as_str());
+
+    // Filed under the class's own name, beside the other class's file.
+    let saved = bin()
+        .args(["gate", "--baseline"])
+        .arg(&folder)
+        .arg("--save-baseline")
+        .arg(&base)
+        .output()
+        .unwrap();
+    assert_eq!(saved.status.code(), Some(0), "{}", text(&saved.stderr));
+    let slug: String = here
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
+    let filed = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .find(|name| name.starts_with(&format!("ci-{slug}-")))
+        .unwrap_or_else(|| panic!("no ci-{slug}-*.json in the folder"));
+    assert_eq!(signature(&folder.join(&filed)), here);
+    assert!(folder.join("a-other.json").is_file());
+
+    std::fs::write(folder.join("broken.json"), "{").unwrap();
+    assert_bad_input(&gate(&folder, &base, &[]), "broken.json");
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    assert_bad_input(&gate(&empty, &base, &[]), "holds no .json results file");
 }

@@ -45,6 +45,19 @@ pub fn copy_tree(from: &Path, to: &Path) {
     }
 }
 
+/// The committed gate baselines (`results/baseline/*.json`, one per machine class), sorted;
+/// the first of them is the one the tests read.
+pub fn committed_baseline() -> std::path::PathBuf {
+    let folder = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/baseline");
+    let mut files: Vec<_> = std::fs::read_dir(&folder)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    files.sort();
+    files.into_iter().next().expect("a committed baseline")
+}
+
 /// A temporary `results/` holding a copy of the committed quick sweep.
 pub fn quick_results_copy() -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
