@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The MPI tests, run for real: builds with `--features mpi` and checks under `mpirun -n 1..4`
 # that distributed runs end in the state of the serial run (to rounding) with every particle
-# present once, for both decompositions (the cell list and the Verlet list on the spatial one),
+# present once, for the replicated and the spatial decomposition (the cell list and the Verlet
+# list on the spatial one), that the distributed trees give forces within validate's bound,
 # uneven particle counts, ranks left without particles, particles migrating beyond the
 # neighbouring regions and rebalancing; then the error paths, the JSON outputs, `mpi-bench` and
 # a sweep under the launcher.
@@ -74,6 +75,25 @@ for ranks in 1 2 3 4; do
     check "$ranks" --scenario lj-box --kernel verlet --decomp domain -n 3001 --steps 60 ${migration[@]+"${migration[@]}"}
 done
 
+# The distributed Barnes-Hut trees: forces within validate's bound at θ = 0.5 and energy drift
+# of the order of the serial run's (a few hundred steps), for gravity and for Coulomb's two
+# trees, with bodies crossing domains; the source's octants (8^k domains; other counts get
+# balanced runs of cells) and the locally essential trees over a rebalanced bisection.
+for ranks in 1 2 3 4; do
+    migration=()
+    if [ "$ranks" -gt 1 ]; then migration=(--expect-migration); fi
+    for decomp in octants tree; do
+        check "$ranks" --scenario galaxy --kernel octree --decomp "$decomp" -n 2001 --steps 300 ${migration[@]+"${migration[@]}"}
+        check "$ranks" --scenario coulomb --kernel octree --decomp "$decomp" -n 1501 --steps 30 ${migration[@]+"${migration[@]}"}
+    done
+done
+# Ranks without bodies, the quadrupole order, and rebalancing of the bisection.
+check 4 --scenario galaxy --kernel octree --decomp octants -n 3 --steps 20 --expect-empty-rank
+check 4 --scenario galaxy --kernel octree --decomp tree -n 3 --steps 20 --no-rebalance --expect-empty-rank
+check 3 --scenario galaxy --kernel octree --decomp tree -n 3000 --steps 50 --multipole quadrupole --theta 0.7
+check 3 --scenario galaxy --kernel octree --decomp octants -n 3000 --steps 50 --multipole quadrupole --theta 0.7
+check 4 --scenario galaxy --kernel octree --decomp tree -n 2001 --steps 60 --rebalance-above 1.01 --expect-rebalance
+
 # More kernels and shapes.
 check 3 --scenario galaxy --kernel octree --decomp allgather -n 600 --steps 5
 check 2 --scenario coulomb --kernel per-thread --decomp allgather -n 1500 --steps 5 --threads 2
@@ -96,6 +116,9 @@ check 4 --scenario lj-box --kernel cell-list --decomp domain -n 400 --steps 100 
 
 # Errors: clear message, exit 2, every rank stops.
 refuses 2 "needs --kernel cell-list or verlet" run --decomp domain --scenario lj-box --kernel naive -n 100
+refuses 2 "--decomp tree distributes the Barnes-Hut tree and needs --kernel octree" run --decomp tree --scenario galaxy --kernel naive -n 100
+refuses 2 "--decomp octants distributes the Barnes-Hut tree and needs --kernel octree" run --decomp octants --scenario galaxy --kernel cell-list -n 100
+refuses 2 "--rank-grid applies to --decomp domain only" run --decomp tree --scenario galaxy --kernel octree -n 100 --rank-grid 2x1
 refuses 2 "--skin applies to the verlet kernel only" run --decomp allgather --scenario lj-box --kernel cell-list -n 100 --skin 0.003
 refuses 1 "needs at least 2 ranks" mpi-bench --out "$TMP/bench.json"
 refuses 3 "still outside the box after one reflection" \

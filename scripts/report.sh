@@ -8,7 +8,7 @@
 #   scripts/report.sh --report   only regenerate REPORT.md from the committed results
 #
 # About 35 minutes on a 2-vCPU Intel Xeon (2026-12-02), 9 of them the pytreegrav comparison
-# (numba compiles in every run). Run it on a quiet machine: the sweeps record the background
+# (numba compiles in every run), plus about 25 for the MPI sweeps (scripts/mpi-report.sh). Run it on a quiet machine: the sweeps record the background
 # load they saw, and the report shows it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -34,8 +34,7 @@ if [[ "$mode" != "--report" ]]; then
             "$bin" sweep --config "configs/$name.toml" --out results
         fi
     done
-    if [[ -x scripts/mpi-report.sh ]]; then
-        scripts/mpi-report.sh
-    fi
+    # The MPI sweeps and their mpi-bench files (rebuilds the binary with the mpi feature).
+    scripts/mpi-report.sh "$mode"
 fi
 "$bin" report --results results --out REPORT.md

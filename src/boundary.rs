@@ -62,6 +62,10 @@ impl<T: Real, const D: usize> Boundary<T, D> {
             }
             Boundary::Open => {
                 let (lo, hi) = state.bounding_box();
+                // No particle, nothing to check (a rank of a distributed run may own none).
+                if state.is_empty() {
+                    return Ok((lo, hi));
+                }
                 for d in 0..D {
                     // min/max skip NaN, so test finiteness separately: x·0 is NaN for NaN and ±∞.
                     let poison = state.pos[d]
@@ -171,5 +175,8 @@ mod tests {
         s.pos = [vec![-3.0, 4.0], vec![1.0, -2.0]];
         let (lo, hi) = Boundary::<f64, 2>::Open.apply(&mut s, 0).unwrap();
         assert_eq!((lo, hi), ([-3.0, -2.0], [4.0, 1.0]));
+        // A rank of a distributed run may own no particle: nothing to report, no error.
+        let mut none = State::<f64, 2>::new(0);
+        assert!(Boundary::<f64, 2>::Open.apply(&mut none, 0).is_ok());
     }
 }

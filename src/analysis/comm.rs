@@ -50,6 +50,32 @@ fn log2_ceil(p: usize) -> f64 {
     (p as f64).log2().ceil()
 }
 
+/// The α-β time of `msgs` latencies and `bytes` bytes, with the 95% band of the fit's
+/// bootstrap replicates.
+pub fn predict(f: &AlphaBetaFit, msgs: f64, bytes: f64) -> (f64, [f64; 2]) {
+    let at = |a: f64, b: f64| msgs * a + bytes * b;
+    let mut reps: Vec<f64> = f.replicates().iter().map(|r| at(r[0], r[1])).collect();
+    reps.sort_by(f64::total_cmp);
+    let q = |x: f64| reps[((x * reps.len() as f64) as usize).min(reps.len() - 1)];
+    let mid = at(f.alpha.estimate, f.beta.estimate);
+    if reps.is_empty() {
+        (mid, [mid, mid])
+    } else {
+        (mid, [q(0.025), q(0.975)])
+    }
+}
+
+/// The α-β fit of the ping-pong of `bench`.
+pub fn fit_ping_pong(bench: &MpiBenchFile) -> Result<AlphaBetaFit, fit::FitError> {
+    let samples: Vec<Samples> = bench
+        .ping_pong
+        .points
+        .iter()
+        .map(|p| Samples::new(p.bytes as f64, p.seconds.clone()))
+        .collect();
+    fit::fit_alpha_beta(&samples, fit::DEFAULT_SEED)
+}
+
 /// Fits the ping-pong of `bench` and predicts both decompositions for n = `n_per_rank`·p
 /// particles of a 2-D f32 system at `density` with cutoff `cutoff`.
 pub fn comm_model(
@@ -59,29 +85,12 @@ pub fn comm_model(
     density: f64,
     cutoff: f64,
 ) -> CommModel {
-    let samples: Vec<Samples> = bench
-        .ping_pong
-        .points
-        .iter()
-        .map(|p| Samples::new(p.bytes as f64, p.seconds.clone()))
-        .collect();
-    let ab = fit::fit_alpha_beta(&samples, fit::DEFAULT_SEED);
+    let ab = fit_ping_pong(bench);
     let (dim, value_bytes) = (2, 4);
     let mut allgather = Vec::new();
     let mut domain = Vec::new();
     if let Ok(f) = &ab {
-        let time = |msgs: f64, bytes: f64| -> (f64, [f64; 2]) {
-            let at = |a: f64, b: f64| msgs * a + bytes * b;
-            let mut reps: Vec<f64> = f.replicates().iter().map(|r| at(r[0], r[1])).collect();
-            reps.sort_by(f64::total_cmp);
-            let q = |x: f64| reps[((x * reps.len() as f64) as usize).min(reps.len() - 1)];
-            let mid = at(f.alpha.estimate, f.beta.estimate);
-            if reps.is_empty() {
-                (mid, [mid, mid])
-            } else {
-                (mid, [q(0.025), q(0.975)])
-            }
-        };
+        let time = |msgs: f64, bytes: f64| predict(f, msgs, bytes);
         for &p in &PREDICTED_RANKS {
             let n = n_per_rank * p;
             // Replicated data: an Allgatherv of every position, ⌈log2 p⌉ latencies.

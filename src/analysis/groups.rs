@@ -32,6 +32,13 @@ pub struct Point {
     /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases).
     pub comm_s_per_step: Option<f64>,
     pub bytes_per_step: Option<f64>,
+    /// Of `comm_s_per_step`, the part left after the estimated wait for slower ranks: moving
+    /// data and MPI overhead (MPI cases).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transfer_s_per_step: Option<f64>,
+    /// Mean over the rounds of max/mean over ranks of the compute time (MPI cases).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub compute_imbalance: Option<f64>,
     /// Seconds per step: every raw sample, the median and its bootstrap 95% CI.
     #[serde(skip)]
     pub samples: Vec<f64>,
@@ -234,6 +241,15 @@ fn point(r: &CaseRecord) -> Option<Point> {
         decomp: r.case.decomp,
         comm_s_per_step: mpi_mean(r, &|m| m.reduced.comm_s.mean),
         bytes_per_step: mpi_mean(r, &|m| m.reduced.bytes_sent.mean),
+        transfer_s_per_step: mpi_mean(r, &|m| m.reduced.transfer_s.mean),
+        compute_imbalance: {
+            let per_round: Vec<f64> = r
+                .rounds
+                .iter()
+                .filter_map(|round| Some(round.mpi.as_ref()?.reduced.compute_imbalance))
+                .collect();
+            (!per_round.is_empty()).then(|| per_round.iter().sum::<f64>() / per_round.len() as f64)
+        },
         samples: r
             .rounds
             .iter()

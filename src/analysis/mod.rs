@@ -7,6 +7,7 @@
 pub mod comm;
 pub mod groups;
 pub mod peers;
+pub mod tree_comm;
 
 use crate::calibrate::Calibration;
 use crate::experiment::code::Code;

@@ -166,7 +166,9 @@ pub struct RunArgs {
     #[arg(long)]
     pub yes: bool,
     /// Split the run over MPI ranks (start it under `mpirun -n P`): allgather (replicated data,
-    /// any kernel) or domain (spatial regions; cell-list or verlet). Needs the `mpi` feature.
+    /// any kernel), domain (spatial regions; cell-list or verlet), octants (the source's
+    /// distributed octree) or tree (locally essential trees over a balanced bisection); the
+    /// last two with the octree. Needs the `mpi` feature.
     #[arg(long, value_enum, help_heading = MPI_HEADING)]
     pub decomp: Option<Decomposition>,
     #[command(flatten)]
@@ -187,7 +189,8 @@ pub struct MpiOptions {
     #[arg(long, value_name = "AxB[xC]", requires = "decomp")]
     pub rank_grid: Option<String>,
     /// Move the domain boundaries when the busiest rank owns more than this times the mean
-    /// particle count.
+    /// particle count (domain), or spent more than this times the mean force time in the last
+    /// step (tree; octants never moves them).
     #[arg(long, default_value_t = 1.1, value_parser = parse_positive, requires = "decomp")]
     pub rebalance_above: f64,
     /// Keep the domain boundaries fixed: equal regions, never rebalanced.
@@ -435,21 +438,34 @@ pub struct FitArgs {
     long_about = "Compare this build's timings with a baseline, case by case; exit 1 if a case got \
         slower beyond the threshold (with its whole confidence interval), 2 for bad input or a \
         comparison that cannot be made.\n\n\
+        The baseline is a results file or a folder of them, one per machine class (CPU model, \
+        CPU signature, logical CPUs): from a folder the gate takes the file of the class it \
+        compares with, else the newest.\n\n\
         Three ways:\n\
         - with --current: compare two results files (they must come from one machine class);\n\
         - without --current: the gate sweeps the baseline's config with this build; if the \
         baseline comes from this machine class it is compared with the baseline file (the fast \
         path), else the gate builds the baseline's revision (a git worktree, cached in \
         target/gate-base/) and measures both builds here, interleaved case by case (A/B);\n\
-        - with --against REV: always A/B against REV.",
+        - with --against REV: always A/B against REV.\n\n\
+        --save-baseline RESULTS files a sweep of the baseline's config as this machine class's \
+        baseline (scripts/refresh-baseline.sh does it from a fresh sweep).",
     after_help = "Examples:\n  nbody-bench gate                       # CI: judge this build on any machine\n  \
     nbody-bench gate --against origin/main  # a pull request against its base\n  \
-    nbody-bench gate --baseline results/baseline/ci.json --current ci --format markdown"
+    nbody-bench gate --baseline results/baseline --current ci --format markdown\n  \
+    nbody-bench gate --save-baseline ci     # the latest ci sweep becomes this machine's baseline"
 )]
 pub struct GateArgs {
-    /// Results of the reference run.
-    #[arg(long, value_name = "FILE", default_value = "results/baseline/ci.json")]
+    /// The reference run: a results file, or a folder of baselines, one per machine class
+    /// (the gate takes the one of this machine's class, else A/B against the newest one's
+    /// commit).
+    #[arg(long, value_name = "FILE|DIR", default_value = "results/baseline")]
     pub baseline: PathBuf,
+    /// Keep RESULTS (a results.json, a run directory or a config name) in the --baseline folder
+    /// as the baseline of the machine class it was measured on, replacing that class's file,
+    /// and measure nothing.
+    #[arg(long, value_name = "RESULTS", conflicts_with_all = ["current", "against"])]
+    pub save_baseline: Option<PathBuf>,
     /// Results of the run to check: a results.json, a run directory or a config name (its
     /// latest run). Without it the gate measures this build itself.
     #[arg(long, value_name = "RESULTS")]

@@ -102,8 +102,9 @@ mod with_mpi {
             .max(1);
         let copies = match decomp {
             Decomposition::Allgather => local_ranks,
-            // Ghost layers aside, the ranks together hold the system once.
-            Decomposition::Domain => 1,
+            // Ghost layers (or imported tree nodes) aside, the ranks together hold the
+            // system once.
+            Decomposition::Domain | Decomposition::Octants | Decomposition::Tree => 1,
         };
         if let Err(e) = setup.validate() {
             return Err(MpiError::Usage(e.to_string()));
@@ -287,6 +288,21 @@ mod with_mpi {
             report.position_error,
             report.velocity_error
         );
+        if let Some(t) = &report.tree {
+            outln!(
+                "forces            median error {:.2e} against the direct sum (serial octree {:.2e}, bound {:.1e})",
+                t.force_error,
+                t.serial_force_error,
+                t.force_tolerance
+            );
+            outln!(
+                "energy drift      {:.2e} (serial {:.2e}, allowed {:.1e}); the positions are not held to rounding: the tree's nodes differ",
+                t.energy_drift,
+                t.serial_energy_drift,
+                nbody_bench::decomp::check::DRIFT_FACTOR * t.serial_energy_drift
+                    + nbody_bench::decomp::check::DRIFT_FLOOR
+            );
+        }
         outln!(
             "migration         {} particles changed rank, {} beyond the neighbours",
             report.migrated,

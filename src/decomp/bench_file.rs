@@ -27,6 +27,10 @@ pub struct MpiBenchFile {
     pub logical_cpus: usize,
     /// More ranks than logical CPUs: timings include time-sharing of the CPUs.
     pub oversubscribed: bool,
+    /// The Open MPI byte-transfer layers the run was restricted to (`OMPI_MCA_btl`, e.g.
+    /// `tcp,self`); absent when the library chose (shared memory between ranks of one node).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub transport: Option<String>,
     /// Ranks 0 and 1 (on the first two slots): one-way time of a message of `bytes`, taken as
     /// half the round trip of a ping-pong.
     pub ping_pong: Series,
@@ -69,7 +73,21 @@ pub enum BenchFileError {
     Schema { path: PathBuf, found: String },
 }
 
+/// The byte-transfer layers this process's MPI runs were restricted to, if any.
+pub fn transport_from_env() -> Option<String> {
+    std::env::var("OMPI_MCA_btl")
+        .ok()
+        .filter(|v| !v.trim().is_empty())
+}
+
 impl MpiBenchFile {
+    /// Whether the run went over TCP (`--mca btl tcp,self`).
+    pub fn over_tcp(&self) -> bool {
+        self.transport
+            .as_deref()
+            .is_some_and(|t| t.split(',').any(|l| l.trim() == "tcp"))
+    }
+
     pub fn load(path: &Path) -> Result<MpiBenchFile, BenchFileError> {
         let text = crate::input::read_text(path).map_err(|source| BenchFileError::Read {
             path: path.into(),
@@ -174,9 +192,20 @@ mod tests {
             mpi_standard: "3.1".into(),
             logical_cpus: 2,
             oversubscribed: true,
+            transport: None,
             ping_pong: series(2),
             allgatherv: series(4),
         }
+    }
+
+    #[test]
+    fn a_tcp_run_says_so() {
+        let mut b = sample();
+        assert!(!b.over_tcp());
+        b.transport = Some("tcp,self".into());
+        assert!(b.over_tcp());
+        b.transport = Some("self,vader".into());
+        assert!(!b.over_tcp());
     }
 
     #[test]

@@ -89,6 +89,33 @@ pub fn select<T: Real, const D: usize>(
     set
 }
 
+/// `domain`'s boxes with every face that lies on a face of `root` moved out to infinity. A body
+/// that leaves the root box still belongs to the rank whose box touched that wall (as
+/// `Domains::owner` places it), so the selection must hold out there too; the open boxes are
+/// exactly the points the owner test gives the rank.
+pub fn open_at_walls<const D: usize>(domain: &[Aabb<D>], root: &Aabb<D>) -> Vec<Aabb<D>> {
+    domain
+        .iter()
+        .map(|(lo, hi)| {
+            let lo = std::array::from_fn(|d| {
+                if lo[d] <= root.0[d] {
+                    f64::NEG_INFINITY
+                } else {
+                    lo[d]
+                }
+            });
+            let hi = std::array::from_fn(|d| {
+                if hi[d] >= root.1[d] {
+                    f64::INFINITY
+                } else {
+                    hi[d]
+                }
+            });
+            (lo, hi)
+        })
+        .collect()
+}
+
 impl EssentialSet {
     /// Exported entries: nodes plus bodies.
     pub fn entries(&self) -> usize {

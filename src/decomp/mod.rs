@@ -10,7 +10,8 @@
 //! the octants of the root cube in Morton order ([`octants`], the gravity source's scheme) or a
 //! weighted orthogonal recursive bisection for any rank count ([`orb`]), both behind
 //! [`Domains`]; and the locally essential tree ([`essential`]): the nodes and bodies of one
-//! rank's octree that another rank's domain needs, selected with the octree's own opening test.
+//! rank's octree that another rank's domain needs, selected with the octree's own opening test;
+//! and the top nodes a rank shares in the source's scheme ([`top_nodes`]).
 
 pub mod bench_file;
 pub mod check;
@@ -20,6 +21,7 @@ pub mod octants;
 pub mod orb;
 pub mod regions;
 pub mod stats;
+pub mod top_nodes;
 pub mod wire;
 
 use crate::kernels::KernelKind;
@@ -40,6 +42,14 @@ pub enum Decomposition {
     /// Spatial decomposition (cell list and Verlet list): each rank owns a region, exchanges
     /// ghosts within the cutoff with its neighbours and migrates particles that cross its border.
     Domain,
+    /// The gravity source's distributed Barnes-Hut (octree): domains from the octants of the
+    /// root cube, local trees, top nodes shared with an Allgather, and the bodies that fail
+    /// the opening test against a remote domain sent to its owner for their near forces.
+    Octants,
+    /// Distributed Barnes-Hut (octree) with locally essential trees over a cost-balanced
+    /// orthogonal recursive bisection: each rank sends each other rank the part of its tree
+    /// that rank's domain needs, in one round, and the domains move when the load drifts.
+    Tree,
 }
 
 #[derive(Debug, Error, PartialEq)]
@@ -49,15 +59,30 @@ pub enum DecompError {
          use --decomp allgather with {0}"
     )]
     DomainKernel(&'static str),
+    #[error(
+        "--decomp {decomp} distributes the Barnes-Hut tree and needs --kernel octree; use \
+         --decomp allgather with {kernel}"
+    )]
+    TreeKernel {
+        decomp: &'static str,
+        kernel: &'static str,
+    },
 }
 
 impl Decomposition {
-    pub const ALL: [Decomposition; 2] = [Decomposition::Allgather, Decomposition::Domain];
+    pub const ALL: [Decomposition; 4] = [
+        Decomposition::Allgather,
+        Decomposition::Domain,
+        Decomposition::Octants,
+        Decomposition::Tree,
+    ];
 
     pub fn name(self) -> &'static str {
         match self {
             Decomposition::Allgather => "allgather",
             Decomposition::Domain => "domain",
+            Decomposition::Octants => "octants",
+            Decomposition::Tree => "tree",
         }
     }
 
@@ -66,15 +91,27 @@ impl Decomposition {
         match self {
             Decomposition::Allgather => true,
             Decomposition::Domain => matches!(kernel, KernelKind::CellList | KernelKind::Verlet),
+            Decomposition::Octants | Decomposition::Tree => kernel == KernelKind::Octree,
         }
+    }
+
+    /// Whether the decomposition distributes the Barnes-Hut tree (its forces then differ from
+    /// the serial tree's within the opening-angle tolerance, not to rounding).
+    pub fn distributes_the_tree(self) -> bool {
+        matches!(self, Decomposition::Octants | Decomposition::Tree)
     }
 
     /// Refuses kernels the decomposition cannot run, saying what to use instead.
     pub fn check(self, kernel: KernelKind) -> Result<(), DecompError> {
         if self.supports(kernel) {
             Ok(())
-        } else {
+        } else if self == Decomposition::Domain {
             Err(DecompError::DomainKernel(kernel.name()))
+        } else {
+            Err(DecompError::TreeKernel {
+                decomp: self.name(),
+                kernel: kernel.name(),
+            })
         }
     }
 }
@@ -147,5 +184,17 @@ mod tests {
             msg.contains("cell-list") && msg.contains("allgather"),
             "{msg}"
         );
+    }
+
+    #[test]
+    fn the_tree_decompositions_run_the_octree_only() {
+        for decomp in [Decomposition::Octants, Decomposition::Tree] {
+            for k in KernelKind::ALL {
+                assert_eq!(decomp.check(k).is_ok(), k == KernelKind::Octree);
+            }
+            let msg = decomp.check(KernelKind::Naive).unwrap_err().to_string();
+            assert!(msg.contains("--kernel octree"), "{msg}");
+            assert!(msg.contains(decomp.name()), "{msg}");
+        }
     }
 }

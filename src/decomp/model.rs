@@ -2,9 +2,10 @@
 //! the cutoff: the inputs of an α-β (latency-bandwidth) prediction of communication time,
 //! `T(p) = messages · α + bytes · β`, fitted on `mpi-bench` timings (see `docs/mpi.md`).
 //!
-//! The tree decompositions of a Barnes-Hut run: the gravity source's octants, which replicate
-//! the bodies (bytes grow like n), and the locally essential tree, whose size grows like the
-//! surface of a domain; modelled on a uniform cloud, or counted on a given one.
+//! The tree decompositions of a Barnes-Hut run, counted on a given cloud: the gravity source's
+//! octants (top nodes to everyone, and the groups near another domain sent to it and
+//! answered: a fixed share of each domain, so like n/p), and the locally essential tree, whose
+//! size grows like the surface of a domain (also modelled on a uniform cloud).
 //!
 //! Counts are for the busiest rank and one step, ignoring migration (a small fraction of the
 //! ghosts at the time steps the scenarios use) and the per-step status exchange (one small
@@ -13,6 +14,7 @@
 use super::Domains;
 use super::essential::{self, body_entry_values, node_entry_values};
 use super::regions::grid_dims;
+use super::top_nodes::{self, TopNodes, TopWalk};
 use crate::kernels::{Multipole, Octree};
 use crate::real::Real;
 use crate::state::State;
@@ -88,26 +90,83 @@ pub fn domain_messages_per_rank(dims: &[usize]) -> f64 {
     4.0 * neighbours as f64
 }
 
-/// The octant scheme of the gravity source, as modelled here: each rank owns octants of the
-/// root cube (`decomp::octants`) but builds the whole tree, so every step it receives every
-/// other rank's bodies as (position, mass) records — masses travel because bodies migrate
-/// between octants. Bytes of the busiest receiver, the rank that owns fewest bodies, when the
-/// ranks own `counts` bodies: `(n − min counts) · (D + 1) · w`. Grows like n, as allgather.
-pub fn octants_bytes_per_rank(counts: &[usize], dim: usize, value_bytes: usize) -> f64 {
-    let n: usize = counts.iter().sum();
-    let own = counts.iter().copied().min().unwrap_or(0);
-    (n - own) as f64 * (body_entry_values(dim) * value_bytes) as f64
+/// The octant scheme of the gravity source (`--decomp octants`) on a given cloud, counted by
+/// running its selection without MPI: every rank builds the octree of the bodies it owns under
+/// `domains`, shares its top nodes (`top_levels` levels, [`top_nodes::node_values`] values each,
+/// with every other rank), and sends each group of its bodies whose walk of another rank's top
+/// nodes must open a node to that rank (a count, then position and strength per body), which
+/// answers with D force values per body. Returns the bytes each rank sends in one step, as the
+/// MPI driver counts them (a collective's block once per other rank). Grows with the bodies
+/// near other domains, within a top node's reach `s/θ`: as the top nodes' side `s` scales
+/// with the domains, a fixed share of each domain's bodies, so like n/p, not like the surface.
+pub fn octants_bytes_of_cloud<T: Real, const D: usize>(
+    cloud: &State<T, D>,
+    domains: &impl Domains<D>,
+    theta: f64,
+    leaf_size: usize,
+    top_levels: u32,
+) -> Vec<f64> {
+    let ranks = domains.ranks();
+    let w = std::mem::size_of::<T>() as f64;
+    let trees: Vec<Octree<(), T, D>> = split(cloud, domains)
+        .iter()
+        .map(|own| {
+            let mut tree = Octree::with_multipole((), theta, leaf_size, Multipole::Monopole);
+            tree.build(own);
+            tree
+        })
+        .collect();
+    let tops: Vec<TopNodes<T, D>> = trees
+        .iter()
+        .map(|t| {
+            if t.view().body_count() == 0 {
+                TopNodes::default()
+            } else {
+                TopNodes::of(&t.view(), top_levels)
+            }
+        })
+        .collect();
+    let mut sent = vec![0.0; ranks];
+    for (me, tree) in trees.iter().enumerate() {
+        let view = tree.view();
+        sent[me] += tops[me].encode().len() as f64 * w * (ranks - 1) as f64;
+        if view.body_count() == 0 {
+            continue;
+        }
+        for group in view.groups() {
+            let points: Vec<[T; D]> = group.clone().map(|k| view.position(k)).collect();
+            let (lo, hi) = top_nodes::bounding_box(&points);
+            for (r, top) in tops.iter().enumerate() {
+                if r != me && !top.is_empty() && top.walk(&lo, &hi) == TopWalk::Open {
+                    let bodies = points.len() as f64;
+                    sent[me] += (1.0 + bodies * (D + 1) as f64) * w;
+                    sent[r] += bodies * D as f64 * w;
+                }
+            }
+        }
+    }
+    sent
 }
 
-/// The octant scheme on a uniform cloud of `n` bodies and `ranks = 8^k` ranks (equal counts).
-pub fn octants_uniform_bytes_per_rank(
-    n: usize,
-    ranks: usize,
-    dim: usize,
-    value_bytes: usize,
-) -> f64 {
-    let ranks = ranks.max(1);
-    (n - n / ranks) as f64 * (body_entry_values(dim) * value_bytes) as f64
+/// The bodies each rank owns under `domains`, as states of their own (positions, strengths).
+fn split<T: Real, const D: usize>(
+    cloud: &State<T, D>,
+    domains: &impl Domains<D>,
+) -> Vec<State<T, D>> {
+    let owners = domains.assign(&cloud.pos);
+    (0..domains.ranks())
+        .map(|rank| {
+            let mine: Vec<usize> = (0..cloud.len()).filter(|&i| owners[i] == rank).collect();
+            let mut own = State::new(mine.len());
+            for (k, &i) in mine.iter().enumerate() {
+                for d in 0..D {
+                    own.pos[d][k] = cloud.pos[d][i];
+                }
+                own.source[k] = cloud.source[i];
+            }
+            own
+        })
+        .collect()
 }
 
 /// The locally essential tree the busiest rank receives per step on a uniform cloud of `n`
@@ -176,22 +235,13 @@ pub fn tree_bytes_of_cloud<T: Real, const D: usize>(
     leaf_size: usize,
     multipole: Multipole,
 ) -> Vec<f64> {
-    let owners = domains.assign(&cloud.pos);
     let ranks = domains.ranks();
     let boxes: Vec<_> = (0..ranks).map(|r| domains.boxes(r)).collect();
     let mut received = vec![0.0; ranks];
-    for sender in 0..ranks {
-        let mine: Vec<usize> = (0..cloud.len()).filter(|&i| owners[i] == sender).collect();
-        let mut own = State::new(mine.len());
-        for (k, &i) in mine.iter().enumerate() {
-            for d in 0..D {
-                own.pos[d][k] = cloud.pos[d][i];
-            }
-            own.source[k] = cloud.source[i];
-        }
+    for (sender, own) in split(cloud, domains).iter().enumerate() {
         // The tree needs no force law to be built.
         let mut tree = Octree::with_multipole((), theta, leaf_size, multipole);
-        tree.build(&own);
+        tree.build(own);
         for (r, domain) in boxes.iter().enumerate().filter(|&(r, _)| r != sender) {
             let set = essential::select(&tree.view(), domain);
             received[r] += set.bytes(D, std::mem::size_of::<T>()) as f64;
@@ -250,22 +300,41 @@ mod tests {
     }
 
     #[test]
-    fn octants_replicate_the_bodies() {
-        assert_eq!(octants_bytes_per_rank(&[10, 20, 30], 3, 8), 50.0 * 32.0);
-        assert_eq!(octants_bytes_per_rank(&[], 3, 8), 0.0);
-        assert_eq!(octants_uniform_bytes_per_rank(8000, 8, 3, 8), 7000.0 * 32.0);
-        // Counted on a uniform cloud with the octant domains: close to the model.
-        let s = random_state::<f64, 3>(8000, 1.0, false, SEED_1);
-        let (lo, side) = root_cube(&s.pos);
-        let counts = Octants::new(lo, side, 8, &s.pos)
-            .expect("octants")
-            .counts(&s.pos);
-        let counted = octants_bytes_per_rank(&counts, 3, 8);
-        let modelled = octants_uniform_bytes_per_rank(8000, 8, 3, 8);
-        assert!(
-            (counted / modelled - 1.0).abs() < 0.02,
-            "{counted} vs {modelled}"
+    fn octants_send_the_groups_near_other_domains() {
+        // One rank: nothing to send. Eight octants of a uniform cloud: every rank sends its top
+        // nodes to seven others and some groups; doubling n at fixed p keeps the requested
+        // share of bodies (the top nodes scale with the domains), so bytes about double.
+        let count = |n: usize, p: usize| {
+            let s = random_state::<f64, 3>(n, 1.0, false, SEED_1);
+            let (lo, side) = root_cube(&s.pos);
+            let octants = Octants::new(lo, side, p, &s.pos).expect("octants");
+            octants_bytes_of_cloud(&s, &octants, 0.5, 8, 3)
+        };
+        assert_eq!(count(4000, 1), vec![0.0]);
+        let a = count(8000, 8);
+        let b = count(16_000, 8);
+        let (ma, mb) = (
+            a.iter().copied().fold(0.0, f64::max),
+            b.iter().copied().fold(0.0, f64::max),
         );
+        assert!(a.iter().all(|&x| x > 0.0), "{a:?}");
+        assert!(mb / ma > 1.5 && mb / ma < 2.5, "×{} for 2× n", mb / ma);
+        // Less than replicating every body (the replicated data's Allgatherv).
+        assert!(mb < allgather_bytes_per_rank(16_000, 8, 3, 8), "{mb}");
+        // θ = 0 accepts no top node: every group goes to every other rank.
+        let s = random_state::<f64, 3>(2000, 1.0, false, SEED_1);
+        let (lo, side) = root_cube(&s.pos);
+        let oct = Octants::new(lo, side, 2, &s.pos).expect("octants");
+        let sent = octants_bytes_of_cloud(&s, &oct, 0.0, 8, 3);
+        let counts = oct.counts(&s.pos);
+        for r in 0..2 {
+            // Its bodies (4 values) plus group counts out, the other's forces (3 values) back.
+            let floor = (counts[r] * 4 + counts[1 - r] * 3) as f64 * 8.0;
+            assert!(
+                sent[r] > floor && sent[r] < floor * 1.2,
+                "{sent:?} {counts:?}"
+            );
+        }
     }
 
     #[test]
@@ -282,8 +351,6 @@ mod tests {
                 );
                 let all = |n| allgather_bytes_per_rank(n, p, dim, 8);
                 assert!((all(2_000_000) / all(1_000_000) - 2.0).abs() < 1e-6);
-                let oct = |n| octants_uniform_bytes_per_rank(n, p, dim, 8);
-                assert!((oct(2_000_000) / oct(1_000_000) - 2.0).abs() < 1e-6);
                 assert!(tree(1_000_000) < 0.5 * all(1_000_000), "{dim}-D, p = {p}");
             }
         }

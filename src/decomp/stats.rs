@@ -68,6 +68,15 @@ impl MinMeanMax {
             max,
         }
     }
+
+    /// Max over mean: the load imbalance of a per-rank quantity (1 when the mean is 0).
+    pub fn imbalance(&self) -> f64 {
+        if self.mean > 0.0 {
+            self.max / self.mean
+        } else {
+            1.0
+        }
+    }
 }
 
 /// The per-rank statistics reduced over the ranks.
@@ -105,11 +114,7 @@ pub fn reduce(per_rank: &[RankStats]) -> ReducedStats {
         messages_sent: of(&|r| r.messages_sent as f64),
         ghosts_received: of(&|r| r.ghosts_received as f64),
         migrated_out: of(&|r| r.migrated_out as f64),
-        compute_imbalance: if compute.mean > 0.0 {
-            compute.max / compute.mean
-        } else {
-            1.0
-        },
+        compute_imbalance: compute.imbalance(),
         comm_fraction: if compute.mean + comm.mean > 0.0 {
             comm.mean / (compute.mean + comm.mean)
         } else {
@@ -237,6 +242,8 @@ mod tests {
         );
         assert_eq!(red.compute_s.mean, 2.5);
         assert_eq!(red.compute_imbalance, 4.0 / 2.5);
+        assert_eq!(MinMeanMax::of([0.0, 0.0]).imbalance(), 1.0);
+        assert_eq!(MinMeanMax::of([100.0, 300.0]).imbalance(), 1.5);
         assert_eq!(red.comm_fraction, 1.0 / 3.5);
         assert_eq!(red.bytes_sent.max, 30.0);
         assert_eq!(MinMeanMax::of([]), MinMeanMax::default());

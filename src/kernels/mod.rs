@@ -20,7 +20,7 @@ pub mod verlet;
 pub use cell_list::CellList;
 pub use naive::Naive;
 pub(crate) use octree::interleave;
-pub use octree::{Multipole, Octree, TreeView};
+pub use octree::{Multipole, Octree, TreeView, far_from_box};
 pub use per_thread::PerThread;
 pub use share::Share;
 pub use symmetric::Symmetric;

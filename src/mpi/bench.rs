@@ -70,6 +70,7 @@ pub fn run(comm: &mut Comm, o: &BenchOptions) -> Result<Option<MpiBenchFile>, Mp
         mpi_standard: format!("{major}.{minor}"),
         logical_cpus: logical,
         oversubscribed: here > logical,
+        transport: crate::decomp::bench_file::transport_from_env(),
         ping_pong: Series {
             definition: "one-way seconds: half the round trip of a message of `bytes` from rank 0 \
                          to rank 1 and back"

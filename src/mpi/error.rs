@@ -25,6 +25,8 @@ pub enum MpiError {
     Decomp(#[from] DecompError),
     #[error(transparent)]
     Regions(#[from] RegionsError),
+    #[error(transparent)]
+    Domains(#[from] crate::decomp::DomainError),
     #[error("rank {rank}: {error}")]
     Boundary { rank: usize, error: BoundaryError },
     #[error("rank {rank} stopped at step {step}; its error is printed above")]

@@ -7,8 +7,9 @@ use super::comm::{Comm, Lent};
 use super::domain::{Domain, DomainOptions};
 use super::driver::{Driver, Timeline, drive, pack_owned};
 use super::error::MpiError;
+use super::tree::{EssentialTree, OctantTree};
 use crate::decomp::Decomposition;
-use crate::decomp::check::{CheckReport, compare};
+use crate::decomp::check::{CheckReport, TreeCheck, compare, relative_drift};
 use crate::decomp::stats::{MasterSummary, MpiReport, RankStats, attribute_waits, reduce};
 use crate::decomp::wire::{bytes_of, floats_of, particle_values};
 use crate::engine::{PhaseTimes, Simulation};
@@ -20,8 +21,13 @@ use crate::run::{Measured, RunOutcome};
 use crate::scenario::{System, SystemJob};
 use crate::state::{Field, State, zero_field};
 use crate::stats::StepHistogram;
+use crate::validate::{octree_tolerance, sampled_force_error};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
+
+/// Bodies whose forces `mpi-check` compares with the direct sum for a distributed tree (all of
+/// them up to this n; the sum costs n per body).
+const TREE_CHECK_BODIES: usize = 4000;
 
 /// What to run on every rank.
 #[derive(Clone, Debug)]
@@ -69,7 +75,7 @@ impl SystemJob for MpiJob<'_> {
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
         let MpiJob { spec, comm } = self;
         spec.decomp.check(spec.kernel)?;
-        if spec.decomp == Decomposition::Allgather && spec.domain.rank_grid.is_some() {
+        if spec.decomp != Decomposition::Domain && spec.domain.rank_grid.is_some() {
             return Err(MpiError::Usage(
                 "--rank-grid applies to --decomp domain only".into(),
             ));
@@ -97,6 +103,13 @@ impl SystemJob for MpiJob<'_> {
                     let border = KernelKind::CellList.build::<T, L, D>(law, &spec.params)?;
                     Box::new(Domain::new(system, kernel, border, &spec.domain, comm)?)
                 }
+                Decomposition::Octants => Box::new(OctantTree::new(system, &spec.params, comm)?),
+                Decomposition::Tree => Box::new(EssentialTree::new(
+                    system,
+                    &spec.params,
+                    spec.domain.rebalance_above,
+                    comm,
+                )?),
             };
             let line = drive(driver.as_mut(), comm, spec.warmup, spec.steps)?;
             let records = gather_records(driver.as_ref(), &line, comm)?;
@@ -302,7 +315,25 @@ fn finish<T: Real, L: PairLaw<T>, const D: usize>(
                 .map_err(|error| MpiError::Boundary { rank: 0, error })?;
         }
         let migrated = report.per_rank.iter().map(|r| r.migrated_out).sum();
-        Some(compare(&serial.state, &state, migrated, far_migrated))
+        let mut check = compare(&serial.state, &state, migrated, far_migrated);
+        if spec.decomp.distributes_the_tree() {
+            // `end` holds the serial octree's forces at the distributed final positions.
+            let e_serial = serial.probe().finite_after(steps_done)?;
+            let picks = n.min(TREE_CHECK_BODIES);
+            let scale = e0.kinetic.abs() + e0.potential.abs() + e0.external.abs();
+            // (`end` holds its state in the kernel's order, the gathered one in id order.)
+            let error = |s: &State<T, D>, f: &Field<T, D>| {
+                sampled_force_error(&reference.law, s, f, picks, 1).0
+            };
+            check.tree = Some(TreeCheck {
+                force_error: error(&state, &forces),
+                serial_force_error: error(&end.state, &end.forces),
+                force_tolerance: octree_tolerance(reference.law.kind(), spec.params.theta),
+                energy_drift: relative_drift(e0.total(), scale, e1.total()),
+                serial_energy_drift: relative_drift(e0.total(), scale, e_serial.total()),
+            });
+        }
+        Some(check)
     } else {
         None
     };

@@ -1,5 +1,7 @@
 //! The MPI drivers (cargo feature `mpi`): the replicated-data and the spatial decomposition
-//! of a run over MPI ranks, the comparison with a serial run, and the communication benchmark.
+//! of a run over MPI ranks, the two distributed Barnes-Hut trees ([`tree`]: the source's
+//! octants and the locally essential trees), the comparison with a serial run, and the
+//! communication benchmark.
 //! The physics, kernels and integrator are the engine's; this module only decides which
 //! particles each rank integrates and moves data between ranks. What does not need MPI
 //! (regions, statistics, byte counts, file formats) is in [`crate::decomp`].
@@ -11,6 +13,7 @@ mod domain;
 mod driver;
 mod error;
 mod job;
+mod tree;
 
 pub use crate::decomp::check::CheckReport;
 pub use bench::BenchOptions;

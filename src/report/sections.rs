@@ -12,7 +12,12 @@ const NO_NOTES: &str =
 
 pub use super::comm_section::{Comm, comm_figures};
 
-pub fn document(sweeps: &[Sweep], comm: Option<&Comm>, results_dir: &Path) -> String {
+pub fn document(
+    sweeps: &[Sweep],
+    comm: Option<&Comm>,
+    tree: Option<&crate::analysis::tree_comm::TreeComm>,
+    results_dir: &Path,
+) -> String {
     let mut md = String::new();
     let dir = results_dir.display().to_string().replace('\\', "/");
     let _ = writeln!(
@@ -29,6 +34,7 @@ pub fn document(sweeps: &[Sweep], comm: Option<&Comm>, results_dir: &Path) -> St
     strong(&mut md, sweeps);
     weak(&mut md, sweeps);
     super::comm_section::section(&mut md, sweeps, comm, NO_NOTES);
+    super::tree_section::section(&mut md, tree, NO_NOTES);
     octree(&mut md, sweeps);
     peers(&mut md, sweeps);
     sanity(&mut md, sweeps);

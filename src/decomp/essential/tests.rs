@@ -251,3 +251,44 @@ fn entries_and_bytes_count_the_payload() {
     let empty = tree_of(&State::<f64, 3>::new(0), 0.5, Multipole::Monopole);
     assert_eq!(select(&empty.view(), &orb.boxes(0)).entries(), 0);
 }
+
+#[test]
+fn faces_on_the_root_walls_open_to_infinity_and_the_export_still_holds_beyond_them() {
+    let cloud = plummer_state::<f64, 3>(3000, SEED_1);
+    let orb = Orb::over(2, &cloud.pos, &vec![1.0; 3000]).expect("orb");
+    let root = crate::decomp::orb::bounding_box(&cloud.pos);
+    let open = open_at_walls(&orb.boxes(1), &root);
+    assert_eq!(open.len(), 1);
+    let (lo, hi) = open[0];
+    // Two ranks: one cut; every other face lies on a wall.
+    let inner = (0..3)
+        .filter(|&d| lo[d].is_finite() || hi[d].is_finite())
+        .count();
+    assert_eq!(inner, 1, "{open:?}");
+    // A point far outside the root box on rank 1's side: owned by rank 1, and every exported
+    // node passes the test there.
+    let sender = bodies_of(&cloud, &orb.assign(&cloud.pos), 0);
+    let k = tree_of(&sender, 0.5, Multipole::Monopole);
+    let view = k.view();
+    let set = select(&view, &open);
+    // Rank 1 is the upper side of the cut: beyond the top wall of that axis and below the
+    // bottom walls of the others.
+    let axis = (0..3).find(|&d| lo[d].is_finite()).expect("the cut");
+    let extent = (0..3).map(|d| root.1[d] - root.0[d]).fold(0.0, f64::max);
+    let far: [f64; 3] = std::array::from_fn(|d| {
+        if d == axis {
+            root.1[d] + 100.0 * extent
+        } else {
+            root.0[d] - 100.0 * extent
+        }
+    });
+    assert_eq!(orb.owner(far), 1);
+    for &node in &set.nodes {
+        assert!(
+            view.far_from_box(node, &far, &far),
+            "node {node} fails at {far:?}"
+        );
+    }
+    // The finite box is the easier test: its export is a coarsening, never larger.
+    assert!(select(&view, &orb.boxes(1)).entries() <= set.entries());
+}

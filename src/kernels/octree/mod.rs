@@ -40,6 +40,7 @@ use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::state::{Field, State};
+pub use node::far_from_box;
 use std::ops::Range;
 use std::sync::Mutex;
 use std::time::Instant;

@@ -29,14 +29,26 @@ impl<T: Real, const D: usize> Node<T, D> {
     /// walk tests whole families with it; a NaN distance fails the test, so the node is opened.
     #[inline(always)]
     pub fn far_from_box(&self, lo: &[T; D], hi: &[T; D]) -> bool {
-        let mut d2 = T::zero();
-        for d in 0..D {
-            let x = self.com[d];
-            let e = max(max(lo[d] - x, x - hi[d]), T::zero());
-            d2 += e * e;
-        }
-        d2 > self.crit2
+        far_from_box(&self.com, self.crit2, lo, hi)
     }
+}
+
+/// The opening test of a node given by its centre of strength and `crit2 = (side/θ)²` (see
+/// [`Node::far_from_box`]), for nodes that travel without their tree (`decomp::top_nodes`).
+#[inline(always)]
+pub fn far_from_box<T: Real, const D: usize>(
+    com: &[T; D],
+    crit2: T,
+    lo: &[T; D],
+    hi: &[T; D],
+) -> bool {
+    let mut d2 = T::zero();
+    for d in 0..D {
+        let x = com[d];
+        let e = max(max(lo[d] - x, x - hi[d]), T::zero());
+        d2 += e * e;
+    }
+    d2 > crit2
 }
 
 /// The larger of two values as a plain compare-and-select (a NaN gives `b`): `Float::max`

@@ -56,6 +56,15 @@ impl<T: Real, const D: usize> TreeView<'_, T, D> {
         n.start as usize..n.end as usize
     }
 
+    /// The kernel's target groups: runs of sorted slots of neighbouring bodies (up to
+    /// `GROUP_SIZE`) that share one interaction list; they tile the sorted bodies.
+    pub fn groups(&self) -> impl Iterator<Item = Range<usize>> + '_ {
+        self.tree
+            .groups
+            .iter()
+            .map(|g| g.start as usize..g.end as usize)
+    }
+
     /// Number of bodies in the tree.
     pub fn body_count(&self) -> usize {
         self.tree.src.len()
@@ -92,6 +101,13 @@ impl<T: Real, const D: usize> TreeView<'_, T, D> {
     pub fn moments(&self, node: u32) -> &[T] {
         let w = self.moment_values();
         &self.tree.quad.values[node as usize * w..(node as usize + 1) * w]
+    }
+
+    /// `(side/θ)²` of `node`: the node may act as a multipole on a point whose squared
+    /// distance from its centre exceeds this (infinite at θ = 0), the test of
+    /// [`TreeView::far_from_box`] for one point.
+    pub fn open_radius2(&self, node: u32) -> T {
+        self.tree.nodes[node as usize].crit2
     }
 
     /// The kernel's opening test: whether `node` may act as a multipole on every point of the
