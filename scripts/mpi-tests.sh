@@ -84,7 +84,8 @@ for ranks in 1 2 3 4; do
     if [ "$ranks" -gt 1 ]; then migration=(--expect-migration); fi
     for decomp in octants tree; do
         check "$ranks" --scenario galaxy --kernel octree --decomp "$decomp" -n 2001 --steps 300 ${migration[@]+"${migration[@]}"}
-        check "$ranks" --scenario coulomb --kernel octree --decomp "$decomp" -n 1501 --steps 30 ${migration[@]+"${migration[@]}"}
+        # (The plasma's charges barely leave their octants in 30 steps: the galaxy tests migration.)
+        check "$ranks" --scenario coulomb --kernel octree --decomp "$decomp" -n 1501 --steps 30
     done
 done
 # Ranks without bodies, the quadrupole order, and rebalancing of the bisection.
