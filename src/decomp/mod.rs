@@ -43,8 +43,8 @@ pub enum Decomposition {
     /// ghosts within the cutoff with its neighbours and migrates particles that cross its border.
     Domain,
     /// The gravity source's distributed Barnes-Hut (octree): domains from the octants of the
-    /// root cube, local trees, top nodes shared with an Allgather, and the bodies that fail
-    /// the opening test against a remote domain sent to its owner for their near forces.
+    /// root cube, local trees, top nodes shared with an Allgather, and the groups of bodies that
+    /// fail the opening test against a remote domain sent to its owner for their forces.
     Octants,
     /// Distributed Barnes-Hut (octree) with locally essential trees over a cost-balanced
     /// orthogonal recursive bisection: each rank sends each other rank the part of its tree
