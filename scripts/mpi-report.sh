@@ -11,6 +11,8 @@
 # About 25 minutes on a 2-vCPU machine. Installs Open MPI when missing (scripts/install-mpi.sh).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/lib/sweep.sh
+source scripts/lib/sweep.sh
 
 mode="${1:-}"
 scripts/install-mpi.sh
@@ -34,15 +36,7 @@ bench() { # DIR RANKS FILE [MPIRUN ARGS...]
 }
 
 sweep() { # NAME
-    local name=$1
-    echo "== sweep configs/$name.toml"
-    if [[ "$mode" == "--fresh" ]]; then
-        "$bin" sweep --config "configs/$name.toml" --out results --fresh
-    elif [[ -f "results/$name/results.json" ]]; then
-        "$bin" sweep --config "configs/$name.toml" --out results --resume --force
-    else
-        "$bin" sweep --config "configs/$name.toml" --out results
-    fi
+    sweep_into_results "$bin" "$1" "$mode"
 }
 
 bench weak-mpi 2 mpi-bench-2.json

@@ -12,6 +12,8 @@
 # load they saw, and the report shows it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
+# shellcheck source=scripts/lib/sweep.sh
+source scripts/lib/sweep.sh
 
 CONFIGS=(complexity complexity-large strong weak weak-time octree-accuracy
     vs-lammps vs-lammps-liquid vs-pytreegrav)
@@ -25,14 +27,7 @@ fi
 
 if [[ "$mode" != "--report" ]]; then
     for name in "${CONFIGS[@]}"; do
-        echo "== sweep configs/$name.toml"
-        if [[ "$mode" == "--fresh" ]]; then
-            "$bin" sweep --config "configs/$name.toml" --out results --fresh
-        elif [[ -f "results/$name/results.json" ]]; then
-            "$bin" sweep --config "configs/$name.toml" --out results --resume --force
-        else
-            "$bin" sweep --config "configs/$name.toml" --out results
-        fi
+        sweep_into_results "$bin" "$name" "$mode"
     done
     # The MPI sweeps and their mpi-bench files (rebuilds the binary with the mpi feature).
     scripts/mpi-report.sh "$mode"

@@ -156,18 +156,26 @@ fn split<T: Real, const D: usize>(
 ) -> Vec<State<T, D>> {
     let owners = domains.assign(&cloud.pos);
     (0..domains.ranks())
-        .map(|rank| {
-            let mine: Vec<usize> = (0..cloud.len()).filter(|&i| owners[i] == rank).collect();
-            let mut own = State::new(mine.len());
-            for (k, &i) in mine.iter().enumerate() {
-                for d in 0..D {
-                    own.pos[d][k] = cloud.pos[d][i];
-                }
-                own.source[k] = cloud.source[i];
-            }
-            own
-        })
+        .map(|rank| bodies_of(cloud, &owners, rank))
         .collect()
+}
+
+/// The bodies of `cloud` whose owner in `owners` is `rank`, as a state of their own (positions
+/// and strengths; the rest zero).
+pub(crate) fn bodies_of<T: Real, const D: usize>(
+    cloud: &State<T, D>,
+    owners: &[usize],
+    rank: usize,
+) -> State<T, D> {
+    let mine: Vec<usize> = (0..cloud.len()).filter(|&i| owners[i] == rank).collect();
+    let mut own = State::new(mine.len());
+    for (k, &i) in mine.iter().enumerate() {
+        for d in 0..D {
+            own.pos[d][k] = cloud.pos[d][i];
+        }
+        own.source[k] = cloud.source[i];
+    }
+    own
 }
 
 /// The locally essential tree the busiest rank receives per step on a uniform cloud of `n`

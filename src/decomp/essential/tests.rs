@@ -5,6 +5,7 @@
 
 use super::*;
 use crate::decomp::Domains;
+use crate::decomp::model::bodies_of;
 use crate::decomp::octants::{Octants, root_cube};
 use crate::decomp::orb::Orb;
 use crate::kernels::{Multipole, Octree};
@@ -14,19 +15,6 @@ use crate::testing::{SEED_1, SEED_2, plummer_state, random_state};
 use std::ops::Range;
 
 const LEAF: usize = 8;
-
-/// The bodies of `s` that `rank` owns, as a state of their own.
-fn bodies_of<const D: usize>(s: &State<f64, D>, owners: &[usize], rank: usize) -> State<f64, D> {
-    let mine: Vec<usize> = (0..s.len()).filter(|&i| owners[i] == rank).collect();
-    let mut out = State::new(mine.len());
-    for (k, &i) in mine.iter().enumerate() {
-        for d in 0..D {
-            out.pos[d][k] = s.pos[d][i];
-        }
-        out.source[k] = s.source[i];
-    }
-    out
-}
 
 fn tree_of<const D: usize>(
     s: &State<f64, D>,
