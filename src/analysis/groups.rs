@@ -113,6 +113,22 @@ pub fn workers_suffix(threads: usize, ranks: usize) -> String {
     }
 }
 
+/// What the p of a scaling series counts, for an axis, from its cases' `(threads, ranks)`:
+/// "threads" when every case ran one rank, "ranks" when every case ran one thread, else
+/// "workers (threads × ranks)".
+pub fn workers_noun(cases: impl IntoIterator<Item = (usize, usize)>) -> &'static str {
+    let (mut threads, mut ranks) = (false, false);
+    for (t, r) in cases {
+        threads |= t > 1;
+        ranks |= r > 1;
+    }
+    match (threads, ranks) {
+        (false, true) => "ranks",
+        (true, true) => "workers (threads × ranks)",
+        _ => "threads",
+    }
+}
+
 /// Cases that differ only in the quantity the series varies, sorted by it.
 #[derive(Clone, Debug, Serialize)]
 pub struct Series {
@@ -280,7 +296,7 @@ fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64)
 
 #[cfg(test)]
 mod tests {
-    use super::workers_suffix;
+    use super::{workers_noun, workers_suffix};
 
     #[test]
     fn workers_are_named_in_labels() {
@@ -288,5 +304,16 @@ mod tests {
         assert_eq!(workers_suffix(2, 1), ", 2 threads");
         assert_eq!(workers_suffix(1, 2), ", 2 ranks");
         assert_eq!(workers_suffix(2, 2), ", 2 threads × 2 ranks");
+    }
+
+    #[test]
+    fn scaling_axes_name_what_p_counts() {
+        assert_eq!(workers_noun([(1, 1), (2, 1), (4, 1)]), "threads");
+        assert_eq!(workers_noun([(1, 1), (1, 2), (1, 4)]), "ranks");
+        assert_eq!(
+            workers_noun([(1, 1), (2, 1), (1, 2)]),
+            "workers (threads × ranks)"
+        );
+        assert_eq!(workers_noun([]), "threads");
     }
 }

@@ -259,14 +259,23 @@ fn kernel_figures_render_for_every_input() {
         let ceiling = [(1.0, 1.0), (2.0, 1.08)];
         let charts = [
             ("time", figures::time_per_step(&kernels, CAPTION)),
-            ("speedup", figures::speedup(&kernels, &ceiling, CAPTION)),
+            (
+                "speedup",
+                figures::speedup(&kernels, &ceiling, "threads", CAPTION),
+            ),
             (
                 "speedup-no-ceiling",
-                figures::speedup(&kernels, &[], CAPTION),
+                figures::speedup(&kernels, &[], "threads", CAPTION),
             ),
-            ("efficiency", figures::efficiency(&kernels, CAPTION)),
-            ("weak", figures::weak_efficiency(&kernels, CAPTION)),
-            ("karp-flatt", figures::karp_flatt(&kernels, CAPTION)),
+            (
+                "efficiency",
+                figures::efficiency(&kernels, "threads", CAPTION),
+            ),
+            ("weak", figures::weak_efficiency(&kernels, "ranks", CAPTION)),
+            (
+                "karp-flatt",
+                figures::karp_flatt(&kernels, "threads", CAPTION),
+            ),
         ];
         for (name, chart) in charts {
             let stem = format!("{name}-{}", case.replace(' ', "-"));
@@ -279,7 +288,7 @@ fn kernel_figures_render_for_every_input() {
 fn a_missing_series_fails_the_check() {
     let dir = tempfile::tempdir().unwrap();
     let kernels = kernel_cases().pop().unwrap().1;
-    let full = figures::speedup(&kernels, &[(1.0, 1.0), (2.0, 1.08)], CAPTION);
+    let full = figures::speedup(&kernels, &[(1.0, 1.0), (2.0, 1.08)], "threads", CAPTION);
     for dropped in 0..full.series.len() {
         let mut partial = full.clone();
         partial.series.remove(dropped);
@@ -487,7 +496,7 @@ fn rendering_replaces_files_and_makes_the_directory() {
 #[test]
 fn bad_names_and_places_are_errors_that_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let chart = figures::efficiency(&[], CAPTION);
+    let chart = figures::efficiency(&[], "threads", CAPTION);
     for stem in ["", "../escape", "a/b", ".hidden", "spaced name"] {
         let err = render(&chart, dir.path(), stem).unwrap_err();
         assert!(matches!(err, PlotError::BadName(_)), "{stem:?}: {err}");

@@ -3,7 +3,7 @@
 //! step-time percentiles, and octree error vs cost. Each states machine, commit and sweep in
 //! its caption.
 
-use crate::analysis::groups::Point;
+use crate::analysis::groups::{Point, workers_noun};
 use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis};
 use crate::kernels::Multipole;
 use crate::plot::figures::{
@@ -172,8 +172,13 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 acc
             });
         let speed: Vec<KernelSeries> = same.iter().map(|s| speedup_series(s)).collect();
-        let mut chart = fig::speedup(&speed, &ceiling, &cap);
-        chart.title = format!("{title}: speedup vs threads");
+        let workers = workers_noun(
+            same.iter()
+                .flat_map(|s| &s.points)
+                .map(|c| (c.threads, c.ranks)),
+        );
+        let mut chart = fig::speedup(&speed, &ceiling, workers, &cap);
+        chart.title = format!("{title}: speedup vs {workers}");
         out.push((format!("speedup-{stem}"), Drawing::Chart(chart)));
         let eff: Vec<KernelSeries> = same
             .iter()
@@ -194,7 +199,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 KernelSeries::new(s.label.clone(), m)
             })
             .collect();
-        let mut chart = fig::efficiency(&eff, &cap);
+        let mut chart = fig::efficiency(&eff, workers, &cap);
         chart.title = format!("{title}: parallel efficiency");
         out.push((format!("efficiency-{stem}"), Drawing::Chart(chart)));
         let kf: Vec<KernelSeries> = same
@@ -216,7 +221,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
             })
             .collect();
         if kf.iter().any(|k| !k.measured.is_empty()) {
-            let mut chart = fig::karp_flatt(&kf, &cap);
+            let mut chart = fig::karp_flatt(&kf, workers, &cap);
             chart.title = format!("{title}: Karp-Flatt serial fraction e(p)");
             out.push((format!("karp-flatt-{stem}"), Drawing::Chart(chart)));
         }
@@ -245,7 +250,14 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 KernelSeries::new(o.label.clone(), m)
             })
             .collect();
-        let mut chart = fig::weak_efficiency(&series, &cap);
+        let workers = workers_noun(
+            a.weak
+                .iter()
+                .filter(|o| o.series.scenario == w.series.scenario)
+                .flat_map(|o| &o.points)
+                .map(|c| (c.threads, c.ranks)),
+        );
+        let mut chart = fig::weak_efficiency(&series, workers, &cap);
         chart.title = format!("{scen}: weak-scaling efficiency T(1)/T(p)");
         out.push((format!("weak-efficiency-{scen}"), Drawing::Chart(chart)));
         weak_seen.push(scen);

@@ -2,6 +2,7 @@
 
 use super::Sweep;
 use super::keep::region;
+use crate::calibrate::Calibration;
 use crate::experiment::config::Study;
 use crate::render::tables;
 use std::fmt::Write;
@@ -82,13 +83,24 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
             m.target_features.join(" ")
         );
     }
-    md.push_str("| sweep | study | cases | commit | started | p = 2 ceiling | other load while calibrating |\n|---|---|---|---|---|---|---|\n");
+    let machines = machine_classes(sweeps);
+    if machines.len() > 1 {
+        let _ = writeln!(
+            md,
+            "The sweeps ran on {} machine classes ({}): the table above is the calibration that \
+             measured the most thread counts, the column below names each sweep's machine. Every \
+             comparison in this report sets measurements of one machine against each other.\n",
+            machines.len(),
+            machines.join(", "),
+        );
+    }
+    md.push_str("| sweep | study | cases | commit | started | machine (FMA GFLOP/s per thread) | p = 2 ceiling | other load while calibrating |\n|---|---|---|---|---|---|---|---|\n");
     for s in sweeps {
         let a = &s.analysis;
         let c = a.calibration.as_ref();
         let _ = writeln!(
             md,
-            "| `{}` | {:?} | {}{} | {}{} | {} | {} | {} |",
+            "| `{}` | {:?} | {}{} | {}{} | {} | {} | {} | {} |",
             a.source,
             a.study,
             a.cases.len(),
@@ -100,6 +112,8 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
             a.metadata.git_commit.chars().take(7).collect::<String>(),
             if a.metadata.git_dirty { "+dirty" } else { "" },
             a.metadata.started,
+            c.map(|c| format!("{} ({:.0})", machine_class(c), c.fma_gflops_1t))
+                .unwrap_or_else(|| "–".into()),
             c.and_then(|c| c.ceiling(2))
                 .map(|r| format!("{r:.2}×"))
                 .unwrap_or_else(|| "–".into()),
@@ -109,6 +123,28 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         );
     }
     md.push('\n');
+}
+
+/// A machine's class as the gate files it: the CPU signature, else the model name.
+fn machine_class(c: &Calibration) -> String {
+    c.cpu_signature
+        .clone()
+        .unwrap_or_else(|| c.cpu_model.clone())
+}
+
+/// The distinct machine classes of the sweeps, in order of first appearance.
+fn machine_classes(sweeps: &[Sweep]) -> Vec<String> {
+    let mut out: Vec<String> = Vec::new();
+    for c in sweeps
+        .iter()
+        .filter_map(|s| s.analysis.calibration.as_ref())
+    {
+        let class = machine_class(c);
+        if !out.contains(&class) {
+            out.push(class);
+        }
+    }
+    out
 }
 
 fn complexity(md: &mut String, sweeps: &[Sweep]) {

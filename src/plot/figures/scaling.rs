@@ -1,4 +1,5 @@
-//! Scaling figures: cost against n, and speedup, efficiency and Karp-Flatt against threads.
+//! Scaling figures: cost against n, and speedup, efficiency and Karp-Flatt against the workers
+//! p (`workers` names what p counts: "threads", "ranks", …).
 
 use super::{KernelSeries, extent, kernel_chart};
 use crate::plot::palette::REFERENCE_INDEX;
@@ -13,10 +14,16 @@ pub fn time_per_step(kernels: &[KernelSeries], caption: &str) -> Chart {
 
 /// Speedup T(1)/T(p) against threads with the ideal line S = p, the hardware ceiling measured
 /// by calibration as `(p, ceiling)` points, and each kernel's fit (e.g. Amdahl) with its band.
-pub fn speedup(kernels: &[KernelSeries], ceiling: &[(f64, f64)], caption: &str) -> Chart {
-    let x = Axis::linear("threads p").unit(Unit::Count);
+pub fn speedup(
+    kernels: &[KernelSeries],
+    ceiling: &[(f64, f64)],
+    workers: &str,
+    caption: &str,
+) -> Chart {
+    let x = Axis::linear(format!("{workers} p")).unit(Unit::Count);
     let y = Axis::linear("speedup T(1) / T(p)").from_zero();
-    let mut chart = kernel_chart("Strong scaling: speedup vs threads", x, y, kernels, caption);
+    let title = format!("Strong scaling: speedup vs {workers}");
+    let mut chart = kernel_chart(&title, x, y, kernels, caption);
     let measured = kernels.iter().flat_map(|k| k.measured.iter().map(|m| m.x));
     let fits = kernels.iter().flat_map(|k| &k.fit);
     if let Some((lo, hi)) = extent(measured.chain(fits.flat_map(|f| f.points.iter().map(|p| p.0))))
@@ -46,47 +53,37 @@ fn ideal_at_one() -> RefLine {
 }
 
 /// Parallel efficiency S(p)/p against threads, with the ideal 1.
-pub fn efficiency(kernels: &[KernelSeries], caption: &str) -> Chart {
-    let x = Axis::linear("threads p").unit(Unit::Count);
+pub fn efficiency(kernels: &[KernelSeries], workers: &str, caption: &str) -> Chart {
+    let x = Axis::linear(format!("{workers} p")).unit(Unit::Count);
     let y = Axis::linear("parallel efficiency S(p) / p").from_zero();
-    let mut chart = kernel_chart(
-        "Strong scaling: parallel efficiency vs threads",
-        x,
-        y,
-        kernels,
-        caption,
-    );
+    let title = format!("Strong scaling: parallel efficiency vs {workers}");
+    let mut chart = kernel_chart(&title, x, y, kernels, caption);
     chart.hlines.push(ideal_at_one());
     chart
 }
 
-/// Weak-scaling efficiency T(1)/T(p) against threads (n grows with p), with the ideal 1.
-pub fn weak_efficiency(kernels: &[KernelSeries], caption: &str) -> Chart {
-    let x = Axis::linear("threads p (work per thread held constant)").unit(Unit::Count);
+/// Weak-scaling efficiency T(1)/T(p) against the workers (n grows with p), with the ideal 1.
+pub fn weak_efficiency(kernels: &[KernelSeries], workers: &str, caption: &str) -> Chart {
+    let one = match workers {
+        "threads" => "thread",
+        "ranks" => "rank",
+        _ => "worker",
+    };
+    let x = Axis::linear(format!("{workers} p (work per {one} held constant)")).unit(Unit::Count);
     let y = Axis::linear("weak-scaling efficiency T(1) / T(p)").from_zero();
-    let mut chart = kernel_chart(
-        "Weak scaling: efficiency vs threads",
-        x,
-        y,
-        kernels,
-        caption,
-    );
+    let title = format!("Weak scaling: efficiency vs {workers}");
+    let mut chart = kernel_chart(&title, x, y, kernels, caption);
     chart.hlines.push(ideal_at_one());
     chart
 }
 
 /// The Karp-Flatt experimentally determined serial fraction e(p) against threads (p ≥ 2).
 /// A rising e(p) points to parallel overhead, a flat one to inherently serial work.
-pub fn karp_flatt(kernels: &[KernelSeries], caption: &str) -> Chart {
-    let x = Axis::linear("threads p").unit(Unit::Count);
+pub fn karp_flatt(kernels: &[KernelSeries], workers: &str, caption: &str) -> Chart {
+    let x = Axis::linear(format!("{workers} p")).unit(Unit::Count);
     let y = Axis::linear("serial fraction e(p)");
-    let mut chart = kernel_chart(
-        "Karp-Flatt serial fraction vs threads",
-        x,
-        y,
-        kernels,
-        caption,
-    );
+    let title = format!("Karp-Flatt serial fraction vs {workers}");
+    let mut chart = kernel_chart(&title, x, y, kernels, caption);
     chart.hlines.push(RefLine {
         label: String::new(),
         y: 0.0,
