@@ -99,19 +99,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let kernels = scaling_kernels();
     let ceiling = [(1.0, 1.0), (2.0, 1.08)];
     rendered.push(plot::render(
-        &figures::speedup(&kernels, &ceiling, CAPTION),
+        &figures::speedup(&kernels, &ceiling, "threads", CAPTION),
         &dir,
         "speedup",
     )?);
     let efficiency = ratio_series(&kernels, |p, s| s / p);
     rendered.push(plot::render(
-        &figures::efficiency(&efficiency, CAPTION),
+        &figures::efficiency(&efficiency, "threads", CAPTION),
         &dir,
         "efficiency",
     )?);
     let weak = ratio_series(&kernels, |p, s| (s / p).powf(0.7));
     rendered.push(plot::render(
-        &figures::weak_efficiency(&weak, CAPTION),
+        &figures::weak_efficiency(&weak, "threads", CAPTION),
         &dir,
         "weak-efficiency",
     )?);
@@ -124,7 +124,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             })
             .collect();
     rendered.push(plot::render(
-        &figures::karp_flatt(&karp, CAPTION),
+        &figures::karp_flatt(&karp, "threads", CAPTION),
         &dir,
         "karp-flatt",
     )?);

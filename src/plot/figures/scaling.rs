@@ -106,7 +106,7 @@ mod tests {
             vec![Measured::new(1.0, 1.0), Measured::new(4.0, 2.0)],
         )
         .with_fit(amdahl)];
-        let chart = speedup(&kernels, &[(1.0, 1.0), (2.0, 1.1)], "m");
+        let chart = speedup(&kernels, &[(1.0, 1.0), (2.0, 1.1)], "threads", "m");
         let labels: Vec<&str> = chart.series.iter().map(|s| s.label.as_str()).collect();
         assert_eq!(
             labels,
@@ -123,7 +123,21 @@ mod tests {
 
     #[test]
     fn no_measurements_means_no_ideal_line() {
-        assert!(speedup(&[], &[], "").series.is_empty());
-        assert_eq!(efficiency(&[], "").hlines[0].y, 1.0);
+        assert!(speedup(&[], &[], "threads", "").series.is_empty());
+        assert_eq!(efficiency(&[], "threads", "").hlines[0].y, 1.0);
+    }
+
+    #[test]
+    fn axes_and_titles_name_the_workers() {
+        let weak = weak_efficiency(&[], "ranks", "");
+        assert_eq!(weak.x.label, "ranks p (work per rank held constant)");
+        assert_eq!(weak.title, "Weak scaling: efficiency vs ranks");
+        let mixed = weak_efficiency(&[], "workers (threads × ranks)", "");
+        assert_eq!(
+            mixed.x.label,
+            "workers (threads × ranks) p (work per worker held constant)"
+        );
+        assert_eq!(speedup(&[], &[], "ranks", "").x.label, "ranks p");
+        assert_eq!(karp_flatt(&[], "threads", "").x.label, "threads p");
     }
 }
