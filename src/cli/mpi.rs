@@ -211,9 +211,10 @@ mod with_mpi {
             red.compute_imbalance
         );
         outln!(
-            "traffic per rank  {:.3e} bytes, {:.0} messages sent (mean); particles {:.0}..{:.0}; ghosts received {:.0}, migrated {:.0} (mean)",
+            "traffic per rank  {:.3e} bytes, {:.0} point-to-point messages, {:.0} collective calls (mean); particles {:.0}..{:.0}; ghosts received {:.0}, migrated {:.0} (mean)",
             red.bytes_sent.mean,
             red.messages_sent.mean,
+            red.collectives.mean,
             red.particles.min,
             red.particles.max,
             red.ghosts_received.mean,

@@ -90,6 +90,10 @@ pub struct ReducedStats {
     pub transfer_s: MinMeanMax,
     pub bytes_sent: MinMeanMax,
     pub messages_sent: MinMeanMax,
+    /// Collective calls this rank took part in (absent from files written before they were
+    /// reported).
+    #[serde(default)]
+    pub collectives: MinMeanMax,
     pub ghosts_received: MinMeanMax,
     pub migrated_out: MinMeanMax,
     /// Slowest rank's compute time over the mean (1 = perfectly balanced).
@@ -112,6 +116,7 @@ pub fn reduce(per_rank: &[RankStats]) -> ReducedStats {
         transfer_s: of(&|r| r.transfer_s),
         bytes_sent: of(&|r| r.bytes_sent as f64),
         messages_sent: of(&|r| r.messages_sent as f64),
+        collectives: of(&|r| r.collectives as f64),
         ghosts_received: of(&|r| r.ghosts_received as f64),
         migrated_out: of(&|r| r.migrated_out as f64),
         compute_imbalance: compute.imbalance(),
@@ -228,6 +233,7 @@ mod tests {
                 compute_s: 1.0 + r as f64,
                 comm_s: 1.0,
                 bytes_sent: 10 * r as u64,
+                collectives: 2 + r as u64,
                 ..Default::default()
             })
             .collect();
@@ -246,6 +252,7 @@ mod tests {
         assert_eq!(MinMeanMax::of([100.0, 300.0]).imbalance(), 1.5);
         assert_eq!(red.comm_fraction, 1.0 / 3.5);
         assert_eq!(red.bytes_sent.max, 30.0);
+        assert_eq!(red.collectives.mean, 3.5);
         assert_eq!(MinMeanMax::of([]), MinMeanMax::default());
     }
 }

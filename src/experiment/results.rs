@@ -346,7 +346,10 @@ impl Metadata {
     }
 }
 
-/// The commit of the working directory's repository and whether tracked files differ from it.
+/// The commit of the working directory's repository and whether tracked files differ from it,
+/// measurement outputs aside: `results/` and `REPORT.md` change while sweeps run (an
+/// `mpi-bench` file written before its sweep, a sweep before the next one), not the code they
+/// measure.
 pub fn git_state() -> (String, bool) {
     let run = |args: &[&str]| {
         std::process::Command::new("git")
@@ -358,8 +361,16 @@ pub fn git_state() -> (String, bool) {
     };
     match run(&["rev-parse", "HEAD"]) {
         Some(commit) => {
-            let dirty = run(&["status", "--porcelain", "--untracked-files=no"])
-                .is_some_and(|s| !s.is_empty());
+            let dirty = run(&[
+                "status",
+                "--porcelain",
+                "--untracked-files=no",
+                "--",
+                ":/",
+                ":(top,exclude)results",
+                ":(top,exclude)REPORT.md",
+            ])
+            .is_some_and(|s| !s.is_empty());
             (commit, dirty)
         }
         None => ("unknown".to_string(), false),
