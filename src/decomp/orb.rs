@@ -183,6 +183,30 @@ impl<const D: usize> Orb<D> {
     }
 }
 
+/// The sample of a rank's `bodies` that a new bisection is cut on: every `stride`-th body
+/// (indices `0, stride, 2·stride, …`), each weighing what the bodies it stands for cost — its
+/// own and the next `stride − 1`'s interaction counts from `costs` (one per body; a body
+/// counted at zero still weighs 1, so that it goes somewhere) — or, without per-body costs,
+/// `mean_cost` per body. The weights add up to the rank's total cost either way.
+pub fn sample_weights(
+    bodies: usize,
+    stride: usize,
+    costs: Option<&[u32]>,
+    mean_cost: f64,
+) -> Vec<f64> {
+    let stride = stride.max(1);
+    (0..bodies)
+        .step_by(stride)
+        .map(|i| {
+            let stands_for = i..(i + stride).min(bodies);
+            match costs {
+                Some(c) => c[stands_for].iter().map(|&x| f64::from(x.max(1))).sum(),
+                None => mean_cost * stands_for.len() as f64,
+            }
+        })
+        .collect()
+}
+
 impl<const D: usize> Domains<D> for Orb<D> {
     fn ranks(&self) -> usize {
         self.regions.len()

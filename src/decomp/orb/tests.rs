@@ -156,3 +156,44 @@ fn bad_inputs_are_errors() {
         Err(DomainError::BadBox { .. })
     ));
 }
+
+#[test]
+fn a_sampled_body_weighs_what_the_bodies_it_stands_for_cost() {
+    let costs = [5, 0, 7, 2, 9, 1, 4];
+    // Every third body: 0 stands for 0..3, 3 for 3..6, 6 for itself; a zero counts as 1.
+    assert_eq!(sample_weights(7, 3, Some(&costs), 0.0), [13.0, 12.0, 4.0]);
+    assert_eq!(sample_weights(7, 3, None, 2.5), [7.5, 7.5, 2.5]);
+    assert_eq!(
+        sample_weights(3, 1, Some(&costs[..3]), 0.0),
+        [5.0, 1.0, 7.0]
+    );
+    assert!(sample_weights(0, 4, None, 1.0).is_empty());
+    // Either way the sample carries the rank's whole cost.
+    let sum = |w: Vec<f64>| w.iter().sum::<f64>();
+    assert_eq!(sum(sample_weights(7, 2, Some(&costs), 0.0)), 29.0);
+    assert_eq!(sum(sample_weights(7, 4, None, 3.0)), 21.0);
+}
+
+#[test]
+fn per_body_costs_balance_the_cost_where_even_weights_do_not() {
+    // A Plummer cloud whose central bodies cost more (as in a tree code): cut on even
+    // weights, the rank holding the centre does more than its share; cut on the costs, every
+    // rank is within one body's cost of the mean.
+    let s: State<f64, 3> = plummer_state(4000, SEED_1);
+    let cost: Vec<f64> = (0..s.len())
+        .map(|i| {
+            let r2: f64 = (0..3).map(|d| s.pos[d][i] * s.pos[d][i]).sum();
+            1.0 + 100.0 / (1.0 + 10.0 * r2)
+        })
+        .collect();
+    let imbalance = |weights: &[f64]| {
+        let orb = Orb::over(3, &s.pos, weights).expect("orb");
+        let per_rank = orb.weights_per_rank(&s.pos, &cost);
+        let mean = per_rank.iter().sum::<f64>() / 3.0;
+        per_rank.iter().copied().fold(0.0, f64::max) / mean
+    };
+    let even = imbalance(&vec![1.0; s.len()]);
+    let weighed = imbalance(&cost);
+    assert!(even > 1.05, "even weights: {even}");
+    assert!(weighed < 1.01, "costs: {weighed}");
+}

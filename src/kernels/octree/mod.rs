@@ -43,6 +43,7 @@ use crate::state::{Field, State};
 pub use node::far_from_box;
 use std::ops::Range;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicU32, Ordering};
 use std::time::Instant;
 /// Morton keys, for domains that follow the tree's order (`decomp::octants`).
 pub(crate) use tree::interleave;
@@ -98,6 +99,10 @@ pub struct Octree<L, T, const D: usize> {
     lists: Vec<Mutex<Scratch<T, D>>>,
     /// Pair checks of the previous step: the estimate that decides whether to fork.
     last_pairs: Option<u64>,
+    /// With [`Octree::record_target_costs`]: each sorted slot's interaction count during a
+    /// walk, and each target's of the last [`ForceKernel::compute_targets`], in target order.
+    sorted_costs: Vec<AtomicU32>,
+    target_costs: Option<Vec<u32>>,
 }
 
 impl<L, T: Real, const D: usize> Octree<L, T, D> {
@@ -121,7 +126,22 @@ impl<L, T: Real, const D: usize> Octree<L, T, D> {
             sorted_forces: std::array::from_fn(|_| Vec::new()),
             lists: Vec::new(),
             last_pairs: None,
+            sorted_costs: Vec::new(),
+            target_costs: None,
         }
+    }
+
+    /// From now on [`ForceKernel::compute_targets`] also records each target's interaction
+    /// count (the list it gathered from, less itself: its share of `pair_checks`), for a
+    /// decomposition that weighs bodies by their cost.
+    pub fn record_target_costs(&mut self) {
+        self.target_costs.get_or_insert_with(Vec::new);
+    }
+
+    /// Each target's interaction count in the last `compute_targets` (index `i` for target
+    /// `targets.start + i`), when recording.
+    pub fn target_costs(&self) -> Option<&[u32]> {
+        self.target_costs.as_deref()
     }
 
     /// Builds the tree of `state` (Morton keys, sort, nodes, target groups) without computing
@@ -175,7 +195,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
         };
         let estimate = self.last_pairs.unwrap_or((n as u64) * (n as u64 - 1));
         let totals = if probe {
-            eval_groups::<T, L, D, true>(law, tree, &tree.groups, 0, &mut out, &mut list(0))
+            eval_groups::<T, L, D, true>(law, tree, &tree.groups, 0, &mut out, &mut list(0), &[])
         } else if worth_parallel(estimate) {
             for_group_runs(
                 &tree.groups,
@@ -184,11 +204,14 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
                 chunk_len(n),
                 &|groups, offset, mut part| {
                     let mut list = list(rayon::current_thread_index().unwrap_or(0));
-                    eval_groups::<T, L, D, false>(law, tree, groups, offset, &mut part, &mut list)
+                    let no_costs = &[];
+                    eval_groups::<T, L, D, false>(
+                        law, tree, groups, offset, &mut part, &mut list, no_costs,
+                    )
                 },
             )
         } else {
-            eval_groups::<T, L, D, false>(law, tree, &tree.groups, 0, &mut out, &mut list(0))
+            eval_groups::<T, L, D, false>(law, tree, &tree.groups, 0, &mut out, &mut list(0), &[])
         };
         self.last_pairs = Some(totals.work.pair_checks);
 
@@ -231,6 +254,11 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
                 .any(|&i| targets.contains(&(i as usize)))
         };
         let groups: Vec<Group> = self.tree.groups.iter().copied().filter(wanted).collect();
+        let recording = self.target_costs.is_some();
+        if recording {
+            self.sorted_costs.resize_with(n, || AtomicU32::new(0));
+        }
+        let costs: &[AtomicU32] = if recording { &self.sorted_costs } else { &[] };
         let (law, tree, lists) = (&self.law, &self.tree, &self.lists);
         let list = |slot: usize| {
             lists[slot % lists.len()]
@@ -254,18 +282,27 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Octree<L, T, 
                 chunk_len(targets.len()),
                 &|gs, offset, mut part| {
                     let mut list = list(rayon::current_thread_index().unwrap_or(0));
-                    eval_groups::<T, L, D, false>(law, tree, gs, offset, &mut part, &mut list)
+                    eval_groups::<T, L, D, false>(
+                        law, tree, gs, offset, &mut part, &mut list, costs,
+                    )
                 },
             )
         } else {
-            eval_groups::<T, L, D, false>(law, tree, &groups, 0, &mut sorted, &mut list(0))
+            eval_groups::<T, L, D, false>(law, tree, &groups, 0, &mut sorted, &mut list(0), costs)
         };
+        if let Some(t) = &mut self.target_costs {
+            t.clear();
+            t.resize(targets.len(), 0);
+        }
         for g in &groups {
             for k in g.start as usize..g.end as usize {
                 let i = self.tree.order[k] as usize;
                 if targets.contains(&i) {
                     for d in 0..D {
                         out[d][i - targets.start] = self.sorted_forces[d][k];
+                    }
+                    if let Some(t) = &mut self.target_costs {
+                        t[i - targets.start] = self.sorted_costs[k].load(Ordering::Relaxed);
                     }
                 }
             }

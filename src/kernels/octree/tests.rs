@@ -521,3 +521,38 @@ fn quadrupole_energy_matches_the_direct_sum() {
         "charges",
     );
 }
+
+#[test]
+fn target_costs_are_each_targets_share_of_the_pair_checks() {
+    let s = plummer::<f64, 3>(5000, SEED_1);
+    let n = s.len();
+    let mut k = Octree::new(gravity::<f64>(), 0.5, 8);
+    let mut out = zero_field::<f64, 3>(n);
+    fn slices(f: &mut Field<f64, 3>) -> [&mut [f64]; 3] {
+        f.each_mut().map(|v| v.as_mut_slice())
+    }
+    k.compute_targets(&s, 0..n, slices(&mut out));
+    assert!(k.target_costs().is_none(), "recorded only when asked");
+
+    k.record_target_costs();
+    for threads in [1, 2] {
+        let r = pool(threads).install(|| k.compute_targets(&s, 0..n, slices(&mut out)));
+        let costs = k.target_costs().expect("recording").to_vec();
+        assert_eq!(costs.len(), n);
+        let total: u64 = costs.iter().map(|&c| u64::from(c)).sum();
+        assert_eq!(total, r.work.pair_checks, "{threads} thread(s)");
+        // The dense centre of the cloud costs more than its outskirts.
+        let r2 = |i: usize| (0..3).map(|d| s.pos[d][i] * s.pos[d][i]).sum::<f64>();
+        let mut by_radius: Vec<usize> = (0..n).collect();
+        by_radius.sort_by(|&a, &b| r2(a).total_cmp(&r2(b)));
+        let mean = |ids: &[usize]| {
+            ids.iter().map(|&i| f64::from(costs[i])).sum::<f64>() / ids.len() as f64
+        };
+        assert!(mean(&by_radius[..n / 10]) > 1.2 * mean(&by_radius[n - n / 10..]));
+    }
+    // A block of targets gets its own bodies' costs, in target order.
+    let all = k.target_costs().unwrap().to_vec();
+    let mut part = zero_field::<f64, 3>(1000);
+    k.compute_targets(&s, 2000..3000, slices(&mut part));
+    assert_eq!(k.target_costs().unwrap(), &all[2000..3000]);
+}

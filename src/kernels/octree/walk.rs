@@ -22,6 +22,7 @@ use crate::kernels::rows::{LANES, Sources, Target, gather};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Per-walk scratch: the interaction list of the current group (SoA, `len` entries in use;
 /// the arrays only grow, so that entries can be written before deciding whether to keep
@@ -218,7 +219,9 @@ fn interaction_list<T: Real, const D: usize, const QUAD: bool>(
 }
 
 /// Computes the forces on the particles of `groups` (contiguous in sorted order) into `out`,
-/// whose first element is sorted slot `offset`.
+/// whose first element is sorted slot `offset`. Unless `costs` is empty (one slot per sorted
+/// particle), each particle's slot receives its interaction count: the length of its group's
+/// list less itself, what `pair_checks` counts for it.
 ///
 /// The walk runs at the baseline instruction set; only each group's target loop goes through
 /// `simd::dispatch`. With the walk inlined into the same function as the pair loop, LLVM
@@ -230,11 +233,12 @@ pub(super) fn eval_groups<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
     offset: usize,
     out: &mut [&mut [T]; D],
     list: &mut Scratch<T, D>,
+    costs: &[AtomicU32],
 ) -> Totals {
     if tree.quadrupole() {
-        eval_order::<T, L, D, PROBE, true>(law, tree, groups, offset, out, list)
+        eval_order::<T, L, D, PROBE, true>(law, tree, groups, offset, out, list, costs)
     } else {
-        eval_order::<T, L, D, PROBE, false>(law, tree, groups, offset, out, list)
+        eval_order::<T, L, D, PROBE, false>(law, tree, groups, offset, out, list, costs)
     }
 }
 
@@ -246,6 +250,7 @@ fn eval_order<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const Q
     offset: usize,
     out: &mut [&mut [T]; D],
     list: &mut Scratch<T, D>,
+    costs: &[AtomicU32],
 ) -> Totals {
     let mut totals = Totals::default();
     for g in groups {
@@ -269,6 +274,13 @@ fn eval_order<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const Q
         let real = list.len;
         let nodes = if QUAD { list.nodes.len } else { 0 };
         totals.work.pair_checks += ((end - start) * (real - 1 + nodes)) as u64;
+        if !costs.is_empty() {
+            // Disjoint slots per group: the ordering of these stores does not matter.
+            let each = u32::try_from(real - 1 + nodes).unwrap_or(u32::MAX);
+            for c in &costs[start..end] {
+                c.store(each, Ordering::Relaxed);
+            }
+        }
         if !PROBE {
             let padded = real.next_multiple_of(LANES);
             list.reserve(padded - real);

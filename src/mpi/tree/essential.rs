@@ -2,8 +2,9 @@
 //!
 //! A step: kick, drift, walls; the status Allgather; when the force times of the previous step
 //! are too uneven (max/mean above `--rebalance-above`, at most every [`REBALANCE_GAP`] steps)
-//! a new bisection of a sample of the bodies, weighted by their rank's interactions per body in
-//! the previous step; every body whose position left its rank's domain goes to its owner (all-to-all); then
+//! a new bisection of a sample of the bodies, each weighing the interactions of the bodies it
+//! stands for in the previous step; every body whose position left its rank's domain goes to
+//! its owner (all-to-all); then
 //! the octree of the owned bodies, and for every other rank the essential set of that tree
 //! against the rank's domain (`decomp::essential::select`), its entries sent in one
 //! all-to-all; finally one octree over the owned bodies and every imported entry, walked for the
@@ -62,12 +63,14 @@ impl<T: Real, L: PairLaw<T>, const D: usize> EssentialTree<T, L, D> {
         let owners = orb.assign(pos);
         let me = comm.rank();
         let local = Local::new(&system, params, |i| owners[i] == me);
+        let mut combined_tree = new_tree(system.law, params);
+        combined_tree.record_target_costs();
         let mut driver = EssentialTree {
             local,
             orb,
             root,
             combined: State::new(0),
-            combined_tree: new_tree(system.law, params),
+            combined_tree,
             rebalance_above,
             rebalances: 0,
             last_rebalance: 0,
@@ -76,8 +79,8 @@ impl<T: Real, L: PairLaw<T>, const D: usize> EssentialTree<T, L, D> {
         Ok(driver)
     }
 
-    /// A new bisection of a sample of every rank's bodies, weighted by the interactions per
-    /// body each rank had in the previous step (`Local::gather_sample`).
+    /// A new bisection of a sample of every rank's bodies, weighted by the interactions each
+    /// body had in the previous step (`Local::gather_sample`).
     fn rebalance(&mut self, comm: &mut Comm, all: &[Status]) -> Result<(), MpiError> {
         let (pos, weights) = self.local.gather_sample(comm, all)?;
         self.orb = Orb::over(comm.size(), &pos, &weights)?;
@@ -134,9 +137,13 @@ impl<T: Real, L: PairLaw<T>, const D: usize> EssentialTree<T, L, D> {
             }
         }
         let mut report = Default::default();
+        local.costs.clear();
         if n > 0 {
             let out = local.forces.each_mut().map(|f| f.as_mut_slice());
             report = self.combined_tree.compute_targets(combined, 0..n, out);
+            if let Some(costs) = self.combined_tree.target_costs() {
+                local.costs.extend_from_slice(costs);
+            }
         }
         force_s += started.elapsed().as_secs_f64();
         local.record(&report, build_s, force_s, imported);

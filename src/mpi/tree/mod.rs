@@ -23,6 +23,7 @@ use super::comm::Comm;
 use super::driver::Tally;
 use super::error::MpiError;
 use crate::boundary::{Boundary, BoundaryError};
+use crate::decomp::orb::sample_weights;
 use crate::decomp::stats::MinMeanMax;
 use crate::decomp::wire::{bytes_of, bytes_of_mut, pack_particle, unpack_particles};
 use crate::integrator::{drift, kick};
@@ -69,6 +70,9 @@ pub(super) struct Local<T: Real, L, const D: usize> {
     /// This rank's force time and interactions in the last step, for the next status.
     pub last_force_ns: u64,
     pub last_interactions: u64,
+    /// Each owned body's interaction count in the last force computation, when the driver
+    /// records them (empty otherwise, and after migration until the next computation).
+    pub costs: Vec<u32>,
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
@@ -94,6 +98,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
             tally: Tally::default(),
             last_force_ns: 0,
             last_interactions: 0,
+            costs: Vec::new(),
         }
     }
 
@@ -169,6 +174,10 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
         if leaving > 0 {
             self.owned.retain(&keep);
         }
+        if leaving > 0 || arrived.iter().any(|b| !b.is_empty()) {
+            // The costs were per body of the old set.
+            self.costs.clear();
+        }
         for b in &arrived {
             unpack_particles(b, &mut self.owned);
         }
@@ -191,39 +200,39 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
 
     /// A sample of every rank's bodies for a new bisection (every k-th body, at most
     /// [`SAMPLE_PER_RANK`] per rank, so that a rebalancing moves O(p) values, not O(n)), in
-    /// rank order, and each sampled body's weight: its rank's interactions per body in the
-    /// previous step (1 where a rank counted none) times the k it stands for.
+    /// rank order, and each sampled body's weight: the interaction counts of the k bodies it
+    /// stands for in the previous step (`decomp::orb::sample_weights`), or, where a rank has
+    /// no per-body counts, its interactions per body times k.
     pub fn gather_sample(
         &mut self,
         comm: &mut Comm,
         all: &[Status],
     ) -> Result<([Vec<f64>; D], Vec<f64>), MpiError> {
         let stride = |bodies: u64| bodies.div_ceil(SAMPLE_PER_RANK).max(1);
-        let k = stride(self.owned.len() as u64) as usize;
-        let mut mine = Vec::new();
-        for i in (0..self.owned.len()).step_by(k) {
+        let me = comm.rank();
+        let n = self.owned.len();
+        let k = stride(n as u64) as usize;
+        let costs = (self.costs.len() == n).then_some(&self.costs[..]);
+        let per_body = match all[me] {
+            s if s.bodies > 0 && s.interactions > 0 => s.interactions as f64 / s.bodies as f64,
+            _ => 1.0,
+        };
+        let weights = sample_weights(n, k, costs, per_body);
+        // Per sampled body: its position, then its weight.
+        let mut mine = Vec::with_capacity(weights.len() * (D + 1));
+        for (i, w) in (0..n).step_by(k).zip(&weights) {
             mine.extend(self.owned.position(i).map(|x| x.as_f64()));
+            mine.push(*w);
         }
         let samples: Vec<u64> = all
             .iter()
             .map(|s| s.bodies.div_ceil(stride(s.bodies)))
             .collect();
-        let bytes: Vec<usize> = samples.iter().map(|&c| c as usize * D * 8).collect();
-        let mut flat = vec![0.0f64; samples.iter().sum::<u64>() as usize * D];
+        let bytes: Vec<usize> = samples.iter().map(|&c| c as usize * (D + 1) * 8).collect();
+        let mut flat = vec![0.0f64; samples.iter().sum::<u64>() as usize * (D + 1)];
         comm.allgatherv(bytes_of(&mine), &bytes, bytes_of_mut(&mut flat))?;
-        let pos = std::array::from_fn(|d| flat.iter().skip(d).step_by(D).copied().collect());
-        let mut weights = Vec::with_capacity(flat.len() / D.max(1));
-        for (s, &count) in all.iter().zip(&samples) {
-            let per_body = if s.bodies > 0 && s.interactions > 0 {
-                s.interactions as f64 / s.bodies as f64
-            } else {
-                1.0
-            };
-            weights.extend(std::iter::repeat_n(
-                per_body * stride(s.bodies) as f64,
-                count as usize,
-            ));
-        }
+        let pos = std::array::from_fn(|d| flat.iter().skip(d).step_by(D + 1).copied().collect());
+        let weights = flat.iter().skip(D).step_by(D + 1).copied().collect();
         Ok((pos, weights))
     }
 }
