@@ -4,12 +4,14 @@
 # Works on a fresh machine with a Rust toolchain (Open MPI and libclang are installed with apt
 # when missing and this runs as root).
 #
-# Compile time is most of the run, so the crate is built twice only: once with the default
-# features (what users run), tests, benches and binary together, which runs every test; once
-# more, the binary alone, with the `mpi` feature for the drivers under mpirun. Everything
-# MPI-free of the MPI drivers lives in `crate::decomp` and is tested in the first build. The
-# binary reaches the simulation through the library's non-generic entry points, so the system
-# types are compiled in the library, not again in the binary.
+# Compile time is most of the run, so the crate is built once, with the `mpi` feature: tests,
+# benches and binary together. That binary runs validate and the performance gate, the tests
+# that start it, and the MPI drivers under mpirun (every MPI-free part of the drivers lives in
+# `crate::decomp` and is unit-tested like the rest). The one test of a build without the
+# feature (the MPI entry points refusing with the rebuild hint, tests/suite/mpi_cli.rs) runs in
+# a plain `cargo test`; here clippy checks that build. The binary reaches the simulation through
+# the library's non-generic entry points, so the system types are compiled in the library, not
+# again in the binary.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -28,12 +30,13 @@ cargo fmt --all -- --check
 cargo clippy --all-targets --release -- -D warnings
 cargo clippy --all-targets --release --features mpi -- -D warnings
 
-step "the default build: tests, benches and binary"
+step "the build: tests, benches and binary, with the mpi feature"
 # One build of every test target (unit tests, the integration suite, the benches in test
 # mode, the examples, the binary). The binary it makes is the one judged below: a `cargo build`
 # would compile the crate again (the tests' dev-dependencies change the features of shared
 # dependencies).
-cargo test --release --all-targets --no-run
+features=(--features mpi)
+cargo test --release --all-targets "${features[@]}" --no-run
 bin=target/release/nbody-bench
 
 step "validation and the performance gate"
@@ -47,12 +50,11 @@ step "every test"
 scripts/install-lammps.sh
 # The unit tests; the suite but its timing tests; those alone on one test thread
 # (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
-cargo test --release --lib --bins
-cargo test --release --test suite -- --skip gate:: --skip dry_run::
-cargo test --release --test suite -- --test-threads=1 gate:: dry_run::
-cargo test --release --benches
+cargo test --release "${features[@]}" --lib --bins
+cargo test --release "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
+cargo test --release "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
+cargo test --release "${features[@]}" --benches
 
 step "the MPI drivers under mpirun"
-cargo build --release --features mpi
-NBODY_BENCH_BIN=target/release/nbody-bench scripts/mpi-tests.sh
+NBODY_BENCH_BIN="$bin" scripts/mpi-tests.sh
 step "all checks passed"
