@@ -11,6 +11,7 @@ use crate::real::Real;
 use crate::scenario::{Setup, System, SystemInfo, SystemJob};
 use std::path::PathBuf;
 
+pub mod bench_cases;
 mod outcome;
 
 pub use outcome::{
