@@ -463,7 +463,8 @@ pub struct GateArgs {
     pub baseline: PathBuf,
     /// Keep RESULTS (a results.json, a run directory or a config name) in the --baseline folder
     /// as the baseline of the machine class it was measured on, replacing that class's file,
-    /// and measure nothing.
+    /// and measure nothing. Refused when other processes used 0.25 CPUs or more while it was
+    /// calibrated: a baseline must come from a quiet machine.
     #[arg(long, value_name = "RESULTS", conflicts_with_all = ["current", "against"])]
     pub save_baseline: Option<PathBuf>,
     /// Results of the run to check: a results.json, a run directory or a config name (its

@@ -90,7 +90,7 @@ fn is_baseline_folder(path: &Path) -> bool {
 
 /// `--save-baseline RESULTS`: keeps RESULTS in the baseline folder under its machine class's
 /// name, replacing that class's earlier file, once it compares cleanly with itself (schema,
-/// calibration, config); the other classes' files stay.
+/// calibration, config) and was measured on a quiet machine; the other classes' files stay.
 fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<i32> {
     let source = locate::find_results(results, Path::new("results"))?;
     let file = ResultsFile::load(&source)?;
@@ -99,6 +99,17 @@ fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<i32> {
             "{} was swept without calibration, so its machine class is unknown; sweep \
              configs/ci.toml again with calibration",
             source.display()
+        );
+    }
+    let busy = nbody_bench::gate::background_cpus(&file)
+        .filter(|&b| b >= nbody_bench::gate::BUSY_BASELINE_CPUS);
+    if let Some(busy) = busy {
+        // The reference workload slows down more than the kernels under load: every later
+        // run on a quiet machine would read as a regression.
+        anyhow::bail!(
+            "{} was measured while other processes used {busy:.2} CPUs (at most {} for a              baseline): every later run would be judged against a slowed reference; wait for              the other work to end and run scripts/refresh-baseline.sh again",
+            source.display(),
+            nbody_bench::gate::BUSY_BASELINE_CPUS
         );
     }
     compare(&file, &file, &GateOptions::default())?;

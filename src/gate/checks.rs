@@ -106,10 +106,10 @@ pub(super) fn check_comparable(
 }
 
 /// Other processes' CPU use, from the calibrations, above which a baseline is called busy.
-const BUSY_BASELINE_CPUS: f64 = 0.25;
+pub const BUSY_BASELINE_CPUS: f64 = 0.25;
 
 /// The most CPUs other processes used during the file's calibrations, if measured.
-fn background_cpus(file: &ResultsFile) -> Option<f64> {
+pub fn background_cpus(file: &ResultsFile) -> Option<f64> {
     [&file.calibration.start, &file.calibration.end]
         .into_iter()
         .flatten()

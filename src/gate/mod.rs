@@ -25,7 +25,7 @@ mod render;
 #[cfg(test)]
 mod tests;
 
-pub use checks::prefix;
+pub use checks::{BUSY_BASELINE_CPUS, background_cpus, prefix};
 pub use compare::compare;
 pub use render::{Format, render};
 

@@ -479,6 +479,21 @@ fn a_folder_of_baselines_gives_each_machine_class_its_own() {
     assert_eq!(signature(&folder.join(&filed)), here);
     assert!(folder.join("a-other.json").is_file());
 
+    // A run measured on a busy machine is not filed, and the class's file stays as it was.
+    let before = std::fs::read(folder.join(&filed)).unwrap();
+    let busy = edited(dir.path(), "busy.json", |v| {
+        v["calibration"]["end"]["background_cpus"] = 0.6.into();
+    });
+    let refused = bin()
+        .args(["gate", "--baseline"])
+        .arg(&folder)
+        .arg("--save-baseline")
+        .arg(&busy)
+        .output()
+        .unwrap();
+    assert_bad_input(&refused, "other processes used 0.60 CPUs");
+    assert_eq!(std::fs::read(folder.join(&filed)).unwrap(), before);
+
     std::fs::write(folder.join("broken.json"), "{").unwrap();
     assert_bad_input(&gate(&folder, &base, &[]), "broken.json");
     let empty = dir.path().join("empty");
