@@ -459,13 +459,16 @@ fn a_folder_of_baselines_gives_each_machine_class_its_own() {
     assert_eq!(report["baseline"]["cpu_signature"], here.as_str());
 
     // Filed under the class's own name, beside the other class's file.
-    let saved = bin()
-        .args(["gate", "--baseline"])
-        .arg(&folder)
-        .arg("--save-baseline")
-        .arg(&base)
-        .output()
-        .unwrap();
+    let save = |results: &Path| {
+        bin()
+            .args(["gate", "--baseline"])
+            .arg(&folder)
+            .arg("--save-baseline")
+            .arg(results)
+            .output()
+            .unwrap()
+    };
+    let saved = save(&base);
     assert_eq!(saved.status.code(), Some(0), "{}", text(&saved.stderr));
     let slug: String = here
         .chars()
@@ -484,14 +487,7 @@ fn a_folder_of_baselines_gives_each_machine_class_its_own() {
     let busy = edited(dir.path(), "busy.json", |v| {
         v["calibration"]["end"]["background_cpus"] = 0.6.into();
     });
-    let refused = bin()
-        .args(["gate", "--baseline"])
-        .arg(&folder)
-        .arg("--save-baseline")
-        .arg(&busy)
-        .output()
-        .unwrap();
-    assert_bad_input(&refused, "other processes used 0.60 CPUs");
+    assert_bad_input(&save(&busy), "other processes used 0.60 CPUs");
     assert_eq!(std::fs::read(folder.join(&filed)).unwrap(), before);
 
     std::fs::write(folder.join("broken.json"), "{").unwrap();
