@@ -107,7 +107,9 @@ fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<i32> {
         // The reference workload slows down more than the kernels under load: every later
         // run on a quiet machine would read as a regression.
         anyhow::bail!(
-            "{} was measured while other processes used {busy:.2} CPUs (at most {} for a              baseline): every later run would be judged against a slowed reference; wait for              the other work to end and run scripts/refresh-baseline.sh again",
+            "{} was measured while other processes used {busy:.2} CPUs (at most {} for a \
+             baseline): every later run would be judged against a slowed reference; wait for \
+             the other work to end and run scripts/refresh-baseline.sh again",
             source.display(),
             nbody_bench::gate::BUSY_BASELINE_CPUS
         );
