@@ -12,6 +12,8 @@ pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
     if path != args.results {
         eprintln!("analyzing {}", path.display());
     }
+    // Whatever the analysis writes, under whatever name, never replaces what it reads.
+    nbody_bench::output::protect_inputs(&[("results", &path)]);
     let results = ResultsFile::load(&path)?;
     let dir = args.out.unwrap_or_else(|| default_dir(&path));
     let written = run(&results, &path, &dir)?;

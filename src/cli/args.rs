@@ -33,7 +33,8 @@ pub enum Command {
     /// Check every applicable kernel's forces against the naive sum in f64 (exit 1 on a mismatch).
     Validate(ValidateArgs),
     /// Measure every case of a TOML config (n, threads, kernels, scenarios) with statistics and
-    /// machine calibration; writes <out>/<name>/results.json after every case.
+    /// machine calibration; writes <out>/<name>/results.json after every case (one sweep at a
+    /// time per file). Exit 1 when a case has no successful sample (its errors are kept).
     Sweep(SweepArgs),
     /// Fit a scaling model (amdahl, gustafson, power) to a CSV of measurements from any code.
     Fit(FitArgs),
@@ -355,8 +356,9 @@ pub struct SweepArgs {
     /// With --resume: accept a results file from a different config or commit.
     #[arg(long, requires = "resume")]
     pub force: bool,
-    /// Start over; an existing results file is kept under a .bak name (with --out; a run
-    /// without --out always starts in a new run directory).
+    /// Start over; an existing results file is kept under a new .bak name, never replacing
+    /// an earlier backup (with --out; a run without --out always starts in a new run
+    /// directory).
     #[arg(long)]
     pub fresh: bool,
     /// Write to DIR/<name>/results.json (the layout of the committed reference results)

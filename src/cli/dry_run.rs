@@ -35,11 +35,9 @@ pub fn before_sweep(
         return Ok(None);
     }
     // With --resume, only the rounds the file does not hold yet are left to run.
+    // A file the real resume would refuse is refused here too, dry run or not.
     let done = match (args.resume.is_some(), path) {
-        (true, Some(path)) => ResultsFile::load(path)
-            .ok()
-            .map(done_in)
-            .unwrap_or_default(),
+        (true, Some(path)) if path.exists() => done_in(ResultsFile::load(path)?),
         _ => Done::default(),
     };
     let planned = cases(config);

@@ -76,6 +76,18 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
             report.path.display()
         ),
     }
+    let failed: Vec<_> = results.cases.iter().filter(|c| c.failed()).collect();
+    for c in &failed {
+        let reasons = c.failures();
+        eprintln!(
+            "error: case {}: no sample succeeded{}",
+            c.key,
+            reasons
+                .first()
+                .map(|r| format!(" ({r}{})", more(reasons.len())))
+                .unwrap_or_default()
+        );
+    }
     if report.incomplete > 0 {
         outln!(
             "{} cases are not complete; run `nbody-bench sweep --config {} --resume{}` to finish them",
@@ -87,7 +99,26 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
             }
         );
     }
+    if !failed.is_empty() {
+        eprintln!(
+            "{} of {} cases failed; every failure is kept in {}",
+            failed.len(),
+            results.cases.len(),
+            report.path.display()
+        );
+        return Ok(FAILED_CASES);
+    }
     Ok(0)
+}
+
+/// The exit status of a sweep with a case whose every sample failed.
+pub const FAILED_CASES: i32 = 1;
+
+fn more(count: usize) -> String {
+    match count {
+        0 | 1 => String::new(),
+        n => format!("; and {} more", n - 1),
+    }
 }
 
 /// Where a sweep writes.
@@ -115,10 +146,18 @@ fn where_to_write(args: &SweepArgs, config: &SweepConfig) -> anyhow::Result<Targ
         ),
         (_, Some(_)) => Ok(Target::Out),
         (Some(Some(run)), None) => {
-            let dir = if run.is_file() {
+            let dir = if run.is_dir() {
+                run.clone()
+            } else if run.file_name().is_some_and(|n| n == "results.json") {
                 run.parent().unwrap_or(Path::new(".")).to_path_buf()
             } else {
-                run.clone()
+                // A run is a directory whose results are `results.json`; resuming another
+                // file would write that one instead.
+                anyhow::bail!(
+                    "--resume {}: not a run directory or its results.json; a sweep resumes \
+                     DIR/results.json only: pass the run directory",
+                    run.display()
+                );
             };
             if !dir.join("results.json").is_file() {
                 anyhow::bail!(
@@ -157,7 +196,12 @@ fn print_table(results: &ResultsFile) {
     );
     for c in &results.cases {
         let Some(s) = &c.summary else {
-            outln!("{:<52} {:>11}", c.key, "not measured");
+            let what = if c.failed() {
+                "FAILED: no sample succeeded"
+            } else {
+                "not measured"
+            };
+            outln!("{:<52} {what}", c.key);
             continue;
         };
         outln!(

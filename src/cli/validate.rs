@@ -16,9 +16,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
             .iter()
             .map(|&s| dump_file(dump, scenarios.len(), s))
             .collect();
-        let outputs: Vec<(&str, &std::path::Path)> =
-            paths.iter().map(|p| ("--dump", p.as_path())).collect();
-        nbody_bench::output::check_outputs(&outputs, &[])?;
+        nbody_bench::output::check_derived("--dump", dump, &paths)?;
     }
     let params = kernel_params(&args.kernel_args, None)?;
     let mut results: Vec<ScenarioCheck> = Vec::new();

@@ -391,6 +391,14 @@ impl SweepConfig {
             (Study::Weak, Some(w)) if w.base_n == 0 => {
                 return Err(bad("weak.base_n", "must be at least 1".into()));
             }
+            (Study::Weak, Some(_)) if self.n.is_some() => {
+                return Err(bad(
+                    "n",
+                    "does not apply to study = \"weak\": its sizes follow from weak.base_n and \
+                     the workers; remove `n`"
+                        .into(),
+                ));
+            }
             (Study::Weak, Some(_)) => {}
             (_, Some(_)) => return Err(bad("weak", "only applies to study = \"weak\"".into())),
             (_, None) => match &self.n {
@@ -449,6 +457,62 @@ impl SweepConfig {
             return Err(bad(
                 "measure.max_energy_drift",
                 "must be a finite number > 0".into(),
+            ));
+        }
+        self.validate_unique(path)
+    }
+
+    /// Every value of a list gives its own cases, so a value listed twice would plan one case
+    /// twice (measured once, reported as two, resumed forever): refused, naming the value.
+    /// Then every planned case key must be unique (a `[[external]]` named like a kernel, say).
+    fn validate_unique(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = |key: &str, problem: String| ConfigError::Invalid {
+            path: path.into(),
+            key: key.into(),
+            problem,
+        };
+        fn twice<T: std::fmt::Debug + PartialEq>(list: &[T]) -> Option<String> {
+            let i = (1..list.len()).find(|&i| list[..i].contains(&list[i]))?;
+            Some(format!("{:?}", list[i]))
+        }
+        let n = match &self.n {
+            Some(Counts::List(v)) => v.clone(),
+            _ => Vec::new(),
+        };
+        let names: Vec<&str> = self.external.iter().map(|e| e.name.as_str()).collect();
+        let (ranks, decomp) = match &self.mpi {
+            Some(m) => (m.ranks.clone(), twice(&m.decomp)),
+            None => (Vec::new(), None),
+        };
+        for (key, dup) in [
+            ("scenarios", twice(&self.scenarios)),
+            ("kernels", twice(&self.kernels)),
+            ("n", twice(&n)),
+            ("threads", twice(&self.threads)),
+            ("seeds", twice(&self.seeds)),
+            ("theta", twice(&self.theta)),
+            ("multipole", twice(&self.multipole)),
+            ("mpi.ranks", twice(&ranks)),
+            ("mpi.decomp", decomp),
+            ("external.name", twice(&names)),
+        ] {
+            if let Some(value) = dup {
+                return Err(bad(
+                    key,
+                    format!("lists {value} twice; each value is one set of cases: remove the copy"),
+                ));
+            }
+        }
+        let planned = super::plan::cases(self);
+        let mut keys = std::collections::HashSet::new();
+        if let Some(c) = planned.iter().find(|c| !keys.insert(c.key())) {
+            return Err(bad(
+                "external",
+                format!(
+                    "two planned cases share the key `{}` (an [[external]] named like a built-in \
+                     kernel?); give each code its own name",
+                    c.key()
+                ),
             ));
         }
         Ok(())

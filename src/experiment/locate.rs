@@ -42,6 +42,14 @@ pub enum LocateError {
          --config {name}`, or pass the run to resume: --resume DIR"
     )]
     NothingToResume { name: String, dir: PathBuf },
+    #[error(
+        "the run {dir} cannot be read ({source}); pass the run to resume (--resume DIR), or \
+         move the broken one aside"
+    )]
+    Unreadable {
+        dir: PathBuf,
+        source: Box<super::results::ResultsError>,
+    },
     #[error("cannot create the run directory {path}: {source}")]
     CreateRun {
         path: PathBuf,
@@ -152,19 +160,28 @@ fn run_order(dir: &Path) -> (String, u32) {
     }
 }
 
-/// The newest run of a config whose results file has a case that is not complete.
+/// The newest run of a config whose results file has a case that is not complete. A run
+/// newer than that one whose results cannot be read is an error, not skipped: it may be the
+/// very run the user means, and continuing an older one instead would be silent.
 pub fn latest_unfinished(root: &Path, name: &str) -> Result<PathBuf, LocateError> {
-    runs(root, name)
-        .into_iter()
-        .rev()
-        .find(|dir| {
-            ResultsFile::load(&dir.join("results.json"))
-                .is_ok_and(|f| f.cases.is_empty() || f.cases.iter().any(|c| !c.is_complete()))
-        })
-        .ok_or_else(|| LocateError::NothingToResume {
-            name: name.to_string(),
-            dir: runs_dir(root, name),
-        })
+    for dir in runs(root, name).into_iter().rev() {
+        match ResultsFile::load(&dir.join("results.json")) {
+            Ok(f) if f.cases.is_empty() || f.cases.iter().any(|c| !c.is_complete()) => {
+                return Ok(dir);
+            }
+            Ok(_) => continue,
+            Err(source) => {
+                return Err(LocateError::Unreadable {
+                    dir,
+                    source: Box::new(source),
+                });
+            }
+        }
+    }
+    Err(LocateError::NothingToResume {
+        name: name.to_string(),
+        dir: runs_dir(root, name),
+    })
 }
 
 /// The results file `given` names: a file; a directory holding `results.json`; or a config

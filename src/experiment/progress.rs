@@ -66,14 +66,16 @@ impl Observer for Lines {
 
     fn round_done(&mut self, record: &CaseRecord, round: usize) {
         self.done += 1;
-        let median = record.summary.as_ref().map(|s| s.median_s).unwrap_or(0.0);
+        let result = match &record.summary {
+            Some(s) => format!("{} per step", Duration(s.median_s)),
+            None => "no successful sample so far".to_string(),
+        };
         eprintln!(
-            "[{}/{}] {} round {}: {} per step",
+            "[{}/{}] {} round {}: {result}",
             self.done,
             self.total,
             record.key,
             round + 1,
-            Duration(median)
         );
     }
 

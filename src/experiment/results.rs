@@ -4,6 +4,7 @@
 use super::config::SweepConfig;
 use super::measure::RoundOutcome;
 use super::plan::Case;
+use super::vet::Rejected;
 use crate::calibrate::Calibration;
 use crate::engine::PhaseTimes;
 use crate::kernels::WorkCounters;
@@ -94,6 +95,12 @@ pub struct CaseRecord {
     pub rounds: Vec<RoundOutcome>,
     /// Step-time histogram (HDR, ns): (value, count) of every recorded bucket.
     pub step_histogram: Vec<[u64; 2]>,
+    /// Values taken out of the rounds as impossible (non-finite, zero or negative times...),
+    /// with the reason.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rejected: Vec<Rejected>,
+    /// Recomputed from the raw values whenever they change or are loaded; `None` while the
+    /// case has no successful sample (not measured yet, or every sample failed).
     pub summary: Option<Summary>,
 }
 
@@ -146,6 +153,16 @@ pub enum ResultsError {
     Corrupt { path: PathBuf, detail: String },
     #[error("{path} has schema `{found}`, this version reads `{RESULTS_SCHEMA}`")]
     Schema { path: PathBuf, found: String },
+    #[error(
+        "{path} lists case `{key}` twice; a case key is unique in a results file: remove one \
+         of the copies (or measure the case again in a new run)"
+    )]
+    Duplicate { path: PathBuf, key: String },
+    #[error(
+        "not saving {path}: the results would not read back ({detail}); the file on disk is \
+         unchanged"
+    )]
+    Unreadable { path: PathBuf, detail: String },
     #[error(transparent)]
     Write(#[from] crate::output::WriteError),
 }
@@ -171,15 +188,37 @@ impl ResultsFile {
                 found: schema.to_string(),
             });
         }
-        serde_json::from_value(value).map_err(|e| ResultsError::Corrupt {
-            path: path.into(),
-            detail: e.to_string(),
-        })
+        let mut file: ResultsFile =
+            serde_json::from_value(value).map_err(|e| ResultsError::Corrupt {
+                path: path.into(),
+                detail: e.to_string(),
+            })?;
+        let mut keys = std::collections::HashSet::new();
+        if let Some(dup) = file.cases.iter().find(|c| !keys.insert(c.key.as_str())) {
+            return Err(ResultsError::Duplicate {
+                path: path.into(),
+                key: dup.key.clone(),
+            });
+        }
+        // A stored summary is never trusted: an edited file, or one written by an older
+        // version, could disagree with its own samples.
+        let max_drift = file.config.measure.max_energy_drift;
+        for case in &mut file.cases {
+            case.recompute(max_drift);
+        }
+        Ok(file)
     }
 
-    /// Writes the whole file atomically (temporary file + rename).
+    /// Writes the whole file atomically (temporary file + rename), after checking that the
+    /// text reads back: a file that was readable before a save is readable after it.
     pub fn save(&self, path: &Path) -> Result<(), ResultsError> {
         let text = serde_json::to_string_pretty(self).expect("results serialize");
+        if let Err(e) = serde_json::from_str::<ResultsFile>(&text) {
+            return Err(ResultsError::Unreadable {
+                path: path.into(),
+                detail: e.to_string(),
+            });
+        }
         crate::output::write_atomic(path, text.as_bytes())?;
         Ok(())
     }
@@ -201,6 +240,7 @@ impl CaseRecord {
             steps_per_sample: 0,
             rounds: Vec::new(),
             step_histogram: Vec::new(),
+            rejected: Vec::new(),
             summary: None,
         }
     }
@@ -237,22 +277,59 @@ impl CaseRecord {
         max_drift: f64,
     ) {
         self.step_histogram = hist.counts();
-        for round in rounds {
+        for mut round in rounds {
+            let index = self.rounds.len();
+            self.rejected.extend(super::vet::round(index, &mut round));
             self.n = round.n;
             self.steps_per_sample = round.steps_per_sample;
             self.rounds.push(round);
             self.rounds_done += 1;
         }
-        self.summary = Some(self.summarize(&hist, max_drift));
+        self.summary = self.summarize(&hist, max_drift);
     }
 
-    fn summarize(&self, hist: &StepHistogram, max_drift: f64) -> Summary {
+    /// Checks the raw values again and recomputes everything derived from them (a loaded
+    /// file's summary, rounds done).
+    fn recompute(&mut self, max_drift: f64) {
+        for (index, round) in self.rounds.iter_mut().enumerate() {
+            let taken = super::vet::round(index, round);
+            self.rejected.extend(taken);
+        }
+        self.rounds_done = self.rounds.len();
+        let hist = StepHistogram::from_counts(&self.step_histogram);
+        self.summary = self.summarize(&hist, max_drift);
+    }
+
+    /// Rounds were measured but not one sample succeeded.
+    pub fn failed(&self) -> bool {
+        self.rounds_done > 0 && self.summary.is_none()
+    }
+
+    /// Why the samples of a failed case failed: the first reasons recorded.
+    pub fn failures(&self) -> Vec<String> {
+        let external = self.rounds.iter().filter_map(|r| r.external.as_ref());
+        let errors = external.flat_map(|e| {
+            e.setup_error
+                .iter()
+                .chain(e.runs.iter().filter_map(|r| r.error.as_ref()))
+                .map(|e| format!("`{}` {}", e.command, e.what))
+        });
+        let rejected = self
+            .rejected
+            .iter()
+            .map(|r| format!("{} = {}: {}", r.what, r.value, r.reason));
+        let mut all: Vec<String> = errors.chain(rejected).collect();
+        all.dedup();
+        all
+    }
+
+    fn summarize(&self, hist: &StepHistogram, max_drift: f64) -> Option<Summary> {
         let samples: Vec<f64> = self
             .rounds
             .iter()
             .flat_map(|r| r.samples_s.iter().copied())
             .collect();
-        let med = median(&samples).unwrap_or(0.0);
+        let med = median(&samples)?;
         let rounds = self.rounds.len().max(1) as f64;
         let steps: u64 = self.rounds.iter().map(|r| r.steps).sum();
         let mean_of =
@@ -266,25 +343,20 @@ impl CaseRecord {
             .iter()
             .map(|r| r.energy_drift.abs())
             .fold(0.0, f64::max);
-        let n = self.n as f64;
-        Summary {
+        let n = self.n.max(1) as f64;
+        Some(Summary {
             median_s: med,
             ci95_s: bootstrap_median_ci(&samples, BOOTSTRAP_RESAMPLES, 0x5eed)
                 .unwrap_or([med, med]),
             mad_s: mad(&samples).unwrap_or(0.0),
-            // A round can hold no sample (an external program whose every run failed); JSON
-            // has no infinity.
-            min_s: if samples.is_empty() {
-                0.0
-            } else {
-                samples.iter().copied().fold(f64::INFINITY, f64::min)
-            },
-            mean_s: samples.iter().sum::<f64>() / samples.len().max(1) as f64,
+            min_s: samples.iter().copied().fold(f64::INFINITY, f64::min),
+            mean_s: samples.iter().sum::<f64>() / samples.len() as f64,
             samples: samples.len(),
             step_ns: hist.percentiles().unwrap_or_default(),
             ns_per_particle_step: med * 1e9 / n,
-            particle_steps_per_s: if med > 0.0 { n / med } else { 0.0 },
-            pair_evals_per_s: if med > 0.0 { pair_checks / med } else { 0.0 },
+            // Vetted samples take more than zero time.
+            particle_steps_per_s: n / med,
+            pair_evals_per_s: pair_checks / med,
             phases: PhaseTimes {
                 force_build: mean_of(&|r| r.phases.force_build),
                 force_interact: mean_of(&|r| r.phases.force_interact),
@@ -307,7 +379,7 @@ impl CaseRecord {
                 .iter()
                 .map(|r| r.clock_overhead)
                 .fold(0.0, f64::max),
-        }
+        })
     }
 }
 
@@ -448,6 +520,76 @@ mod tests {
         };
         assert_eq!(end_only.for_analysis().unwrap().ceiling(2), Some(1.7));
         assert!(Calibrations::default().for_analysis().is_none());
+    }
+
+    /// Any value a sample, force error or drift can take (NaN, ±inf, zero, negative, huge)
+    /// recorded into a results file leaves a file that loads, whose summaries are those of
+    /// its raw samples.
+    mod any_samples {
+        use super::super::*;
+        use proptest::prelude::*;
+
+        fn value() -> impl Strategy<Value = f64> {
+            prop_oneof![
+                Just(f64::NAN),
+                Just(f64::INFINITY),
+                Just(f64::NEG_INFINITY),
+                Just(0.0),
+                Just(-1e-3),
+                Just(1e300),
+                1e-9..1e-1f64,
+                any::<f64>(),
+            ]
+        }
+
+        fn fixture() -> ResultsFile {
+            let path = concat!(env!("CARGO_MANIFEST_DIR"), "/results/quick/results.json");
+            let mut file = ResultsFile::load(Path::new(path)).unwrap();
+            file.cases.truncate(1);
+            file
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(24))]
+            #[test]
+            fn leave_a_file_that_loads_with_the_summaries_of_its_samples(
+                rounds in prop::collection::vec(prop::collection::vec(value(), 0..6), 1..4),
+                error in prop::option::of((value(), value())),
+                drift in value(),
+            ) {
+                let mut file = fixture();
+                let max_drift = file.config.measure.max_energy_drift;
+                let template = file.cases[0].rounds[0].clone();
+                let mut record = CaseRecord::new(file.cases[0].case.clone(), rounds.len(), 2);
+                for samples in &rounds {
+                    let mut round = template.clone();
+                    round.reference_s = samples.clone();
+                    round.samples_s = samples.clone();
+                    round.force_error = error.map(|(a, b)| [a, b]);
+                    round.energy_drift = drift;
+                    record.add_round(round, max_drift);
+                }
+                file.cases[0] = record;
+                let dir = tempfile::tempdir().unwrap();
+                let path = dir.path().join("results.json");
+                file.save(&path).unwrap();
+                let loaded = ResultsFile::load(&path).unwrap();
+                let case = &loaded.cases[0];
+                prop_assert_eq!(&case.summary, &file.cases[0].summary);
+                let kept: Vec<f64> =
+                    case.rounds.iter().flat_map(|r| r.samples_s.clone()).collect();
+                prop_assert!(kept.iter().all(|s| s.is_finite() && *s > 0.0));
+                let given = rounds.iter().map(Vec::len).sum::<usize>();
+                prop_assert!(case.rejected.len() >= given - kept.len());
+                match &case.summary {
+                    None => prop_assert!(kept.is_empty()),
+                    Some(s) => {
+                        prop_assert_eq!(s.median_s, median(&kept).unwrap());
+                        prop_assert_eq!(s.samples, kept.len());
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -2,6 +2,7 @@
 //! file after every round of every case, and resumes an interrupted sweep.
 
 use super::code::Code;
+use super::lock::WriterLock;
 use super::config::SweepConfig;
 use super::measure::{MeasureJob, RoundSpec};
 use super::plan::{Case, cases};
@@ -82,6 +83,13 @@ pub enum SweepError {
     External(#[from] super::external::ExternalError),
     #[error("cannot find this program for {{nbody_bench}}: {0}")]
     Exe(std::io::Error),
+    #[error(transparent)]
+    Lock(#[from] super::lock::LockError),
+    #[error("cannot keep {path} as a backup: {source}")]
+    Backup {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     #[error("cannot create {path}: {source}")]
     Dir {
         path: PathBuf,
@@ -171,6 +179,14 @@ pub fn run_sweep<C: Clock>(
         super::external::check_programs(ext, launcher, &context)?;
     }
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
+            path: dir.into(),
+            source,
+        })?;
+    }
+    // Held until the sweep returns: nobody else reads, backs up or saves this file meanwhile.
+    let _writer = WriterLock::acquire(&path)?;
     let mut results = open(config, config_text, options, &path)?;
     if let Some(s) = slowdown {
         observer.message(&format!(
@@ -186,12 +202,6 @@ pub fn run_sweep<C: Clock>(
         if results.record_mut(&case.key()).is_none() {
             results.cases.push(CaseRecord::new(case, rounds, logical));
         }
-    }
-    if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
-            path: dir.into(),
-            source,
-        })?;
     }
     let oversubscribed: Vec<&str> = results
         .cases
@@ -413,12 +423,9 @@ fn open(
         return Ok(fresh());
     }
     if options.fresh {
-        let backup = path.with_extension(format!(
-            "json.{}.bak",
-            super::results::utc_now().replace(':', "")
-        ));
-        std::fs::rename(path, &backup).map_err(|source| SweepError::Dir {
-            path: backup.clone(),
+        let stamp = super::results::utc_now().replace(':', "");
+        super::lock::back_up(path, &stamp).map_err(|source| SweepError::Backup {
+            path: path.into(),
             source,
         })?;
         return Ok(fresh());

@@ -165,6 +165,8 @@ pub enum FitError {
         n_first: f64,
         n_other: f64,
     },
+    #[error("{model}: the data do not support it: {why}")]
+    Unsupported { model: &'static str, why: String },
     #[error("timed serial fraction: {what}")]
     BadPhases { what: String },
 }

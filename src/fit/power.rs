@@ -141,6 +141,7 @@ pub fn fit_power(samples: &[Samples], seed: u64) -> Result<PowerFit, FitError> {
         why: "no complexity class fits with a positive coefficient",
     })?;
     let chosen = hypotheses[best].clone();
+    refuse_unsupported(k, &chosen)?;
     let fitted: Vec<f64> = data.xs.iter().map(|n| ln_c.exp() * n.powf(k)).collect();
 
     struct Replicate {
@@ -204,6 +205,33 @@ pub fn fit_power(samples: &[Samples], seed: u64) -> Result<PowerFit, FitError> {
         resamples: RESAMPLES,
         notes,
     })
+}
+
+/// The worst leave-one-out SMAPE, percent, at which a selected class still describes the
+/// data; the committed sweeps' selections miss by 25 % at most.
+pub const MAX_CLASS_SMAPE_PERCENT: f64 = 50.0;
+
+/// A selection the data cannot support is an error, not a result: times that do not grow
+/// with n fit no growth class (the least bad one would be "chosen" all the same), and a class
+/// that misses the held-out points by more than [`MAX_CLASS_SMAPE_PERCENT`] describes nothing.
+fn refuse_unsupported(k: f64, chosen: &ClassCandidate) -> Result<(), FitError> {
+    let smape = chosen.loo_smape_percent.unwrap_or(f64::INFINITY);
+    let why = if k <= 0.0 {
+        format!(
+            "the times do not grow with n (free exponent k = {k:.3}); no complexity class \
+             applies: check that the cases differ only in n"
+        )
+    } else if smape > MAX_CLASS_SMAPE_PERCENT {
+        format!(
+            "the best complexity class, {}, misses the left-out points by {smape:.0} % \
+             (leave-one-out SMAPE, more than {MAX_CLASS_SMAPE_PERCENT} %); measure more samples \
+             or more sizes",
+            chosen.class.name()
+        )
+    } else {
+        return Ok(());
+    };
+    Err(FitError::Unsupported { model: MODEL, why })
 }
 
 /// The n in `[lo, hi]` where the fitted curves ([`PowerFit::predict`]) of two kernels cross,

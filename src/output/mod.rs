@@ -40,6 +40,11 @@ pub enum OutputError {
         input: String,
     },
     #[error(
+        "{flag} {path}: is a symbolic link that leads nowhere (its target is missing, or the \
+         links loop); writing it would replace the link: fix or remove the link, or name a file"
+    )]
+    BrokenLink { flag: String, path: PathBuf },
+    #[error(
         "{flag} and {other} both name {path}; one output would be lost: give each its own file"
     )]
     Twice {
@@ -63,15 +68,43 @@ fn real(path: &Path) -> PathBuf {
     }
 }
 
+/// The inputs of this command (flag, real path): no output may replace one, whether its path
+/// was typed or derived (a figure's name, a file inside `--out`). Every file is written
+/// through [`AtomicFile::create`], which checks it against these.
+static INPUTS: std::sync::Mutex<Vec<(String, PathBuf)>> = std::sync::Mutex::new(Vec::new());
+
+fn inputs() -> std::sync::MutexGuard<'static, Vec<(String, PathBuf)>> {
+    INPUTS.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Declares `inputs` (flag, path) as inputs of this command for every later output check.
+pub fn protect_inputs(list: &[(&str, &Path)]) {
+    let mut known = inputs();
+    for &(flag, path) in list {
+        let entry = (flag.to_string(), real(path));
+        if !known.contains(&entry) {
+            known.push(entry);
+        }
+    }
+}
+
 /// Checks every output of a command before it starts working: each names a regular file (or
-/// one to create) in an existing directory, none is one of the command's inputs, no two are the
-/// same. `outputs` and `inputs` are (flag, path) pairs, the flag as the user typed it.
+/// one to create) in an existing directory, none is one of the command's inputs (these and
+/// every one declared before, see [`protect_inputs`]), no two are the same. `outputs` and
+/// `inputs` are (flag, path) pairs, the flag as the user typed it.
 pub fn check_outputs(
     outputs: &[(&str, &Path)],
-    inputs: &[(&str, &Path)],
+    inputs_now: &[(&str, &Path)],
 ) -> Result<(), OutputError> {
+    protect_inputs(inputs_now);
+    let protected = inputs().clone();
     for (i, &(flag, path)) in outputs.iter().enumerate() {
         let bad = |path: &Path| (flag.to_string(), path.to_path_buf());
+        let is_link = fs::symlink_metadata(path).is_ok_and(|m| m.file_type().is_symlink());
+        if is_link && fs::metadata(path).is_err() {
+            let (flag, path) = bad(path);
+            return Err(OutputError::BrokenLink { flag, path });
+        }
         let target = real(path);
         if let Ok(meta) = fs::metadata(&target) {
             let (flag, path) = bad(path);
@@ -89,12 +122,12 @@ pub fn check_outputs(
                 dir: dir.to_path_buf(),
             });
         }
-        if let Some(&(input, _)) = inputs.iter().find(|(_, p)| real(p) == target) {
+        if let Some((input, _)) = protected.iter().find(|(_, p)| *p == target) {
             let (flag, path) = bad(path);
             return Err(OutputError::IsInput {
                 flag,
                 path,
-                input: input.to_string(),
+                input: input.clone(),
             });
         }
         if let Some(&(other, _)) = outputs[..i].iter().find(|(_, p)| real(p) == target) {
@@ -212,6 +245,16 @@ impl Drop for AtomicFile {
             temporaries().retain(|t| *t != self.tmp);
         }
     }
+}
+
+/// Checks an output whose name is derived from the path the user typed (`--dump out` writing
+/// `out.lj-box`, ...): the typed path must itself be a possible output (not a device, pipe,
+/// directory or broken link, which it would otherwise escape by a suffix), and so must each
+/// derived path.
+pub fn check_derived(flag: &str, typed: &Path, derived: &[PathBuf]) -> Result<(), OutputError> {
+    check_outputs(&[(flag, typed)], &[])?;
+    let outputs: Vec<(&str, &Path)> = derived.iter().map(|p| (flag, p.as_path())).collect();
+    check_outputs(&outputs, &[])
 }
 
 /// Writes `contents` to `path` atomically.

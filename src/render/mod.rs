@@ -21,11 +21,20 @@ pub struct Written {
 
 /// Writes `fits.json`, `summary.md` and the figures into `dir` (atomically, file by file).
 pub fn write(analysis: &Analysis, dir: &Path) -> Result<Written, crate::output::WriteError> {
-    let (figures, figure_errors) = figures::render_all(analysis, dir);
     let fits = dir.join("fits.json");
+    let summary = dir.join("summary.md");
+    // Checked before any figure is drawn, so that a refusal writes nothing.
+    if dir.is_dir()
+        && let Err(e) = crate::output::check_outputs(&[("analysis", &fits), ("analysis", &summary)], &[])
+    {
+        return Err(crate::output::WriteError {
+            path: dir.to_path_buf(),
+            source: std::io::Error::other(e.to_string()),
+        });
+    }
+    let (figures, figure_errors) = figures::render_all(analysis, dir);
     let text = serde_json::to_string_pretty(analysis).expect("analysis serializes");
     crate::output::write_atomic(&fits, text.as_bytes())?;
-    let summary = dir.join("summary.md");
     let md = summary::markdown(analysis, &figures);
     crate::output::write_atomic(&summary, md.as_bytes())?;
     Ok(Written {

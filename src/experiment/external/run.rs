@@ -227,7 +227,7 @@ fn sample(
     let reported_s = match time {
         None => None,
         Some((re, unit)) => match last_number(re, done) {
-            Some(Ok(t)) if t.is_finite() && t >= 0.0 => Some(t * unit),
+            Some(Ok(t)) if t.is_finite() && t > 0.0 => Some(t * unit),
             Some(Ok(t)) => return fail(format!("it printed the time {t}, not a duration")),
             Some(Err(text)) => {
                 return fail(format!(
@@ -257,10 +257,20 @@ fn sample(
             }
             Some(c) => {
                 let num = |i: usize| c.get(i).and_then(|m| m.as_str().trim().parse::<f64>().ok());
-                match (num(1), c.get(2).map(|_| num(2))) {
+                let printed = match (num(1), c.get(2).map(|_| num(2))) {
                     (Some(med), None) => Some([med, med]),
                     (Some(med), Some(Some(max))) => Some([med, max]),
-                    _ => {
+                    _ => None,
+                };
+                match printed.map(|e| (e, crate::experiment::vet::force_error(e))) {
+                    Some((_, Ok(e))) => Some(e),
+                    Some((e, Err(why))) => {
+                        return fail(format!(
+                            "it printed the force error [{}, {}]: {why}",
+                            e[0], e[1]
+                        ));
+                    }
+                    None => {
                         return fail(format!(
                             "the force_error regex `{}` matched no number",
                             re.as_str()
