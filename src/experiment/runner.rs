@@ -2,8 +2,8 @@
 //! file after every round of every case, and resumes an interrupted sweep.
 
 use super::code::Code;
-use super::lock::WriterLock;
 use super::config::SweepConfig;
+use super::lock::WriterLock;
 use super::measure::{MeasureJob, RoundSpec};
 use super::plan::{Case, cases};
 use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};

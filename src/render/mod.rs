@@ -25,7 +25,8 @@ pub fn write(analysis: &Analysis, dir: &Path) -> Result<Written, crate::output::
     let summary = dir.join("summary.md");
     // Checked before any figure is drawn, so that a refusal writes nothing.
     if dir.is_dir()
-        && let Err(e) = crate::output::check_outputs(&[("analysis", &fits), ("analysis", &summary)], &[])
+        && let Err(e) =
+            crate::output::check_outputs(&[("analysis", &fits), ("analysis", &summary)], &[])
     {
         return Err(crate::output::WriteError {
             path: dir.to_path_buf(),

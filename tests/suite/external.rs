@@ -310,7 +310,10 @@ check = 'check OK'
     );
     let errors = |name: &str| {
         let c = record(&r, &format!("lj-box/{name}/n=50/p=1/r=1/seed=1"));
-        assert!(c.summary.is_none() && c.failed(), "{name}: no sample, no summary");
+        assert!(
+            c.summary.is_none() && c.failed(),
+            "{name}: no sample, no summary"
+        );
         let runs = &c.rounds[0].external.as_ref().unwrap().runs;
         assert_eq!(runs.len(), 2, "{name}");
         runs.iter()
