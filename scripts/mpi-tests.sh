@@ -127,6 +127,82 @@ refuses 3 "still outside the box after one reflection" \
 refuses 2 "not of the form AxB" run --decomp domain --scenario lj-box --kernel cell-list -n 100 --rank-grid 2y1
 [ ! -e "$TMP/bench.json" ] || fail "a refused mpi-bench left a file"
 
+# Ranks started with different jobs (mpirun's MPMD form `-n 1 A : -n 1 B`): MPI starts, rank 0
+# broadcasts the digest of its job, and every rank stops with exit 2 before any other
+# collective: rank 0 names the ranks that differ, and they say what they ran. Each rank runs
+# under a wrapper that records its own exit status; a timeout catches a hang.
+cat >"$TMP/rank.sh" <<'WRAPPER'
+#!/bin/sh
+"$@"
+status=$?
+echo "$status" >"$RANK_STATUS.${OMPI_COMM_WORLD_RANK:-x}"
+exit "$status"
+WRAPPER
+chmod +x "$TMP/rank.sh"
+# mismatched DIFFERING_RANK APP [: APP ...], each APP `-n K SUBCOMMAND ARGS...`: mpirun must exit
+# with 2, every rank must exit with 2 by itself, and the messages must name DIFFERING_RANK.
+mismatched() {
+    local differing=$1
+    shift
+    local apps=() word prev="" in_app=0 ranks=0
+    for word in "$@"; do
+        case "$word" in
+        run | mpi-check)
+            apps+=("$TMP/rank.sh" "$BIN" "$word")
+            in_app=1
+            ;;
+        :)
+            apps+=(:)
+            in_app=0
+            ;;
+        *)
+            apps+=("$word")
+            if [ "$in_app" = 0 ] && [ "$prev" = -n ]; then ranks=$((ranks + word)); fi
+            ;;
+        esac
+        prev=$word
+    done
+    echo "--- ranks started with different jobs: $*"
+    local out status=0
+    out=$(RANK_STATUS="$TMP/status" timeout 60 "${MPIRUN[@]}" -x RANK_STATUS "${apps[@]}" 2>&1 </dev/null) ||
+        status=$?
+    [ "$status" != 124 ] || fail "ranks started with different jobs hung: $*
+$out"
+    [ "$status" = 2 ] || fail "ranks started with different jobs: mpirun exited with $status, not 2: $*
+$out"
+    # Again with orte_abort_on_non_zero_status 0: mpirun then lets every rank end by itself
+    # after the first exits with an error (and exits 0 itself), so each rank's own status and
+    # message are seen.
+    rm -f "$TMP"/status.*
+    status=0
+    out=$(RANK_STATUS="$TMP/status" timeout 60 "${MPIRUN[@]}" --mca orte_abort_on_non_zero_status 0 \
+        -x RANK_STATUS "${apps[@]}" 2>&1 </dev/null) || status=$?
+    [ "$status" != 124 ] || fail "ranks started with different jobs hung: $*
+$out"
+    local rank
+    for ((rank = 0; rank < ranks; rank++)); do
+        [ -e "$TMP/status.$rank" ] || fail "rank $rank reported no exit status: $*
+$out"
+        [ "$(cat "$TMP/status.$rank")" = 2 ] ||
+            fail "rank $rank exited with $(cat "$TMP/status.$rank"), not 2: $*
+$out"
+    done
+    grep -qF "the MPI ranks were not started with the same job: rank $differing (different arguments)" <<<"$out" ||
+        fail "rank 0 did not name rank $differing: $*
+$out"
+    grep -qF "rank $differing was not started with rank 0's job (different arguments): it ran" <<<"$out" ||
+        fail "rank $differing did not say what it ran: $*
+$out"
+}
+JOB=(--decomp domain --scenario lj-box --kernel cell-list -n 500 --steps 3 --yes)
+mismatched 1 -n 1 run "${JOB[@]}" : -n 1 run "${JOB[@]/3/30}"
+mismatched 1 -n 1 run "${JOB[@]}" : -n 1 run "${JOB[@]/domain/allgather}"
+mismatched 1 -n 1 run "${JOB[@]}" : -n 1 run "${JOB[@]/500/600}"
+mismatched 1 -n 1 run "${JOB[@]}" --seed 1 : -n 1 run "${JOB[@]}" --seed 2
+JOB_CHECK=(--decomp domain --scenario lj-box --kernel cell-list -n 500 --steps 3)
+mismatched 1 -n 1 mpi-check "${JOB_CHECK[@]}" : -n 1 run "${JOB_CHECK[@]}"
+mismatched 2 -n 2 run "${JOB[@]}" : -n 1 run "${JOB[@]/3/4}"
+
 # Outputs.
 echo "--- one rank without mpirun: run --decomp domain --json"
 "$BIN" run --decomp domain --scenario lj-box --kernel cell-list -n 500 --steps 5 \

@@ -7,6 +7,22 @@
 
 use crate::cli::args::{MpiBenchArgs, MpiCheckArgs, RunArgs};
 use nbody_bench::decomp::Decomposition;
+use nbody_bench::decomp::job::Job;
+
+/// The job the ranks compare when MPI starts (`Mpi::init`): the subcommand `name` and its
+/// parsed arguments (so `--steps=3` and `--steps 3` agree, and defaults count), and the
+/// command line as typed for the messages.
+#[cfg_attr(not(feature = "mpi"), allow(dead_code))]
+fn job(name: &str, args: &dyn std::fmt::Debug) -> Job {
+    let typed: Vec<String> = std::env::args_os()
+        .skip(1)
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    Job {
+        command: format!("{name} {args:?}"),
+        typed: format!("nbody-bench {}", typed.join(" ")),
+    }
+}
 
 #[cfg(not(feature = "mpi"))]
 pub fn run(_args: RunArgs, _decomp: Decomposition) -> anyhow::Result<i32> {
@@ -39,6 +55,14 @@ mod with_mpi {
     use nbody_bench::scenario::Precision;
     use nbody_bench::units::Duration;
     use std::path::PathBuf;
+
+    /// Starts MPI and checks that every rank runs `job` (see `Mpi::init`, which prints a
+    /// mismatch itself); on an error, prints it where it should be and gives exit code 2.
+    fn start(job: &Job) -> Result<Mpi, i32> {
+        // Before the check no rank knows which it is; the errors of this step say where they
+        // are printed (`MpiError::printed_by` ignores the rank for them).
+        Mpi::init(job).map_err(|err| fail(0, err))
+    }
 
     /// Prints an error on the ranks that should, and gives exit code 2.
     fn fail(rank: usize, err: MpiError) -> i32 {
@@ -129,7 +153,10 @@ mod with_mpi {
                 )?;
             }
         }
-        let mut mpi = Mpi::init()?;
+        let mut mpi = match start(&job("run", &args)) {
+            Ok(mpi) => mpi,
+            Err(code) => return Ok(code),
+        };
         let rank = mpi.rank();
         if args.trajectory.is_some() {
             let err = MpiError::Usage(
@@ -227,7 +254,10 @@ mod with_mpi {
     }
 
     pub fn check(args: MpiCheckArgs) -> anyhow::Result<i32> {
-        let mut mpi = Mpi::init()?;
+        let mut mpi = match start(&job("mpi-check", &args)) {
+            Ok(mpi) => mpi,
+            Err(code) => return Ok(code),
+        };
         let rank = mpi.rank();
         let setup = setup(args.scenario, &args.system);
         if let Err(err) = fits(
@@ -345,7 +375,10 @@ mod with_mpi {
 
     pub fn bench(args: MpiBenchArgs) -> anyhow::Result<i32> {
         nbody_bench::output::check_outputs(&[("--out", &args.out)], &[])?;
-        let mut mpi = Mpi::init()?;
+        let mut mpi = match start(&job("mpi-bench", &args)) {
+            Ok(mpi) => mpi,
+            Err(code) => return Ok(code),
+        };
         let rank = mpi.rank();
         let options = BenchOptions {
             max_bytes: args.max_bytes as u64,
@@ -395,5 +428,60 @@ mod with_mpi {
         nbody_bench::output::write_atomic(&args.out, text.as_bytes())?;
         outln!("timings written to {}", args.out.display());
         Ok(0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::job;
+    use crate::cli::args::{Cli, Command};
+    use clap::Parser;
+    use nbody_bench::decomp::job::{Difference, JobDigest};
+
+    /// The digest of the MPI job of a command line, as `Mpi::init` computes it.
+    fn digest(line: &str) -> JobDigest {
+        let argv = std::iter::once("nbody-bench").chain(line.split_whitespace());
+        let cli = Cli::try_parse_from(argv).unwrap();
+        let job = match &cli.command {
+            Command::Run(a) => job("run", a),
+            Command::MpiCheck(a) => job("mpi-check", a),
+            Command::MpiBench(a) => job("mpi-bench", a),
+            other => panic!("not an MPI command: {other:?}"),
+        };
+        JobDigest::of(&job, "one build")
+    }
+
+    const RUN: &str =
+        "run --decomp domain --scenario lj-box --kernel cell-list -n 500 --steps 3 --seed 1";
+
+    #[test]
+    fn the_same_command_line_is_the_same_job_however_spelled() {
+        assert_eq!(digest(RUN), digest(RUN));
+        let spelled = "run --decomp=domain --kernel=cell-list --scenario lj-box --steps=3 \
+                       --seed 1 -n 500 --threads 1";
+        assert_eq!(digest(RUN), digest(spelled));
+    }
+
+    #[test]
+    fn any_argument_that_differs_is_another_job() {
+        let base = digest(RUN);
+        for other in [
+            RUN.replace("--steps 3", "--steps 30"),
+            RUN.replace("--decomp domain", "--decomp allgather"),
+            RUN.replace("-n 500", "-n 501"),
+            RUN.replace("--seed 1", "--seed 2"),
+            format!("{RUN} --warmup-steps 1"),
+            format!("{RUN} --json out.json"),
+            "mpi-check --decomp domain --scenario lj-box --kernel cell-list -n 500 --steps 3 \
+             --seed 1"
+                .into(),
+        ] {
+            assert_eq!(
+                base.differences(&digest(&other)),
+                Difference::COMMAND,
+                "{other}"
+            );
+        }
+        assert_ne!(digest("mpi-bench --reps 10"), digest("mpi-bench --reps 11"));
     }
 }

@@ -1,10 +1,11 @@
 //! Decompositions of a simulation over processes, without MPI itself: the spatial regions of
 //! the domain decomposition and their rebalancing ([`regions`]), the per-rank statistics and
 //! their reduction ([`stats`]), the bytes each decomposition moves ([`model`]), the
-//! `mpi-bench` results file ([`bench_file`]), particles as message bytes ([`wire`]) and the
-//! comparison of a distributed run with a serial one ([`check`]). The drivers that use them
-//! with MPI are in `crate::mpi` (feature `mpi`); everything here builds and is tested without
-//! an MPI library.
+//! `mpi-bench` results file ([`bench_file`]), particles as message bytes ([`wire`]), the
+//! comparison of a distributed run with a serial one ([`check`]) and the digest of the job the
+//! ranks compare before their first collective ([`job`]). The drivers that use them with MPI
+//! are in `crate::mpi` (feature `mpi`); everything here builds and is tested without an MPI
+//! library.
 //!
 //! The geometry of a distributed Barnes-Hut, also MPI-free: the domains of the ranks, either
 //! the octants of the root cube in Morton order ([`octants`], the gravity source's scheme) or a
@@ -16,6 +17,7 @@
 pub mod bench_file;
 pub mod check;
 pub mod essential;
+pub mod job;
 pub mod model;
 pub mod octants;
 pub mod orb;

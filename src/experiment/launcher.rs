@@ -32,6 +32,14 @@ pub enum LaunchError {
     Result { path: PathBuf, detail: String },
     #[error("cannot find this program to launch it: {0}")]
     Exe(std::io::Error),
+    #[error(
+        "cannot create a private temporary directory in {dir} for the run's result: {source}; \
+         set TMPDIR to a writable directory"
+    )]
+    TempDir {
+        dir: PathBuf,
+        source: std::io::Error,
+    },
 }
 
 /// The fields of a `run --json` result a round needs.
@@ -153,6 +161,18 @@ pub fn round_from_json(text: &str, samples: usize, warmup: u64) -> Result<RoundO
     })
 }
 
+/// A new directory for the result a launched run writes back: created exclusively under a
+/// random name with mode 0700 in the temporary directory, so that no other user can plant a
+/// link where the run writes (a predictable name in a shared `/tmp` let one overwrite any file
+/// of the user running the sweep). It and its contents are removed when dropped, after a
+/// round as after a failed one, and by the interrupt handler.
+pub fn private_dir() -> Result<crate::output::TemporaryDir, LaunchError> {
+    crate::output::TemporaryDir::new("nbody-bench-round-").map_err(|source| LaunchError::TempDir {
+        dir: std::env::temp_dir(),
+        source,
+    })
+}
+
 /// Launches one round of `case` and reads its result.
 pub fn measure_round(
     launch: &MpiLaunch,
@@ -160,11 +180,8 @@ pub fn measure_round(
     spec: &RoundSpec,
 ) -> Result<RoundOutcome, LaunchError> {
     let exe = std::env::current_exe().map_err(LaunchError::Exe)?;
-    let json = std::env::temp_dir().join(format!(
-        "nbody-bench-round-{}-{}.json",
-        std::process::id(),
-        case.key().replace('/', "_")
-    ));
+    let dir = private_dir()?;
+    let json = dir.path().join("round.json");
     let args = launch_args(launch, case, &exe, &json);
     let command = format!("{} {}", launch.launcher, args.join(" "));
     let output = Command::new(&launch.launcher)
@@ -176,7 +193,6 @@ pub fn measure_round(
             source,
         })?;
     let text = std::fs::read_to_string(&json);
-    let _ = std::fs::remove_file(&json);
     if !output.status.success() {
         let all = String::from_utf8_lossy(&output.stderr).into_owned()
             + &String::from_utf8_lossy(&output.stdout);

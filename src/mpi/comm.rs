@@ -145,6 +145,12 @@ impl Comm {
         all
     }
 
+    /// Rank 0's `buf` on every rank (every rank passes a buffer of the same length).
+    pub fn broadcast_from_root(&mut self, buf: &mut [u8]) {
+        self.collective(if self.rank == 0 { buf.len() } else { 0 });
+        self.timed(|w| w.process_at_rank(0).broadcast_into(buf));
+    }
+
     /// Element-wise sum over the ranks.
     pub fn all_reduce_sum_f64(&mut self, mine: &[f64], out: &mut [f64]) {
         self.collective(std::mem::size_of_val(mine));

@@ -49,14 +49,20 @@ pub enum MpiError {
     },
     #[error("{0}")]
     Usage(String),
+    #[error("{0}")]
+    JobMismatch(crate::decomp::job::Mismatch),
 }
 
 impl MpiError {
     /// Whether every rank meets this error at the same point (bad input, a blown-up energy
     /// computed from gathered data): then only rank 0 prints it. Errors of one rank (its
     /// particles, its files) are printed by that rank; a `Peer` error by rank 0 as a pointer.
+    /// MPI that could not start is reported by every process (none knows its peers yet); a
+    /// job mismatch was printed by `Mpi::init` already, before MPI was finalized.
     pub fn printed_by(&self, rank: usize) -> bool {
         match self {
+            MpiError::Init | MpiError::Threading(_) => true,
+            MpiError::JobMismatch(_) => false,
             MpiError::Boundary { .. } | MpiError::Pool { .. } => true,
             MpiError::Write(_) | MpiError::Serialize(_) => true,
             _ => rank == 0,

@@ -13,6 +13,7 @@ mod domain;
 mod driver;
 mod error;
 mod job;
+mod same_job;
 mod tree;
 
 pub use crate::decomp::check::CheckReport;
@@ -22,6 +23,7 @@ pub use error::MpiError;
 pub use job::{MpiSpec, RootResult};
 
 use crate::decomp::bench_file::MpiBenchFile;
+use crate::decomp::job::Job;
 use crate::scenario::Setup;
 use ::mpi::Threading;
 use ::mpi::environment::Universe;
@@ -35,18 +37,35 @@ pub struct Mpi {
 }
 
 impl Mpi {
-    /// Initializes MPI (at most once per process) with thread level `serialized`: the drivers
-    /// run on a rayon thread while the kernels use the rest of the pool.
-    pub fn init() -> Result<Mpi, MpiError> {
+    /// Initializes MPI (at most once per process) with thread level `serialized` (the drivers
+    /// run on a rayon thread while the kernels use the rest of the pool), then checks that
+    /// every rank was started with `job` by the same build, before any other collective: a
+    /// rank that differs makes every rank return [`MpiError::JobMismatch`]. Every MPI entry
+    /// point starts here.
+    ///
+    /// A mismatch is printed here (on rank 0 and on the ranks that differ), before MPI is
+    /// finalized: a launcher ends the whole job when the first rank exits with an error, and a
+    /// rank that printed only after finalizing could be killed before it did.
+    pub fn init(job: &Job) -> Result<Mpi, MpiError> {
         let (universe, level) =
             ::mpi::initialize_with_threading(Threading::Serialized).ok_or(MpiError::Init)?;
         if level < Threading::Serialized {
             return Err(MpiError::Threading(format!("{level:?}").to_lowercase()));
         }
-        Ok(Mpi {
+        let mut mpi = Mpi {
             comm: Comm::new(universe.world()),
             _universe: universe,
-        })
+        };
+        if let Err(err) = same_job::check(&mut mpi.comm, job) {
+            if let MpiError::JobMismatch(m) = &err
+                && m.printed()
+            {
+                eprintln!("error: {m}");
+            }
+            // Dropping `mpi` finalizes MPI, on every rank together.
+            return Err(err);
+        }
+        Ok(mpi)
     }
 
     pub fn rank(&self) -> usize {

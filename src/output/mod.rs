@@ -3,6 +3,9 @@
 
 pub mod dump;
 pub mod nbview;
+mod temporary_dir;
+
+pub use temporary_dir::TemporaryDir;
 
 use std::fs::{self, File};
 use std::io::{self, BufWriter, Write};
@@ -142,7 +145,7 @@ pub fn check_outputs(
     Ok(())
 }
 
-/// Temporary files being written now, removed by [`remove_temporaries`] when the process is
+/// Temporary files being written now (and private temporary directories), removed by [`remove_temporaries`] when the process is
 /// interrupted (SIGINT, SIGTERM), so that an interrupted run leaves nothing behind.
 static TEMPORARIES: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
@@ -156,7 +159,8 @@ fn temporaries() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 pub fn remove_temporaries_and_exit(code: i32) -> ! {
     let mut open = temporaries();
     for tmp in open.drain(..) {
-        let _ = fs::remove_file(tmp);
+        // A private directory ([`TemporaryDir`]) goes with its contents.
+        let _ = fs::remove_file(&tmp).or_else(|_| fs::remove_dir_all(&tmp));
     }
     std::process::exit(code)
 }

@@ -121,3 +121,54 @@ fn a_round_needs_a_step_per_sample_and_a_complete_result() {
     assert!(err.contains("fewer than the 3 samples"), "{err}");
     assert!(round_from_json("{\"n\": 3}", 3, 0).is_err());
 }
+
+/// A round's result is written back in a private directory, never at a name another user could
+/// predict: a link planted at the old name (`$TMPDIR/nbody-bench-round-<pid>-<case>.json`) is
+/// not written through, and the directory is gone after the round, here a failed one. The
+/// launcher is `sh -c SCRIPT`, which writes what a run would to the file given as `--json`
+/// (through any link, as a run's atomic write does) and records that file's directory.
+#[cfg(target_os = "linux")]
+#[test]
+fn a_round_is_written_back_in_a_private_directory_not_through_a_planted_link() {
+    let tmp = tempfile::tempdir().unwrap();
+    let victim = tmp.path().join("victim");
+    std::fs::write(&victim, "precious").unwrap();
+    let case = case();
+    let planted = std::env::temp_dir().join(format!(
+        "nbody-bench-round-{}-{}.json",
+        std::process::id(),
+        case.key().replace('/', "_")
+    ));
+    let _ = std::fs::remove_file(&planted);
+    std::os::unix::fs::symlink(&victim, &planted).unwrap();
+    let log = tmp.path().join("log");
+    let script = format!(
+        r#"while [ "$#" -gt 0 ]; do [ "$1" = --json ] && json=$2; shift; done
+d=$(dirname "$json"); stat -c %a "$d" > '{log}'; echo "$d" >> '{log}'; echo junk > "$json""#,
+        log = log.display()
+    );
+    let launch = MpiLaunch {
+        launcher: "sh".into(),
+        args: vec!["-c".into(), script, "sh".into()],
+        ..launch()
+    };
+    let spec = RoundSpec {
+        samples: 2,
+        warmup_s: 0.0,
+        min_sample_s: 0.0,
+        steps_per_sample: None,
+        force_error_sample: 0,
+        reference_s: 0.0,
+        slowdown: None,
+    };
+    let err = measure_round(&launch, &case, &spec).unwrap_err();
+    std::fs::remove_file(&planted).unwrap();
+    assert!(matches!(err, LaunchError::Result { .. }), "{err}");
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    let log = std::fs::read_to_string(&log).unwrap();
+    let (mode, dir) = log.trim().split_once('\n').unwrap();
+    assert_eq!(mode, "700", "{log}");
+    let dir = Path::new(dir);
+    assert_ne!(dir, std::env::temp_dir(), "{log}");
+    assert!(!dir.exists(), "{} left behind", dir.display());
+}
