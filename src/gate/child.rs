@@ -158,8 +158,8 @@ pub fn output(
     // Both pipes are read while the child runs, so that a chatty child never blocks on a full
     // pipe; the readers report through a channel, so that none is waited for forever.
     let readers = [
-        child.child.stdout.take().map(|s| drain(s)),
-        child.child.stderr.take().map(|s| drain(s)),
+        child.child.stdout.take().map(drain),
+        child.child.stderr.take().map(drain),
     ];
     let status = child.wait(limit, what)?;
     let [stdout, stderr] = readers.map(|r| {
