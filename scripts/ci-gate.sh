@@ -4,10 +4,11 @@
 # base revision that is missing or does not build) — it never passes without judging.
 #
 # - results/baseline/ holds one baseline per machine class (CPU model, CPU signature, logical
-#   CPUs). If one was measured on this machine class, the gate sweeps its config
-#   (configs/ci.toml) with this build and compares with it (the fast path, about 25 s;
-#   threshold 0.25).
-# - Otherwise it builds the newest baseline's commit in a git worktree (cached in
+#   CPUs). If one was measured on this machine class, and the machine's calibrated FMA rate
+#   is within 12 % of the baseline's, the gate sweeps its config (configs/ci.toml) with this
+#   build and compares with it (the fast path, about 25 s; threshold 0.25).
+# - Otherwise (another class, or the machine running faster or slower than when its baseline
+#   was measured) it builds the baseline's commit in a git worktree (cached in
 #   target/gate-base/) and measures both builds here, interleaved case by case (A/B; threshold
 #   0.10). scripts/refresh-baseline.sh on such a machine adds its class's file.
 #

@@ -12,8 +12,12 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     // An interrupted command (SIGINT, SIGTERM) leaves no temporary file behind: files are
     // written under a temporary name and renamed into place, and whatever is half-written when
-    // the signal comes is removed here. Results saved before the signal are whole.
-    let _ = ctrlc::set_handler(|| nbody_bench::output::remove_temporaries_and_exit(130));
+    // the signal comes is removed here. Results saved before the signal are whole. The gate's
+    // children run in process groups of their own, so they are told too.
+    let _ = ctrlc::set_handler(|| {
+        nbody_bench::gate::child::terminate_all();
+        nbody_bench::output::remove_temporaries_and_exit(130)
+    });
     let code = match cli::dispatch(cli) {
         Ok(code) => code,
         Err(err) => {

@@ -334,6 +334,31 @@ fn parse_positive(s: &str) -> Result<f64, String> {
     }
 }
 
+/// A gate threshold: a fraction from 0 to `gate::MAX_THRESHOLD`.
+fn parse_threshold(s: &str) -> Result<f64, String> {
+    let v = parse_non_negative(s)?;
+    nbody_bench::gate::check_threshold(v).map_err(|e| e.to_string())?;
+    Ok(v)
+}
+
+/// A/B rounds per build: even, from 2 to `gate::ab::MAX_ROUNDS`.
+fn parse_ab_rounds(s: &str) -> Result<usize, String> {
+    let v = s
+        .parse::<usize>()
+        .map_err(|_| format!("`{s}` is not a whole number"))?;
+    nbody_bench::gate::ab::check_rounds(v).map_err(|e| e.to_string())?;
+    Ok(v)
+}
+
+/// Seconds, more than 0 and at most a week.
+fn parse_timeout(s: &str) -> Result<f64, String> {
+    const WEEK_S: f64 = 7.0 * 24.0 * 3600.0;
+    match parse_positive(s)? {
+        v if v > WEEK_S => Err(format!("{v} s is more than a week ({WEEK_S} s)")),
+        v => Ok(v),
+    }
+}
+
 fn parse_non_negative(s: &str) -> Result<f64, String> {
     let v = parse_float(s)?;
     if v >= 0.0 {
@@ -480,17 +505,25 @@ pub struct GateArgs {
     /// The config to measure when the gate measures [default: the baseline's own config].
     #[arg(long, value_name = "FILE|NAME", conflicts_with = "current")]
     pub config: Option<PathBuf>,
-    /// Rounds of every case per build in an A/B run.
-    #[arg(long, default_value_t = nbody_bench::gate::AB_ROUNDS, value_parser = parse_count, conflicts_with = "current")]
+    /// Rounds of every case per build in an A/B run: even (each build goes first as often),
+    /// from 2 to 100.
+    #[arg(long, default_value_t = nbody_bench::gate::AB_ROUNDS, value_parser = parse_ab_rounds, conflicts_with = "current")]
     pub rounds: usize,
+    /// Longest one build's sweep of one case may take in an A/B run, seconds (also the limit
+    /// of asking the base binary for its options) [default: 10 times the case's estimate, at
+    /// least 120 s]; a child past its limit is stopped and the gate exits 2. The base build has
+    /// a limit of its own, an hour.
+    #[arg(long, value_name = "SECONDS", value_parser = parse_timeout, conflicts_with = "current")]
+    pub timeout: Option<f64>,
     /// Where a measuring gate keeps what it measured [default: results/runs/gate/<UTC time>/].
     #[arg(long, value_name = "DIR", conflicts_with = "current")]
     pub out: Option<PathBuf>,
     /// Relative slowdown a case must exceed, with its whole 95% CI, to count as a regression
     /// (0.10 = 10%); the same margin below 1 counts as an improvement [default: 0.10 for two
     /// files and for A/B runs, 0.25 when the gate sweeps and compares with a baseline file
-    /// measured at another time: the margins the noise studies in the README found safe].
-    #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
+    /// measured at another time: the margins the noise studies in the README found safe];
+    /// at most 1 (a doubling).
+    #[arg(long, value_parser = parse_threshold, allow_hyphen_values = true)]
     pub threshold: Option<f64>,
     /// Output format; markdown is made for a CI job summary.
     #[arg(long, value_enum, default_value = "text")]
@@ -502,7 +535,8 @@ pub struct GateArgs {
     /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
     #[arg(long)]
     pub force: bool,
-    /// Also fail (exit 1) when a deterministic work counter changed.
+    /// Also fail (exit 1) when a deterministic work counter changed; a case whose counters
+    /// cannot be compared (a file without them) is then an error (exit 2), not a pass.
     #[arg(long)]
     pub fail_on_work_change: bool,
 }

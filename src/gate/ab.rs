@@ -10,23 +10,45 @@
 //! and judged by [`super::compare`] like any two results files.
 
 use super::base_build::BaseBinary;
+use super::child::{self, ChildError};
 use crate::experiment::config::SweepConfig;
 use crate::experiment::plan::{Case, cases};
 use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::experiment::slowdown::SLOWDOWN_ENV;
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Duration;
 use thiserror::Error;
+
+/// Most rounds of every case per build: 4 are the default and were enough for the error rates
+/// in the README; 100 rounds of `configs/ci.toml` already take about half an hour.
+pub const MAX_ROUNDS: usize = 100;
+
+/// Whether `rounds` rounds per build can be measured: an even number from 2 to
+/// [`MAX_ROUNDS`].
+pub fn check_rounds(rounds: usize) -> Result<(), AbError> {
+    if rounds < 2 || !rounds.is_multiple_of(2) || rounds > MAX_ROUNDS {
+        return Err(AbError::Rounds(rounds));
+    }
+    Ok(())
+}
 
 #[derive(Debug, Error)]
 pub enum AbError {
     #[error("the A/B gate cannot run config `{name}`: {why}")]
     Unsupported { name: String, why: String },
     #[error(
-        "--rounds must be an even number of at least 2 (got {0}): each build must go first as \
-         often as the other"
+        "--rounds must be an even number from 2 to {max} (got {0}): each build must go first \
+         as often as the other, and {max} rounds of every case are already far more than the \
+         noise of the gate needs",
+        max = MAX_ROUNDS
     )]
     Rounds(usize),
+    /// A build's sweep past its time limit.
+    #[error(transparent)]
+    Stuck(ChildError),
+    #[error("the base build at {path} cannot be asked for its options: {source}")]
+    Probe { path: PathBuf, source: ChildError },
     #[error(
         "the {side} build failed to measure {key} (round {round}); its output ends with:\n{tail}"
     )]
@@ -65,6 +87,8 @@ impl Side {
 pub struct AbPlan<'a> {
     pub config: &'a SweepConfig,
     pub config_text: &'a str,
+    /// Every case with its one-case config, from [`prepare`].
+    pub cases: &'a [OneCase],
     pub base: &'a BaseBinary,
     /// This build's binary.
     pub current: &'a Path,
@@ -72,6 +96,110 @@ pub struct AbPlan<'a> {
     pub rounds: usize,
     /// Scratch directory for the one-case sweeps.
     pub work: &'a Path,
+    /// The longest one build's one-case sweep of a case may take, by case; see
+    /// [`child_limit`].
+    pub limit: &'a dyn Fn(&Case) -> Duration,
+}
+
+/// One case of an A/B run and the config text both builds sweep it with.
+#[derive(Clone, Debug)]
+pub struct OneCase {
+    pub case: Case,
+    pub text: String,
+}
+
+/// Everything about an A/B run of `config` that can be refused without the base build, so
+/// that no refusal comes after minutes of compiling: the rounds, the kinds of config the A/B
+/// form cannot run, and every case's one-case config, which must parse back (with this
+/// build's parser) to exactly that case.
+pub fn prepare(
+    config: &SweepConfig,
+    config_text: &str,
+    rounds: usize,
+) -> Result<Vec<OneCase>, AbError> {
+    let unsupported = |why: String| AbError::Unsupported {
+        name: config.name.clone(),
+        why,
+    };
+    check_rounds(rounds)?;
+    if config.mpi.is_some() {
+        return Err(unsupported(
+            "it runs cases under MPI; gate a config without [mpi]".into(),
+        ));
+    }
+    let planned = cases(config);
+    if planned.iter().any(|c| c.time_factor != 1) {
+        return Err(unsupported(
+            "its weak-by-time cases have no one-case config form".into(),
+        ));
+    }
+    let table: toml::Table = toml::from_str(config_text).map_err(|e| {
+        unsupported(format!(
+            "its text does not parse as a TOML table ({}; a TOML table holds integers up \
+             to {})",
+            e.message().trim(),
+            i64::MAX
+        ))
+    })?;
+    let samples = samples_per_round(config, rounds);
+    planned
+        .into_iter()
+        .map(|case| {
+            let text = one_case_config(&table, &case, samples)
+                .map_err(|e| unsupported(format!("case {}: {e}", case.key())))?;
+            let parsed = SweepConfig::parse(&text, Path::new("ab.toml")).map_err(|e| {
+                unsupported(format!(
+                    "the one-case config of {} does not parse ({e})",
+                    case.key()
+                ))
+            })?;
+            let keys: Vec<String> = cases(&parsed).iter().map(Case::key).collect();
+            if keys != [case.key()] {
+                return Err(unsupported(format!(
+                    "the one-case config of {} plans [{}] instead",
+                    case.key(),
+                    keys.join(", ")
+                )));
+            }
+            Ok(OneCase { case, text })
+        })
+        .collect()
+}
+
+/// Floor of a child's time limit: starting a sweep, building its system and its energy
+/// probes take seconds even for a tiny case, on a machine busy with other work too.
+pub const CHILD_FLOOR: Duration = Duration::from_secs(120);
+/// A child's limit is this many times its estimate (the estimate is a rule of thumb from a
+/// probe at small n; a shared 2-vCPU machine runs the same code up to 3x slower under load).
+pub const CHILD_ESTIMATE_FACTOR: f64 = 10.0;
+/// Runs of an external program in one round besides its samples: the set-up, the empty runs
+/// that measure the launch overhead, and slack for its warm-up runs.
+const EXTERNAL_EXTRA_RUNS: usize = 12;
+/// No limit is longer than a week (an external's `timeout_s` may be huge).
+const LONGEST_LIMIT: Duration = Duration::from_secs(7 * 24 * 3600);
+
+/// The time limit of one build's one-case round of `case`: [`CHILD_ESTIMATE_FACTOR`] times its
+/// estimate `estimate_s` (seconds; `None` when the case was not estimated), at least
+/// [`CHILD_FLOOR`]; an external program's case allows every one of its runs its own
+/// `timeout_s` on top.
+pub fn child_limit(
+    config: &SweepConfig,
+    case: &Case,
+    rounds: usize,
+    estimate_s: Option<f64>,
+) -> Duration {
+    let mut limit = CHILD_FLOOR
+        .as_secs_f64()
+        .max(estimate_s.unwrap_or(0.0) * CHILD_ESTIMATE_FACTOR);
+    if let crate::experiment::code::Code::External(name) = &case.kernel
+        && let Some(ext) = config.external.iter().find(|e| &e.name == name)
+    {
+        let runs = samples_per_round(config, rounds) + ext.warmup_runs + EXTERNAL_EXTRA_RUNS;
+        limit += runs as f64 * ext.timeout_s;
+    }
+    Duration::try_from_secs_f64(limit)
+        .unwrap_or(LONGEST_LIMIT)
+        .min(LONGEST_LIMIT)
 }
 
 /// Both builds' merged results.
@@ -92,43 +220,35 @@ pub fn order(round: usize, case: usize) -> [Side; 2] {
     }
 }
 
-/// Samples per one-case round: the config's samples spread over the A/B rounds (at least 2).
+/// Samples per one-case round: the config's samples spread over the A/B rounds, at least 2,
+/// and at least [`super::MIN_CI_SAMPLES`] per build in all (the fewest a CI is judged on).
 pub fn samples_per_round(config: &SweepConfig, rounds: usize) -> usize {
-    config.measure.samples.div_ceil(rounds).max(2)
+    let rounds = rounds.max(1);
+    config
+        .measure
+        .samples
+        .max(super::MIN_CI_SAMPLES)
+        .div_ceil(rounds)
+        .max(2)
 }
 
 /// Measures every case of the plan with both builds, interleaved.
 pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbResults, AbError> {
-    let unsupported = |why: &str| AbError::Unsupported {
-        name: plan.config.name.clone(),
-        why: why.to_string(),
-    };
-    if plan.rounds < 2 || !plan.rounds.is_multiple_of(2) {
-        return Err(AbError::Rounds(plan.rounds));
-    }
+    check_rounds(plan.rounds)?;
     // A base that estimates a sweep's length before starting it (as this build does) is told
     // not to, like this build, so that neither side does extra work before its samples.
-    let base_takes_yes = takes_yes(&plan.base.path);
-    if plan.config.mpi.is_some() {
-        return Err(unsupported(
-            "it runs cases under MPI; gate a config without [mpi]",
-        ));
-    }
-    let planned = cases(plan.config);
-    if planned.iter().any(|c| c.time_factor != 1) {
-        return Err(unsupported(
-            "its weak-by-time cases have no one-case config form",
-        ));
-    }
-    let table: toml::Table = toml::from_str(plan.config_text)
-        .map_err(|e| unsupported(&format!("its text does not parse ({})", e.message())))?;
-    let samples = samples_per_round(plan.config, plan.rounds);
+    let probe_limit = plan
+        .cases
+        .first()
+        .map_or(CHILD_FLOOR, |c| (plan.limit)(&c.case));
+    let base_takes_yes = takes_yes(&plan.base.path, probe_limit)?;
+    let planned: Vec<&Case> = plan.cases.iter().map(|c| &c.case).collect();
     let logical = crate::run::logical_cpus();
     let mut merged: [Vec<CaseRecord>; 2] = [Vec::new(), Vec::new()];
     for side in &mut merged {
         *side = planned
             .iter()
-            .map(|c| CaseRecord::new(c.clone(), plan.rounds, logical))
+            .map(|c| CaseRecord::new((*c).clone(), plan.rounds, logical))
             .collect();
     }
     let mut metadata = [None, None];
@@ -148,14 +268,13 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
             indices.reverse();
         }
         for i in indices {
-            let text = one_case_config(&table, &planned[i], samples)
-                .map_err(|e| unsupported(&format!("its one-case form does not serialize ({e})")))?;
+            let text = &plan.cases[i].text;
             for side in order(round, i) {
                 let dir = plan
                     .work
                     .join(side.name())
                     .join(format!("case{i}-round{round}"));
-                let file = run_side(plan, side, &text, &dir, &planned[i], round, base_takes_yes)?;
+                let file = run_side(plan, side, text, &dir, planned[i], round, base_takes_yes)?;
                 let slot = side as usize;
                 metadata[slot].get_or_insert_with(|| file.metadata.clone());
                 let record = file
@@ -196,12 +315,24 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
     })
 }
 
-/// Whether a binary's `sweep` has the `--yes` flag.
-fn takes_yes(binary: &Path) -> bool {
-    Command::new(binary)
-        .args(["sweep", "--help"])
-        .output()
-        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).contains("--yes"))
+/// Whether a binary's `sweep` has the `--yes` flag; a binary that does not answer within
+/// `limit` is an error (it would hang every sweep too).
+fn takes_yes(binary: &Path, limit: Duration) -> Result<bool, AbError> {
+    let what = format!("`{} sweep --help`", binary.display());
+    match child::output(
+        Command::new(binary).args(["sweep", "--help"]),
+        limit,
+        &what,
+        "",
+    ) {
+        Ok(o) => Ok(String::from_utf8_lossy(&o.stdout).contains("--yes")),
+        // A binary that cannot start fails its first sweep with the reason.
+        Err(ChildError::Start { .. }) => Ok(false),
+        Err(source) => Err(AbError::Probe {
+            path: binary.to_path_buf(),
+            source,
+        }),
+    }
 }
 
 /// The median of every reference-workload time of a results file, seconds.
@@ -215,12 +346,20 @@ pub fn median_reference(file: &ResultsFile) -> Option<f64> {
 }
 
 /// The config text of one case for one round: the config's own text with the lists narrowed
-/// to the case, one round of `samples` samples, no budget.
-fn one_case_config(
-    table: &toml::Table,
-    case: &Case,
-    samples: usize,
-) -> Result<String, toml::ser::Error> {
+/// to the case, one round of `samples` samples, no budget. A value TOML cannot carry (a seed
+/// above `i64::MAX`) is an error naming it.
+fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<String, String> {
+    let int = |what: &str, v: u64| {
+        i64::try_from(v).map_err(|_| {
+            format!(
+                "its {what} {v} is above {}, the largest integer a TOML config can hold, so \
+                 the builds cannot be given its one-case config; use a smaller {what}",
+                i64::MAX
+            )
+        })
+    };
+    let seed = int("seed", case.seed)?;
+    let n = int("n", case.n as u64)?;
     let mut t = table.clone();
     let list = |v: toml::Value| toml::Value::Array(vec![v]);
     t.insert("name".into(), "ab".into());
@@ -246,9 +385,9 @@ fn one_case_config(
             }
         }
     }
-    t.insert("n".into(), list((case.n as i64).into()));
+    t.insert("n".into(), list(n.into()));
     t.insert("threads".into(), list((case.threads as i64).into()));
-    t.insert("seeds".into(), list((case.seed as i64).into()));
+    t.insert("seeds".into(), list(seed.into()));
     match case.theta {
         Some(theta) => t.insert("theta".into(), list(theta.into())),
         None => t.remove("theta"),
@@ -265,7 +404,7 @@ fn one_case_config(
         m.insert("samples".into(), (samples as i64).into());
         m.remove("budget_s");
     }
-    toml::to_string(&t)
+    toml::to_string(&t).map_err(|e| format!("its one-case form does not serialize ({e})"))
 }
 
 /// One build's one-case sweep; its results file.
@@ -296,8 +435,7 @@ fn run_side(
         .arg(&config)
         .arg("--out")
         .arg(dir)
-        .arg("--no-calibration")
-        .stdin(std::process::Stdio::null());
+        .arg("--no-calibration");
     // A one-case round needs no length estimate (older bases have no such step, nor the flag).
     if side == Side::Current || base_takes_yes {
         command.arg("--yes");
@@ -306,12 +444,24 @@ fn run_side(
         // The test-only slowdown knob is meant for this build only.
         command.env_remove(SLOWDOWN_ENV);
     }
-    let output = command.output().map_err(|e| AbError::Side {
-        side: side.name(),
-        key: case.key(),
-        round,
-        tail: format!("{} cannot be started: {e}", binary.display()),
-    })?;
+    let what = format!(
+        "the {} build's sweep of {} (round {round})",
+        side.name(),
+        case.key()
+    );
+    let hint = "pass --timeout SECONDS if the case really takes that long";
+    let output = match child::output(&mut command, (plan.limit)(case), &what, hint) {
+        Ok(output) => output,
+        Err(ChildError::Start { source, .. }) => {
+            return Err(AbError::Side {
+                side: side.name(),
+                key: case.key(),
+                round,
+                tail: format!("{} cannot be started: {source}", binary.display()),
+            });
+        }
+        Err(stuck) => return Err(AbError::Stuck(stuck)),
+    };
     let results = dir.join("ab").join("results.json");
     if !output.status.success() || !results.is_file() {
         let text = String::from_utf8_lossy(&output.stderr).to_string()
@@ -367,6 +517,55 @@ mod tests {
         }
     }
 
+    fn ci_config() -> (String, SweepConfig) {
+        let text = std::fs::read_to_string("configs/ci.toml").unwrap();
+        let config = SweepConfig::parse(&text, Path::new("configs/ci.toml")).unwrap();
+        (text, config)
+    }
+
+    #[test]
+    fn what_would_fail_after_the_build_is_refused_before_it() {
+        let (text, config) = ci_config();
+        let prepared = prepare(&config, &text, 4).unwrap();
+        assert_eq!(prepared.len(), cases(&config).len());
+        for bad in [0, 1, 3, 101, 1_000_000_000] {
+            let e = prepare(&config, &text, bad).unwrap_err().to_string();
+            assert!(e.contains("even number from 2 to 100"), "{bad}: {e}");
+        }
+        assert!(check_rounds(MAX_ROUNDS).is_ok() && check_rounds(2).is_ok());
+        // A seed TOML cannot write back (the config parser takes u64, a TOML table i64).
+        let big = text.replace("seeds = [", "seeds = [18446744073709551615, ");
+        let big = if big == text {
+            format!("seeds = [18446744073709551615]\n{text}")
+        } else {
+            big
+        };
+        let parsed = SweepConfig::parse(&big, Path::new("big.toml")).unwrap();
+        let e = prepare(&parsed, &big, 4).unwrap_err().to_string();
+        assert!(e.contains("9223372036854775807"), "{e}");
+        // MPI configs have no one-case form.
+        let mpi = std::fs::read_to_string("configs/weak-mpi.toml").unwrap();
+        let config = SweepConfig::parse(&mpi, Path::new("configs/weak-mpi.toml")).unwrap();
+        let e = prepare(&config, &mpi, 4).unwrap_err().to_string();
+        assert!(e.contains("under MPI"), "{e}");
+    }
+
+    #[test]
+    fn child_limits_follow_the_estimate_with_a_floor() {
+        let (_, config) = ci_config();
+        let case = &cases(&config)[0];
+        assert_eq!(child_limit(&config, case, 4, None), CHILD_FLOOR);
+        assert_eq!(child_limit(&config, case, 4, Some(0.5)), CHILD_FLOOR);
+        assert_eq!(
+            child_limit(&config, case, 4, Some(100.0)),
+            Duration::from_secs(1000)
+        );
+        assert_eq!(
+            child_limit(&config, case, 4, Some(f64::INFINITY)),
+            LONGEST_LIMIT
+        );
+    }
+
     #[test]
     fn samples_are_spread_over_the_rounds() {
         let text = std::fs::read_to_string("configs/ci.toml").unwrap();
@@ -376,5 +575,11 @@ mod tests {
             config.measure.samples.div_ceil(3)
         );
         assert_eq!(samples_per_round(&config, 1000), 2);
+        // However few samples the config takes, each build has enough for a CI.
+        let mut few = config.clone();
+        few.measure.samples = 1;
+        for rounds in [2, 4, 6, 8] {
+            assert!(samples_per_round(&few, rounds) * rounds >= crate::gate::MIN_CI_SAMPLES);
+        }
     }
 }

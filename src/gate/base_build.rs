@@ -7,9 +7,19 @@
 //! target directory every base build shares (so a second base revision recompiles only what
 //! changed); `worktree-<commit>/` exists only while that commit builds.
 
+use super::child::{self, ChildError};
 use std::path::{Path, PathBuf};
 use std::process::Command;
+use std::time::Duration;
 use thiserror::Error;
+
+/// Longest a git command may take (a worktree of a large checkout takes seconds).
+const GIT_LIMIT: Duration = Duration::from_secs(300);
+/// Longest the base revision's release build may take: a fresh build takes 1-10 minutes on
+/// the 2-vCPU CI machines (README, CI section), so a build past an hour is stuck.
+pub const BUILD_LIMIT: Duration = Duration::from_secs(3600);
+/// Longest `rustc -vV` may take.
+const RUSTC_LIMIT: Duration = Duration::from_secs(60);
 
 #[derive(Debug, Error)]
 pub enum BaseBuildError {
@@ -55,12 +65,14 @@ pub struct BaseBinary {
 
 /// Runs git with `args` in `dir`; its trimmed standard output, or its error text.
 fn git(dir: &Path, args: &[&str]) -> Result<String, String> {
-    let out = Command::new("git")
-        .arg("-C")
-        .arg(dir)
-        .args(args)
-        .output()
-        .map_err(|e| format!("git cannot be started ({e})"))?;
+    let what = format!("`git {}`", args.join(" "));
+    let out = child::output(
+        Command::new("git").arg("-C").arg(dir).args(args),
+        GIT_LIMIT,
+        &what,
+        "",
+    )
+    .map_err(|e| e.to_string())?;
     if out.status.success() {
         Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
     } else {
@@ -107,6 +119,15 @@ pub fn cache_root(repo: &Path) -> PathBuf {
         .map(|t| if t.is_absolute() { t } else { repo.join(t) })
         .unwrap_or_else(|| repo.join("target"))
         .join("gate-base")
+}
+
+/// Whether `commit`'s binary, built by the toolchain at hand, is in the cache (no build
+/// needed).
+pub fn is_cached(repo: &Path, commit: &str) -> bool {
+    cache_root(repo)
+        .join(cache_key(commit))
+        .join("nbody-bench")
+        .is_file()
 }
 
 /// The binary of `commit`, from the cache or built now; `progress` hears what happens.
@@ -196,9 +217,7 @@ pub fn cache_key(commit: &str) -> String {
 /// A short hash of what else decides the base binary: `rustc -vV` and `RUSTFLAGS`.
 fn toolchain_key() -> String {
     let rustc = std::env::var_os("RUSTC").unwrap_or_else(|| "rustc".into());
-    let version = Command::new(rustc)
-        .arg("-vV")
-        .output()
+    let version = child::output(Command::new(rustc).arg("-vV"), RUSTC_LIMIT, "rustc -vV", "")
         .map(|o| String::from_utf8_lossy(&o.stdout).into_owned())
         .unwrap_or_default();
     let flags = std::env::var("RUSTFLAGS").unwrap_or_default();
@@ -219,14 +238,18 @@ fn build(dir: &Path, target: &Path, log: &Path) -> Result<PathBuf, String> {
         .try_clone()
         .map_err(|e| format!("cannot write {}: {e}", log.display()))?;
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
-    let status = Command::new(cargo)
-        .args(["build", "--release", "--bin", "nbody-bench"])
-        .current_dir(dir)
-        .env("CARGO_TARGET_DIR", target)
-        .stdout(file)
-        .stderr(err_file)
-        .status()
-        .map_err(|e| format!("cargo cannot be started: {e}"))?;
+    let status = child::status(
+        Command::new(cargo)
+            .args(["build", "--release", "--bin", "nbody-bench"])
+            .current_dir(dir)
+            .env("CARGO_TARGET_DIR", target)
+            .stdout(file)
+            .stderr(err_file),
+        BUILD_LIMIT,
+        "the base revision's build",
+        "a release build takes minutes, not an hour: look for what it waits on in the log",
+    )
+    .map_err(|e: ChildError| e.to_string())?;
     let binary = target.join("release").join("nbody-bench");
     if status.success() && binary.is_file() {
         Ok(binary)

@@ -88,6 +88,13 @@ pub(super) fn check_comparable(
              than it is; refresh the baseline on a quiet machine (scripts/refresh-baseline.sh)"
         ));
     }
+    if let (Some(br), Some(cr)) = (calibrated_rate(baseline), calibrated_rate(current))
+        && let Some(why) = rates_differ(br, cr)
+    {
+        warnings.push(format!(
+            "{why}; `gate` without --current measures A/B in that case"
+        ));
+    }
     for (info, which) in [(&b, "baseline"), (&c, "current")] {
         if let Some(knob) = &info.test_slowdown {
             warnings.push(format!(
@@ -103,6 +110,42 @@ pub(super) fn check_comparable(
         }
     }
     Ok(warnings)
+}
+
+/// How far the calibrated single-thread FMA rates of a baseline and a current run may differ
+/// (the faster over the slower, minus 1) before the reference normalisation is not trusted
+/// across them. One machine class's calibrations on a quiet machine spread by up to 9.6% in
+/// the committed results (GenuineIntel 6/167/1: 219.4-240.5 GFLOP/s within one hour; the
+/// start and end of one sweep up to 8.6% apart; AuthenticAMD 25/1/1 90.1 and 92.7 in its
+/// baseline), while a baseline at 175 GFLOP/s against runs at 140 (25%) made the
+/// normalisation over-correct: 12% lets the machine's own drift through and nothing near that.
+pub const RATE_TOLERANCE: f64 = 0.12;
+
+/// The FMA rate of a sweep's calibrations (mean of the start and end), GFLOP/s.
+pub fn calibrated_rate(file: &ResultsFile) -> Option<f64> {
+    let rates: Vec<f64> = [&file.calibration.start, &file.calibration.end]
+        .into_iter()
+        .flatten()
+        .map(|c| c.fma_gflops_1t)
+        .filter(|g| g.is_finite() && *g > 0.0)
+        .collect();
+    (!rates.is_empty()).then(|| rates.iter().sum::<f64>() / rates.len() as f64)
+}
+
+/// Why the calibrated FMA rates `baseline` and `current` (GFLOP/s) are too far apart for the
+/// reference normalisation ([`RATE_TOLERANCE`]), or `None` when they are close enough.
+pub fn rates_differ(baseline: f64, current: f64) -> Option<String> {
+    let (lo, hi) = (baseline.min(current), baseline.max(current));
+    if !(lo > 0.0 && hi.is_finite()) || hi / lo - 1.0 <= RATE_TOLERANCE {
+        return None;
+    }
+    Some(format!(
+        "the baseline's calibrated FMA rate is {baseline:.1} GFLOP/s and this run's {current:.1} \
+         ({:.2}x), more than the {:.0}% the machine drifts by on its own: dividing by the \
+         reference workload would over-correct",
+        current / baseline,
+        RATE_TOLERANCE * 100.0
+    ))
 }
 
 /// Other processes' CPU use, from the calibrations, above which a baseline is called busy.

@@ -1,10 +1,10 @@
 //! Case-by-case comparison: normalisation, the bootstrap CI of the ratio of medians, the
 //! verdict, and the exact comparison of the work counters.
 
-use super::checks::check_comparable;
+use super::checks::{calibrated_rate, check_comparable};
 use super::{
-    CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, MissingCase, Normalization,
-    NormalizationChoice, RunInfo, Verdict, WorkChange,
+    CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, MAX_THRESHOLD, MIN_CI_SAMPLES,
+    MissingCase, Normalization, NormalizationChoice, RunInfo, Verdict, WorkChange,
 };
 use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::WorkCounters;
@@ -16,9 +16,7 @@ pub fn compare(
     current: &ResultsFile,
     options: &GateOptions,
 ) -> Result<GateReport, GateError> {
-    if !(options.threshold.is_finite() && options.threshold >= 0.0) {
-        return Err(GateError::BadThreshold(options.threshold));
-    }
+    check_threshold(options.threshold)?;
     let warnings = check_comparable(baseline, current, options.force)?;
     let mut report = GateReport {
         schema: GATE_SCHEMA.to_string(),
@@ -40,16 +38,28 @@ pub fn compare(
             report.missing.push(missing("not in the current results"));
             continue;
         };
-        if samples(base).is_empty() {
+        let (nb, nc) = (samples(base).len(), samples(cur).len());
+        if nb == 0 {
             report.missing.push(missing("no samples in the baseline"));
-        } else if samples(cur).is_empty() {
+        } else if nc == 0 {
             report
                 .missing
                 .push(missing("not measured in the current run"));
+        } else if nb.min(nc) < MIN_CI_SAMPLES {
+            // Judged on so few samples, the CI would be the extreme samples themselves.
+            report.missing.push(missing(&format!(
+                "{nb} successful sample(s) in the baseline and {nc} in the current run: a 95% \
+                 CI of the ratio needs at least {MIN_CI_SAMPLES} per side, so no verdict"
+            )));
         } else {
-            report
-                .cases
-                .push(compare_case(baseline, base, current, cur, options)?);
+            let case = compare_case(baseline, base, current, cur, options)?;
+            if options.fail_on_work_change && !case.work_compared {
+                report.missing.push(missing(
+                    "its work counters could not be compared (a file has no initial_work: \
+                     swept by an older version), and --fail-on-work-change asks for them",
+                ));
+            }
+            report.cases.push(case);
         }
     }
     report.extra = current
@@ -59,6 +69,15 @@ pub fn compare(
         .map(|c| c.key.clone())
         .collect();
     Ok(report)
+}
+
+/// A threshold is a fraction from 0 to [`MAX_THRESHOLD`].
+pub fn check_threshold(threshold: f64) -> Result<(), GateError> {
+    if (0.0..=MAX_THRESHOLD).contains(&threshold) {
+        Ok(())
+    } else {
+        Err(GateError::BadThreshold(threshold))
+    }
 }
 
 fn compare_case(
@@ -85,7 +104,7 @@ fn compare_case(
     } else {
         Verdict::Unchanged
     };
-    let (work_changes, mut notes) = compare_work(base, cur);
+    let (work_changes, work_compared, mut notes) = compare_work(base, cur);
     for (record, which) in [(base, "baseline"), (cur, "current")] {
         if !record.is_complete() {
             notes.push(format!(
@@ -111,6 +130,7 @@ fn compare_case(
         ci95,
         samples: [b_raw.len(), c_raw.len()],
         work_changes,
+        work_compared,
         notes,
     })
 }
@@ -135,17 +155,6 @@ fn has_reference(record: &CaseRecord) -> bool {
         r.reference_s.len() == r.samples_s.len()
             && r.reference_s.iter().all(|x| x.is_finite() && *x > 0.0)
     })
-}
-
-/// The FMA rate of the sweep's calibrations (mean of start and end), GFLOP/s.
-fn calibrated_rate(file: &ResultsFile) -> Option<f64> {
-    let rates: Vec<f64> = [&file.calibration.start, &file.calibration.end]
-        .into_iter()
-        .flatten()
-        .map(|c| c.fma_gflops_1t)
-        .filter(|g| g.is_finite() && *g > 0.0)
-        .collect();
-    (!rates.is_empty()).then(|| rates.iter().sum::<f64>() / rates.len() as f64)
 }
 
 fn choose_normalization(
@@ -207,8 +216,9 @@ fn initial_work(record: &CaseRecord) -> Option<WorkCounters> {
     record.rounds.iter().find_map(|r| r.initial_work)
 }
 
-/// Exact comparison of the deterministic counters: (changes, notes).
-fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, Vec<String>) {
+/// Exact comparison of the deterministic counters: (changes, whether the kernels' counters
+/// were compared at all, notes).
+fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, bool, Vec<String>) {
     let mut changes = Vec::new();
     let mut notes = Vec::new();
     let mut check = |counter: &str, b: u64, c: u64| {
@@ -221,6 +231,7 @@ fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, Vec<St
         }
     };
     check("particles", base.n as u64, cur.n as u64);
+    let compared = initial_work(base).is_some() && initial_work(cur).is_some();
     match (initial_work(base), initial_work(cur)) {
         (Some(b), Some(c)) => {
             check("pair_checks", b.pair_checks, c.pair_checks);
@@ -253,7 +264,7 @@ fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, Vec<St
             ));
         }
     }
-    (changes, notes)
+    (changes, compared, notes)
 }
 
 /// FNV-1a of the case key: a seed per case that does not depend on the case's position.

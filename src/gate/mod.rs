@@ -20,13 +20,16 @@ pub mod ab;
 pub mod base_build;
 pub mod baselines;
 mod checks;
+pub mod child;
 mod compare;
 mod render;
 #[cfg(test)]
 mod tests;
 
-pub use checks::{BUSY_BASELINE_CPUS, background_cpus, prefix};
-pub use compare::compare;
+pub use checks::{
+    BUSY_BASELINE_CPUS, RATE_TOLERANCE, background_cpus, calibrated_rate, prefix, rates_differ,
+};
+pub use compare::{check_threshold, compare};
 pub use render::{Format, render};
 
 use crate::experiment::results::ResultsFile;
@@ -40,6 +43,18 @@ pub const AB_THRESHOLD: f64 = 0.10;
 pub const FILE_THRESHOLD: f64 = 0.25;
 /// Default rounds of every case per build in an A/B run (even: each build goes first as often).
 pub const AB_ROUNDS: usize = 4;
+
+/// Largest `--threshold`: 1.0 flags a case only once its whole CI lies above twice the
+/// baseline (and no improvement can be claimed, 1 − 1 = 0); a larger one judges nothing.
+pub const MAX_THRESHOLD: f64 = 1.0;
+
+/// Fewest positive samples per side a case's 95% CI is judged on. The bootstrap resamples
+/// each side's samples; with n samples the resampled median is the smallest sample in
+/// P(Binomial(n, 1/n) > n/2) of the resamples: 26% for n = 3, 5% for n = 4 or 5, 0.9% for
+/// n = 6. Only from 6 on does the 2.5% tail fall inside the data, so that the interval comes
+/// from the spread of the samples rather than being pinned to their extremes (with one
+/// sample per side it is the single ratio, e.g. [1.500, 1.500]).
+pub const MIN_CI_SAMPLES: usize = 6;
 
 /// Schema of the JSON rendering of a [`GateReport`].
 pub const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
@@ -147,6 +162,8 @@ pub struct CaseComparison {
     pub samples: [usize; 2],
     /// Deterministic work counters that differ between the runs.
     pub work_changes: Vec<WorkChange>,
+    /// Whether the kernels' work counters were compared (both runs recorded them).
+    pub work_compared: bool,
     /// Anything that weakens the comparison (incomplete case, failed sanity check, ...).
     pub notes: Vec<String>,
 }
@@ -159,7 +176,8 @@ pub struct WorkChange {
     pub current: u64,
 }
 
-/// A baseline case that could not be compared.
+/// A baseline case that could not be compared, or a check of it that could compare nothing
+/// (too few samples for a CI, work counters asked for but absent): the gate exits 2.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct MissingCase {
     pub key: String,
@@ -278,7 +296,11 @@ impl GateReport {
 
 #[derive(Debug, Error)]
 pub enum GateError {
-    #[error("--threshold must be a finite number >= 0 (got {0}); 0.10 means 10%")]
+    #[error(
+        "--threshold must be a number from 0 to {max} (got {0:?}); 0.10 means 10%, {max} a \
+         doubling",
+        max = MAX_THRESHOLD
+    )]
     BadThreshold(f64),
     #[error(
         "the {which} results have no machine calibration (swept with --no-calibration), so \

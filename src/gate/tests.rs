@@ -298,11 +298,12 @@ fn missing_and_extra_cases_are_reported() {
         "{text}"
     );
     // A case measured in fewer rounds than planned is compared, with a note.
-    unmeasured.rounds.truncate(1);
-    unmeasured.rounds_done = 1;
+    // (Two rounds of four samples: enough for a CI, see `too_few_samples_...`.)
+    unmeasured.rounds.truncate(2);
+    unmeasured.rounds_done = 2;
     cur.cases[0] = unmeasured;
     let report = compare(&base, &cur, &GateOptions::default()).unwrap();
-    assert!(report.cases[0].notes[0].contains("current incomplete (1/3 rounds)"));
+    assert!(report.cases[0].notes[0].contains("current incomplete (2/3 rounds)"));
 }
 
 #[test]
@@ -451,4 +452,142 @@ fn renderings() {
     assert_eq!(json["schema"], GATE_SCHEMA);
     assert_eq!(json["cases"][1]["verdict"], "regressed");
     assert_eq!(json["cases"][1]["normalization"], "reference");
+}
+
+/// Every check that could compare nothing is an error (exit 2), never a pass.
+#[test]
+fn too_few_samples_for_a_ci_are_not_judged() {
+    let base = results(Run::nominal(SEED_1));
+    let slower = Run {
+        kernel: Some(("symmetric", 1.5)),
+        ..Run::nominal(SEED_2)
+    };
+    let cur = results(slower);
+    // Keeps `per_round` samples (and their references) of each round of the symmetric case.
+    let keep = |file: &ResultsFile, per_round: [usize; 3]| {
+        let mut file = file.clone();
+        for (round, k) in file.cases[1].rounds.iter_mut().zip(per_round) {
+            round.samples_s.truncate(k);
+            round.reference_s.truncate(k);
+        }
+        file
+    };
+    // One sample per side of the symmetric case: a "CI" of [1.500, 1.500] is no interval.
+    let (one, cur_one) = (keep(&base, [1, 0, 0]), keep(&cur, [1, 0, 0]));
+    let report = compare(&one, &cur_one, &GateOptions::default()).unwrap();
+    assert_eq!(report.missing.len(), 1, "{:?}", report.missing);
+    assert!(report.missing[0].key.contains("/symmetric/"));
+    assert!(
+        report.missing[0]
+            .reason
+            .contains("1 successful sample(s) in the baseline and 1 in the current run"),
+        "{}",
+        report.missing[0].reason
+    );
+    assert!(
+        report.missing[0].reason.contains("at least 6 per side"),
+        "{}",
+        report.missing[0].reason
+    );
+    assert_eq!(report.count(Verdict::Regressed), 0, "not judged");
+    assert_eq!(report.exit_code(), 2);
+    // Exactly the minimum is judged.
+    let (six_base, six) = (keep(&base, [3, 3, 0]), keep(&cur, [3, 3, 0]));
+    let report = compare(&six_base, &six, &GateOptions::default()).unwrap();
+    assert!(report.missing.is_empty(), "{:?}", report.missing);
+    assert_eq!(report.cases[1].samples, [6, 6]);
+    assert_eq!(report.cases[1].verdict, Verdict::Regressed);
+    // Failed (zero or negative) samples do not count.
+    let mut zeros = base.clone();
+    for round in &mut zeros.cases[0].rounds {
+        round.samples_s.iter_mut().for_each(|s| *s = 0.0);
+    }
+    let report = compare(&zeros, &base, &GateOptions::default()).unwrap();
+    assert_eq!(report.missing[0].reason, "no samples in the baseline");
+    assert_eq!(report.exit_code(), 2);
+}
+
+#[test]
+fn fail_on_work_change_with_no_counters_to_compare_is_an_error() {
+    let base = results(Run::nominal(SEED_1));
+    let mut old = results(Run::nominal(SEED_2));
+    for case in &mut old.cases {
+        for round in &mut case.rounds {
+            round.initial_work = None;
+        }
+    }
+    let lenient = compare(&base, &old, &GateOptions::default()).unwrap();
+    assert!(lenient.missing.is_empty(), "only a note without the flag");
+    assert_eq!(lenient.exit_code(), 0);
+    assert!(lenient.cases.iter().all(|c| !c.work_compared));
+    let strict = GateOptions {
+        fail_on_work_change: true,
+        ..GateOptions::default()
+    };
+    let report = compare(&base, &old, &strict).unwrap();
+    assert_eq!(report.missing.len(), 3);
+    assert!(
+        report.missing[0]
+            .reason
+            .contains("--fail-on-work-change asks for them"),
+        "{}",
+        report.missing[0].reason
+    );
+    assert_eq!(report.exit_code(), 2, "not a pass");
+    // Counters on both sides: compared, and a pass.
+    let report = compare(&base, &results(Run::nominal(SEED_2)), &strict).unwrap();
+    assert!(report.missing.is_empty());
+    assert!(report.cases.iter().all(|c| c.work_compared));
+    assert_eq!(report.exit_code(), 0);
+}
+
+#[test]
+fn the_threshold_is_bounded() {
+    let base = results(Run::nominal(SEED_1));
+    for bad in [1e300, 1.0001, -0.1, f64::NAN, f64::INFINITY] {
+        let options = GateOptions {
+            threshold: bad,
+            ..GateOptions::default()
+        };
+        let e = compare(&base, &base, &options).unwrap_err();
+        assert!(matches!(e, GateError::BadThreshold(_)), "{bad}: {e}");
+        assert!(e.to_string().contains("from 0 to 1"), "{e}");
+    }
+    for good in [0.0, 0.25, MAX_THRESHOLD] {
+        assert!(check_threshold(good).is_ok(), "{good}");
+    }
+}
+
+#[test]
+fn calibrated_rates_too_far_apart_are_named() {
+    // The machine's own drift (9.6% across one hour on one class) passes...
+    assert_eq!(rates_differ(219.4, 240.5), None);
+    assert_eq!(rates_differ(91.4, 96.0), None);
+    // ...the 25% that made the reference over-correct does not, either way round.
+    let why = rates_differ(175.0, 140.0).unwrap();
+    assert!(
+        why.contains("175.0 GFLOP/s and this run's 140.0 (0.80x)"),
+        "{why}"
+    );
+    assert!(rates_differ(140.0, 175.0).is_some());
+    assert!(rates_differ(100.0, 100.0 * (1.0 + RATE_TOLERANCE) * 1.01).is_some());
+    assert!(rates_differ(100.0, 100.0 * (1.0 + RATE_TOLERANCE) * 0.99).is_none());
+    // Nothing to compare is no finding here (the file checks handle missing calibrations).
+    assert_eq!(rates_differ(0.0, 100.0), None);
+    assert_eq!(rates_differ(f64::NAN, 100.0), None);
+    // Two files whose calibrations differ that much are compared with a warning.
+    let base = results(Run::nominal(SEED_1));
+    let mut cur = results(Run::nominal(SEED_2));
+    for c in [&mut cur.calibration.start, &mut cur.calibration.end] {
+        c.as_mut().unwrap().fma_gflops_1t = 80.0;
+    }
+    let report = compare(&base, &cur, &GateOptions::default()).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("would over-correct")),
+        "{:?}",
+        report.warnings
+    );
 }

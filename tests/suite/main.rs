@@ -17,6 +17,7 @@ mod export;
 mod external;
 mod fit_cli;
 mod gate;
+mod gate_refusals;
 mod integrity;
 mod invariants;
 mod kernel_parts;

@@ -1,0 +1,288 @@
+//! Every process the gate starts (git, cargo, rustc, and both builds' sweeps) runs under a
+//! time limit: a child that hangs becomes an error naming it and its limit, never a gate that
+//! waits forever.
+//!
+//! Each child runs in a process group of its own, so that at its limit the whole group is
+//! signalled (SIGTERM, a grace period, then SIGKILL): a shell script's `sleep`, or the
+//! compilers cargo started, go with it. Being in its own group, a child no longer receives a
+//! terminal's Ctrl-C itself; [`terminate_all`] signals every running child's group, and the
+//! interrupt handler calls it before the gate exits.
+
+use std::io::Read;
+use std::process::{Child, Command, ExitStatus, Output, Stdio};
+use std::sync::Mutex;
+use std::sync::mpsc;
+use std::time::Duration;
+use thiserror::Error;
+use wait_timeout::ChildExt;
+
+/// Seconds between SIGTERM and SIGKILL for a child past its limit: a sweep removes its
+/// temporary files on SIGTERM.
+const KILL_GRACE: Duration = Duration::from_secs(2);
+/// How long the output of a finished or killed child is still waited for: a grandchild that
+/// left the group may hold the pipe open, and the gate must not wait for it.
+const DRAIN_WAIT: Duration = Duration::from_secs(2);
+/// At most this much of each output stream is kept (the end of it: error messages come last).
+const KEPT_OUTPUT_BYTES: usize = 1 << 20;
+
+#[derive(Debug, Error)]
+pub enum ChildError {
+    #[error("{what} cannot be started: {source}")]
+    Start {
+        what: String,
+        source: std::io::Error,
+    },
+    #[error(
+        "{what} did not finish within {limit} and was stopped{hint}",
+        hint = if hint.is_empty() { String::new() } else { format!("; {hint}") }
+    )]
+    TimedOut {
+        what: String,
+        /// The limit, e.g. "120 s" or "0.3 s".
+        limit: String,
+        hint: String,
+    },
+    #[error("waiting for {what} failed: {source}")]
+    Wait {
+        what: String,
+        source: std::io::Error,
+    },
+}
+
+/// Process groups of the children running now.
+static RUNNING: Mutex<Vec<i32>> = Mutex::new(Vec::new());
+
+fn running() -> std::sync::MutexGuard<'static, Vec<i32>> {
+    RUNNING.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Sends SIGTERM to every running child's process group (for the interrupt handler: the
+/// children are not in the terminal's foreground group, so a Ctrl-C does not reach them).
+pub fn terminate_all() {
+    for &group in running().iter() {
+        signal_group(group, libc::SIGTERM);
+    }
+}
+
+fn signal_group(group: i32, signal: i32) {
+    // SAFETY: kill(2) on the process group of a child this process started and has not
+    // reaped yet (the group id is the child's pid, still ours until it is waited for).
+    unsafe {
+        libc::kill(-group, signal);
+    }
+}
+
+/// A started child, registered until it has been reaped.
+struct Running {
+    child: Child,
+    group: i32,
+}
+
+impl Running {
+    fn start(command: &mut Command, what: &str) -> Result<Running, ChildError> {
+        use std::os::unix::process::CommandExt;
+        command.process_group(0);
+        // Held across the spawn, so that an interrupt cannot come between the spawn and the
+        // registration and miss this child.
+        let mut registry = running();
+        let child = command.spawn().map_err(|source| ChildError::Start {
+            what: what.to_string(),
+            source,
+        })?;
+        let group = i32::try_from(child.id()).unwrap_or(i32::MAX);
+        registry.push(group);
+        Ok(Running { child, group })
+    }
+
+    /// Waits up to `limit`; `None` when the child was stopped at the limit.
+    fn wait(&mut self, limit: Duration, what: &str) -> Result<Option<ExitStatus>, ChildError> {
+        let waited = self
+            .child
+            .wait_timeout(limit)
+            .map_err(|source| ChildError::Wait {
+                what: what.to_string(),
+                source,
+            })?;
+        if waited.is_some() {
+            return Ok(waited);
+        }
+        signal_group(self.group, libc::SIGTERM);
+        if let Ok(Some(_)) = self.child.wait_timeout(KILL_GRACE) {
+            return Ok(None);
+        }
+        signal_group(self.group, libc::SIGKILL);
+        let _ = self.child.wait();
+        Ok(None)
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        // Whatever happened, no child outlives its supervision (a no-op once it has exited).
+        if matches!(self.child.try_wait(), Ok(None)) {
+            signal_group(self.group, libc::SIGKILL);
+            let _ = self.child.wait();
+        }
+        running().retain(|&g| g != self.group);
+    }
+}
+
+/// Runs `command` (its standard output and error already set, e.g. to a log file; standard
+/// input is closed) for at most `limit`; its exit status.
+pub fn status(
+    command: &mut Command,
+    limit: Duration,
+    what: &str,
+    hint: &str,
+) -> Result<ExitStatus, ChildError> {
+    command.stdin(Stdio::null());
+    let mut child = Running::start(command, what)?;
+    child
+        .wait(limit, what)?
+        .ok_or_else(|| timed_out(what, limit, hint))
+}
+
+/// Runs `command` for at most `limit` and collects its output (the last
+/// [`KEPT_OUTPUT_BYTES`] of each stream); standard input is closed.
+pub fn output(
+    command: &mut Command,
+    limit: Duration,
+    what: &str,
+    hint: &str,
+) -> Result<Output, ChildError> {
+    command
+        .stdin(Stdio::null())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped());
+    let mut child = Running::start(command, what)?;
+    // Both pipes are read while the child runs, so that a chatty child never blocks on a full
+    // pipe; the readers report through a channel, so that none is waited for forever.
+    let readers = [
+        child.child.stdout.take().map(drain),
+        child.child.stderr.take().map(drain),
+    ];
+    let status = child.wait(limit, what)?;
+    let [stdout, stderr] = readers.map(|r| {
+        r.and_then(|rx| rx.recv_timeout(DRAIN_WAIT).ok())
+            .unwrap_or_default()
+    });
+    match status {
+        Some(status) => Ok(Output {
+            status,
+            stdout,
+            stderr,
+        }),
+        None => Err(timed_out(what, limit, hint)),
+    }
+}
+
+fn timed_out(what: &str, limit: Duration, hint: &str) -> ChildError {
+    ChildError::TimedOut {
+        what: what.to_string(),
+        limit: seconds(limit),
+        hint: hint.to_string(),
+    }
+}
+
+/// "120 s", "2.5 s", "0.3 s".
+pub fn seconds(d: Duration) -> String {
+    let s = d.as_secs_f64();
+    if s >= 10.0 || s.fract() == 0.0 {
+        format!("{s:.0} s")
+    } else {
+        format!("{s:.1} s")
+    }
+}
+
+/// Reads `stream` to its end on a thread of its own; the last bytes arrive on the channel.
+fn drain(mut stream: impl Read + Send + 'static) -> mpsc::Receiver<Vec<u8>> {
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut kept = Vec::new();
+        let mut buf = [0u8; 8192];
+        loop {
+            match stream.read(&mut buf) {
+                Ok(0) | Err(_) => break,
+                Ok(k) => {
+                    kept.extend_from_slice(&buf[..k]);
+                    if kept.len() > 2 * KEPT_OUTPUT_BYTES {
+                        kept.drain(..kept.len() - KEPT_OUTPUT_BYTES);
+                    }
+                }
+            }
+        }
+        if kept.len() > KEPT_OUTPUT_BYTES {
+            kept.drain(..kept.len() - KEPT_OUTPUT_BYTES);
+        }
+        let _ = tx.send(kept);
+    });
+    rx
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::time::Instant;
+
+    #[test]
+    fn a_child_that_finishes_gives_its_output() {
+        let o = output(
+            Command::new("sh").args(["-c", "echo out; echo err >&2; exit 3"]),
+            Duration::from_secs(30),
+            "the test shell",
+            "",
+        )
+        .unwrap();
+        assert_eq!(o.status.code(), Some(3));
+        assert_eq!(String::from_utf8_lossy(&o.stdout), "out\n");
+        assert_eq!(String::from_utf8_lossy(&o.stderr), "err\n");
+    }
+
+    #[test]
+    fn a_hanging_child_and_its_own_children_are_stopped_at_the_limit() {
+        let started = Instant::now();
+        // The shell's `sleep` holds the output pipe: stopping the shell alone would leave the
+        // gate waiting for the pipe's end.
+        let err = output(
+            Command::new("sh").args(["-c", "sleep 60; echo never"]),
+            Duration::from_millis(300),
+            "the test shell",
+            "a hint",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("the test shell did not finish within 0.3 s and was stopped; a hint"),
+            "{err}"
+        );
+        // Not a timing assertion: a bound far above the limit, so that a hang fails the test.
+        assert!(started.elapsed() < Duration::from_secs(30));
+        let err = status(
+            Command::new("sh")
+                .args(["-c", "sleep 60"])
+                .stdout(Stdio::null()),
+            Duration::from_millis(300),
+            "the second shell",
+            "",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(err.ends_with("was stopped"), "{err}");
+    }
+
+    #[test]
+    fn a_program_that_does_not_exist_is_an_error() {
+        let err = output(
+            &mut Command::new("/nonexistent/program"),
+            Duration::from_secs(5),
+            "the base build's binary",
+            "",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("the base build's binary cannot be started"),
+            "{err}"
+        );
+    }
+}
