@@ -15,6 +15,7 @@ pub mod console;
 pub mod analysis;
 pub mod boundary;
 pub mod calibrate;
+pub mod children;
 pub mod clock;
 pub mod decomp;
 pub mod engine;

@@ -10,12 +10,14 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     // clap exits with code 2 on usage errors and 0 for --help/--version.
     let cli = Cli::parse();
-    // An interrupted command (SIGINT, SIGTERM) leaves no temporary file behind: files are
-    // written under a temporary name and renamed into place, and whatever is half-written when
-    // the signal comes is removed here. Results saved before the signal are whole. The gate's
-    // children run in process groups of their own, so they are told too.
+    // An interrupted command (SIGINT, SIGTERM) leaves no temporary file and no program behind:
+    // files are written under a temporary name and renamed into place, and whatever is
+    // half-written when the signal comes is removed here; child programs (external programs,
+    // an A/B gate's builds and sweeps) run in process groups of their own, which a terminal's
+    // Ctrl-C does not reach, and are stopped here. Results saved before the signal are whole.
     let _ = ctrlc::set_handler(|| {
-        nbody_bench::gate::child::terminate_all();
+        // Held until the exit: no program starts after this.
+        let _stopped = nbody_bench::children::stop_all();
         nbody_bench::output::remove_temporaries_and_exit(130)
     });
     let code = match cli::dispatch(cli) {

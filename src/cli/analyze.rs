@@ -12,6 +12,12 @@ pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
     if path != args.results {
         eprintln!("analyzing {}", path.display());
     }
+    if args.out.is_none() && nbody_bench::input::is_pipe(&path) {
+        anyhow::bail!(
+            "{} is a pipe: its analysis has no directory to go beside; name one with --out DIR",
+            path.display()
+        );
+    }
     // Whatever the analysis writes, under whatever name, never replaces what it reads.
     nbody_bench::output::protect_inputs(&[("results", &path)]);
     let results = ResultsFile::load(&path)?;

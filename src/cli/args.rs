@@ -370,7 +370,8 @@ fn parse_non_negative(s: &str) -> Result<f64, String> {
 
 #[derive(Debug, Args)]
 pub struct SweepArgs {
-    /// The sweep config: a path, or a name looked up in configs/ (`strong`, `strong.toml`).
+    /// The sweep config: a path (a file or a pipe such as `<(...)`, whose {config_dir} is the
+    /// current directory), or a name looked up in configs/ (`strong`, `strong.toml`).
     #[arg(long, value_name = "FILE|NAME")]
     pub config: PathBuf,
     /// Continue an interrupted sweep: cases already measured are kept and not repeated. Without
@@ -444,6 +445,7 @@ pub struct FitArgs {
     #[arg(long, value_enum)]
     pub model: FitModel,
     /// The measurements: `p,time` (amdahl), `p,time` or `p,n,time` (gustafson), `n,time` (power).
+    /// A file or a pipe; a pipe silent for 60 s (NBODY_BENCH_PIPE_WAIT_S) is given up.
     #[arg(long, value_name = "FILE")]
     pub csv: PathBuf,
     /// Also write the fit as JSON (schema nbody-bench/fit/v1): every parameter as

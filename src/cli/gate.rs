@@ -147,6 +147,14 @@ fn listed(items: &[String]) -> String {
 /// classes' files stay. Every refusal leaves the folder as it was.
 fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<i32> {
     let source = locate::find_results(results, Path::new("results"))?;
+    if nbody_bench::input::is_pipe(&source) {
+        // It is read twice: checked, then copied byte for byte.
+        anyhow::bail!(
+            "--save-baseline {}: is a pipe; a baseline is checked and then copied, so it must \
+             be a file: write it to one first",
+            source.display()
+        );
+    }
     let file = ResultsFile::load(&source)?;
     if file.calibration.start.is_none() && file.calibration.end.is_none() {
         anyhow::bail!(
@@ -215,7 +223,7 @@ fn measure_and_judge(args: &GateArgs) -> anyhow::Result<i32> {
     let baseline = if is_baseline_folder(&args.baseline) {
         let chosen = baselines::choose(&args.baseline, &this_machine())?;
         Some((chosen.path, chosen.file))
-    } else if args.baseline.is_file() || args.against.is_none() {
+    } else if nbody_bench::input::is_readable(&args.baseline) || args.against.is_none() {
         Some((args.baseline.clone(), ResultsFile::load(&args.baseline)?))
     } else {
         None

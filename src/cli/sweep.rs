@@ -8,8 +8,19 @@ use nbody_bench::units::Duration;
 use std::path::{Path, PathBuf};
 
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
+    if let Some(Some(run)) = &args.resume
+        && nbody_bench::input::is_pipe(run)
+    {
+        anyhow::bail!(
+            "--resume {}: is a pipe; a resumed run is written back in place: pass its run \
+             directory",
+            run.display()
+        );
+    }
     let config_path = locate::find_config(&args.config)?;
     let (config, text) = SweepConfig::load(&config_path)?;
+    // A config read from a pipe has no directory: its {config_dir} is the current one.
+    let from_pipe = nbody_bench::input::is_pipe(&config_path);
     let target = where_to_write(&args, &config)?;
     let existing = match &target {
         Target::Out => Some(nbody_bench::experiment::runner::results_path(
@@ -43,7 +54,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         stop_after: None,
         config_dir: config_path
             .parent()
-            .filter(|p| !p.as_os_str().is_empty())
+            .filter(|p| !p.as_os_str().is_empty() && !from_pipe)
             .map(Path::to_path_buf),
         nbody_bench: None,
     };

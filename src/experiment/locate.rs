@@ -57,10 +57,11 @@ pub enum LocateError {
     },
 }
 
-/// The config file `given` names: the path itself if it is a file, else `configs/NAME` and
+/// The config file `given` names: the path itself if it is a file or a pipe, else `configs/NAME` and
 /// `configs/NAME.toml` for a bare name.
 pub fn find_config(given: &Path) -> Result<PathBuf, LocateError> {
-    if given.is_file() {
+    // A pipe (`--config <(...)`) is read like a file.
+    if crate::input::is_readable(given) {
         return Ok(given.to_path_buf());
     }
     let mut looked = vec![given.display().to_string()];
@@ -184,11 +185,11 @@ pub fn latest_unfinished(root: &Path, name: &str) -> Result<PathBuf, LocateError
     })
 }
 
-/// The results file `given` names: a file; a directory holding `results.json`; or a config
+/// The results file `given` names: a file or a pipe; a directory holding `results.json`; or a config
 /// name (`quick`, `quick.toml`, `configs/quick.toml`), meaning its latest run under
 /// `<root>/runs/`, else its reference results `<root>/<name>/results.json`.
 pub fn find_results(given: &Path, root: &Path) -> Result<PathBuf, LocateError> {
-    if given.is_file() {
+    if crate::input::is_readable(given) {
         return Ok(given.to_path_buf());
     }
     let mut looked = Vec::new();

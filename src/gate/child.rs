@@ -2,23 +2,18 @@
 //! time limit: a child that hangs becomes an error naming it and its limit, never a gate that
 //! waits forever.
 //!
-//! Each child runs in a process group of its own, so that at its limit the whole group is
-//! signalled (SIGTERM, a grace period, then SIGKILL): a shell script's `sleep`, or the
-//! compilers cargo started, go with it. Being in its own group, a child no longer receives a
-//! terminal's Ctrl-C itself; [`terminate_all`] signals every running child's group, and the
-//! interrupt handler calls it before the gate exits.
+//! Each child runs in a process group of its own ([`crate::children`], as external programs
+//! do), so that at its limit the whole group is signalled (SIGTERM, a grace period, then
+//! SIGKILL): a shell script's `sleep`, or the compilers cargo started, go with it; and the
+//! interrupt handler stops the groups still running before the gate exits.
 
 use std::io::Read;
 use std::process::{Child, Command, ExitStatus, Output, Stdio};
-use std::sync::Mutex;
 use std::sync::mpsc;
 use std::time::Duration;
 use thiserror::Error;
 use wait_timeout::ChildExt;
 
-/// Seconds between SIGTERM and SIGKILL for a child past its limit: a sweep removes its
-/// temporary files on SIGTERM.
-const KILL_GRACE: Duration = Duration::from_secs(2);
 /// How long the output of a finished or killed child is still waited for: a grandchild that
 /// left the group may hold the pipe open, and the gate must not wait for it.
 const DRAIN_WAIT: Duration = Duration::from_secs(2);
@@ -49,48 +44,19 @@ pub enum ChildError {
     },
 }
 
-/// Process groups of the children running now.
-static RUNNING: Mutex<Vec<i32>> = Mutex::new(Vec::new());
-
-fn running() -> std::sync::MutexGuard<'static, Vec<i32>> {
-    RUNNING.lock().unwrap_or_else(|e| e.into_inner())
-}
-
-/// Sends SIGTERM to every running child's process group (for the interrupt handler: the
-/// children are not in the terminal's foreground group, so a Ctrl-C does not reach them).
-pub fn terminate_all() {
-    for &group in running().iter() {
-        signal_group(group, libc::SIGTERM);
-    }
-}
-
-fn signal_group(group: i32, signal: i32) {
-    // SAFETY: kill(2) on the process group of a child this process started and has not
-    // reaped yet (the group id is the child's pid, still ours until it is waited for).
-    unsafe {
-        libc::kill(-group, signal);
-    }
-}
-
-/// A started child, registered until it has been reaped.
+/// A started child, its process group registered until it has been reaped.
 struct Running {
     child: Child,
-    group: i32,
+    group: crate::children::Group,
 }
 
 impl Running {
     fn start(command: &mut Command, what: &str) -> Result<Running, ChildError> {
-        use std::os::unix::process::CommandExt;
-        command.process_group(0);
-        // Held across the spawn, so that an interrupt cannot come between the spawn and the
-        // registration and miss this child.
-        let mut registry = running();
-        let child = command.spawn().map_err(|source| ChildError::Start {
-            what: what.to_string(),
-            source,
-        })?;
-        let group = i32::try_from(child.id()).unwrap_or(i32::MAX);
-        registry.push(group);
+        let (child, group) =
+            crate::children::spawn(command).map_err(|source| ChildError::Start {
+                what: what.to_string(),
+                source,
+            })?;
         Ok(Running { child, group })
     }
 
@@ -106,24 +72,19 @@ impl Running {
         if waited.is_some() {
             return Ok(waited);
         }
-        signal_group(self.group, libc::SIGTERM);
-        if let Ok(Some(_)) = self.child.wait_timeout(KILL_GRACE) {
-            return Ok(None);
-        }
-        signal_group(self.group, libc::SIGKILL);
-        let _ = self.child.wait();
+        self.group.terminate(&mut self.child);
         Ok(None)
     }
 }
 
 impl Drop for Running {
     fn drop(&mut self) {
-        // Whatever happened, no child outlives its supervision (a no-op once it has exited).
+        // Whatever happened, no child outlives its supervision (a no-op once it has exited);
+        // the group's own drop then clears what is left of the group.
         if matches!(self.child.try_wait(), Ok(None)) {
-            signal_group(self.group, libc::SIGKILL);
+            self.group.signal(libc::SIGKILL);
             let _ = self.child.wait();
         }
-        running().retain(|&g| g != self.group);
     }
 }
 

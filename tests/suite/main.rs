@@ -28,6 +28,7 @@ mod parsers;
 mod peers;
 mod report;
 mod runs;
+mod supervision;
 mod sweep;
 mod verlet;
 

@@ -12,7 +12,7 @@ use std::time::Duration;
 #[test]
 fn a_small_lammps_case_runs_through_the_harness() {
     assert!(
-        nbody_bench::experiment::external::process::find_program("lmp").is_some(),
+        nbody_bench::experiment::external::process::resolve("lmp", None).is_ok(),
         "LAMMPS (`lmp`) is not installed: run scripts/install-peers.sh (or apt-get install -y lammps)"
     );
     let shipped = std::fs::read_to_string(

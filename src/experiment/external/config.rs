@@ -178,7 +178,18 @@ impl External {
             if tokens.first().is_some_and(|p| p.trim().is_empty()) {
                 return bad(field, "starts with an empty program name".into());
             }
-            for t in tokens {
+            for (i, t) in tokens.iter().enumerate() {
+                // No argument of a program can hold a NUL byte: refused here, not at every run.
+                if t.contains('\0') {
+                    return bad(
+                        field,
+                        format!(
+                            "has a NUL byte in its token {} (`{}`)",
+                            i + 1,
+                            t.escape_default()
+                        ),
+                    );
+                }
                 if let Err(e) = placeholders::check(t, known) {
                     return bad(field, e.to_string());
                 }
@@ -188,6 +199,12 @@ impl External {
             if name.is_empty() || name.contains('=') || name.contains('\0') {
                 return bad("env", format!("has an invalid variable name `{name}`"));
             }
+            if value.contains('\0') {
+                return bad(
+                    &format!("env.{name}"),
+                    "has a NUL byte, which no environment value can hold".into(),
+                );
+            }
             if let Err(e) = placeholders::check(value, &case_known) {
                 return bad(&format!("env.{name}"), e.to_string());
             }
@@ -195,8 +212,18 @@ impl External {
         if self.steps == 0 {
             return bad("steps", "must be at least 1".into());
         }
-        if !(self.timeout_s.is_finite() && self.timeout_s > 0.0) {
-            return bad("timeout_s", "must be a finite number of seconds > 0".into());
+        if !(self.timeout_s.is_finite()
+            && self.timeout_s > 0.0
+            && self.timeout_s <= super::process::MAX_TIMEOUT_S)
+        {
+            return bad(
+                "timeout_s",
+                format!(
+                    "is {}: it must be a number of seconds > 0 and at most {} (7 days)",
+                    self.timeout_s,
+                    super::process::MAX_TIMEOUT_S
+                ),
+            );
         }
         if let TimeSource::Regex(t) = &self.time {
             match regex::Regex::new(&t.regex) {

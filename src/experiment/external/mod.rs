@@ -71,13 +71,15 @@ pub struct ExternalVersion {
 #[derive(Debug, Error)]
 pub enum ExternalError {
     #[error(
-        "external `{name}`: program `{program}` not found{where_}; install it (for the peers of \
-         configs/vs-*.toml: scripts/install-peers.sh) or fix `command`"
+        "external `{name}`: program `{program}` not found{where_}: {why}; install it (for the peers of \
+         configs/vs-*.toml: scripts/install-peers.sh) or fix `command` (or the PATH its `env` \
+         sets)"
     )]
     NotFound {
         name: String,
         program: String,
         where_: String,
+        why: String,
     },
     #[error("external `{name}`: {source}")]
     Placeholder {
@@ -112,14 +114,21 @@ impl Context {
     }
 }
 
-/// Checks that every program a case would start exists, before anything runs.
+/// Checks that every program a case would start can be started, before anything runs: the
+/// same [`process::resolve`] that each launch uses, with the `PATH` the program's `env` sets.
 pub fn check_programs(
     ext: &External,
     launcher: Option<&str>,
     context: &Context,
 ) -> Result<(), ExternalError> {
     let vars = context.vars();
-    let mut programs: Vec<(&str, String)> = Vec::new();
+    // `None`: the env sets PATH from a case placeholder, known only per case.
+    let path = match ext.env.get("PATH").map(|p| vars.substitute(p)) {
+        None => Some(None),
+        Some(Ok(p)) => Some(Some(p)),
+        Some(Err(_)) => None,
+    };
+    let mut programs: Vec<(&str, String, Option<&str>)> = Vec::new();
     for (field, tokens) in [
         ("command", &ext.command),
         ("setup", &ext.setup),
@@ -133,13 +142,18 @@ pub fn check_programs(
         let Ok(program) = vars.substitute(first) else {
             continue;
         };
-        programs.push((field, program));
+        // The version command runs without the env.
+        match (field, &path) {
+            ("version", _) => programs.push((field, program, None)),
+            (_, Some(p)) => programs.push((field, program, p.as_deref())),
+            (_, None) => {}
+        }
     }
-    if let Some(l) = launcher {
-        programs.push(("[mpi] launcher", l.to_string()));
+    if let (Some(l), Some(p)) = (launcher, &path) {
+        programs.push(("[mpi] launcher", l.to_string(), p.as_deref()));
     }
-    for (field, program) in programs {
-        if process::find_program(&program).is_none() {
+    for (field, program, path) in programs {
+        if let Err(why) = process::resolve(&program, path) {
             return Err(ExternalError::NotFound {
                 name: ext.name.clone(),
                 program,
@@ -148,6 +162,7 @@ pub fn check_programs(
                 } else {
                     format!(" (its `{field}`)")
                 },
+                why,
             });
         }
     }
@@ -169,7 +184,7 @@ pub fn version_line(ext: &External, context: &Context) -> ExternalVersion {
                     .and_then(|()| process::run(&launch, &dir, VERSION_TIMEOUT_S))
                 {
                     Err(e) => format!("(`{}` failed: {e})", launch.display()),
-                    Ok(done) => (done.stdout + &done.stderr)
+                    Ok(done) => (done.stdout.text + &done.stderr.text)
                         .lines()
                         .map(str::trim)
                         .find(|l| !l.is_empty())

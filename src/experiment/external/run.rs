@@ -57,13 +57,24 @@ fn launch(
         argv.push(m.rank_flag.clone());
         argv.push(ranks.to_string());
     }
-    argv.extend(vars.substitute_all(tokens).map_err(placeholder)?);
     let env = ext
         .env
         .iter()
         .map(|(k, v)| Ok((k.clone(), vars.substitute(v)?)))
         .collect::<Result<Vec<_>, _>>()
         .map_err(placeholder)?;
+    let mut program = vars.substitute_all(tokens).map_err(placeholder)?;
+    // Under a launcher the program is the launcher's argument: it gets the path this process
+    // resolves (the same one the check before the sweep found), not a lookup of the launcher's
+    // own from the work directory. One not found stays as written and fails as a sample.
+    if mpi.is_some()
+        && let Some(first) = program.first_mut()
+        && let Ok(found) = process::resolve(first, process::path_of(&env))
+        && let Some(found) = found.to_str()
+    {
+        *first = found.to_string();
+    }
+    argv.extend(program);
     Ok(Launch { argv, env })
 }
 
@@ -87,7 +98,7 @@ pub fn measure_round(
     if !ext.setup.is_empty() {
         // The set-up is not the measured program: it runs without the launcher.
         let setup = launch(ext, &ext.setup, &vars, None, 1)?;
-        if let Err(e) = checked_run(&setup, &dir, ext.timeout_s, None) {
+        if let Err(e) = checked_run(&setup, &dir, ext.timeout_s, None, false) {
             round.setup_error = Some(e.error);
             return Ok(outcome(ext, case, round, steps));
         }
@@ -130,8 +141,9 @@ pub fn measure_round(
         TimeSource::Wall(_) => None,
     };
     let error = ext.force_error.as_deref().map(compile).transpose()?;
+    let reads_output = check.is_some() || time.is_some() || error.is_some();
     for _ in 0..spec.samples {
-        let run = match checked_run(&main, &dir, ext.timeout_s, check.as_ref()) {
+        let run = match checked_run(&main, &dir, ext.timeout_s, check.as_ref(), reads_output) {
             Err(e) => ExternalRun {
                 wall_s: e.wall_s,
                 reported_s: None,
@@ -171,12 +183,15 @@ struct Failed {
     error: SampleError,
 }
 
-/// Runs `launch`; an error unless it exited with status 0 and its output matches `check`.
+/// Runs `launch`; an error unless it exited with status 0 and its output matches `check`. When
+/// the output is searched by regular expressions (`reads_output`) it must also be short enough
+/// to be read back whole.
 fn checked_run(
     launch: &Launch,
     dir: &Path,
     timeout_s: f64,
     check: Option<&Regex>,
+    reads_output: bool,
 ) -> Result<Finished, Failed> {
     let fail = |wall_s: f64, what: String, tail: Vec<String>| Failed {
         wall_s,
@@ -195,12 +210,17 @@ fn checked_run(
             done.tail(),
         )),
         Some(s) if !s.success() => Err(fail(done.wall_s, format!("failed ({s})"), done.tail())),
-        Some(_) => match check {
-            Some(re) if !re.is_match(&done.stdout) && !re.is_match(&done.stderr) => Err(fail(
-                done.wall_s,
-                format!("its output does not match the check `{}`", re.as_str()),
-                done.tail(),
-            )),
+        Some(_) => match (check, done.too_long().filter(|_| reads_output)) {
+            (_, Some(why)) => Err(fail(done.wall_s, why, done.tail())),
+            (Some(re), None)
+                if !re.is_match(&done.stdout.text) && !re.is_match(&done.stderr.text) =>
+            {
+                Err(fail(
+                    done.wall_s,
+                    format!("its output does not match the check `{}`", re.as_str()),
+                    done.tail(),
+                ))
+            }
             _ => Ok(done),
         },
     }
@@ -246,7 +266,7 @@ fn sample(
     let force_error = match error {
         None => None,
         Some(re) => match re
-            .captures_iter(&(done.stdout.clone() + &done.stderr))
+            .captures_iter(&(done.stdout.text.clone() + &done.stderr.text))
             .last()
         {
             None => {
@@ -290,7 +310,7 @@ fn sample(
 
 /// The first group of the last match in standard output (else standard error), parsed.
 fn last_number(re: &Regex, done: &Finished) -> Option<Result<f64, String>> {
-    let text = [&done.stdout, &done.stderr]
+    let text = [&done.stdout.text, &done.stderr.text]
         .into_iter()
         .find(|t| re.is_match(t))?;
     let caps = re.captures_iter(text).last()?;
