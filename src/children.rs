@@ -7,6 +7,8 @@
 //! (SIGINT, SIGTERM), where the interrupt handler calls [`stop_all`] for the groups still
 //! running. A program that leaves its group on purpose (`setsid`, a daemon) is out of reach.
 
+pub mod supervised;
+
 use std::process::{Child, Command};
 use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};

@@ -400,7 +400,7 @@ fn prepare_a_b(
     } else {
         format!(
             "a release build of the base revision comes first (minutes; stopped after {})",
-            nbody_bench::gate::child::seconds(base_build::BUILD_LIMIT)
+            nbody_bench::children::supervised::seconds(base_build::BUILD_LIMIT)
         )
     };
     let unestimated = cases.len().saturating_sub(est.cases.len());

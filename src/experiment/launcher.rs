@@ -12,15 +12,15 @@ use crate::engine::PhaseTimes;
 use crate::kernels::WorkCounters;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Command;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
 pub enum LaunchError {
-    #[error("cannot start `{command}`: {source}; is the MPI launcher installed and on PATH?")]
+    #[error("`{command}`: {source}; is the MPI launcher installed and on PATH?")]
     Spawn {
         command: String,
-        source: std::io::Error,
+        source: crate::children::supervised::ChildError,
     },
     #[error("`{command}` failed ({status}); its last output:\n{output}")]
     Failed {
@@ -173,6 +173,10 @@ pub fn private_dir() -> Result<crate::output::TemporaryDir, LaunchError> {
     })
 }
 
+/// The longest one launch may take (a week): a round has no time limit of its own, but
+/// nothing the sweep starts runs unsupervised.
+const LAUNCH_LIMIT: std::time::Duration = std::time::Duration::from_secs(7 * 24 * 3600);
+
 /// Launches one round of `case` and reads its result.
 pub fn measure_round(
     launch: &MpiLaunch,
@@ -184,14 +188,18 @@ pub fn measure_round(
     let json = dir.path().join("round.json");
     let args = launch_args(launch, case, &exe, &json);
     let command = format!("{} {}", launch.launcher, args.join(" "));
-    let output = Command::new(&launch.launcher)
-        .args(&args)
-        .stdin(Stdio::null())
-        .output()
-        .map_err(|source| LaunchError::Spawn {
-            command: command.clone(),
-            source,
-        })?;
+    // In a process group of its own: the launcher and its ranks are stopped together when
+    // the sweep is interrupted.
+    let output = crate::children::supervised::output(
+        Command::new(&launch.launcher).args(&args),
+        LAUNCH_LIMIT,
+        &command,
+        "",
+    )
+    .map_err(|source| LaunchError::Spawn {
+        command: command.clone(),
+        source,
+    })?;
     let text = std::fs::read_to_string(&json);
     if !output.status.success() {
         let all = String::from_utf8_lossy(&output.stderr).into_owned()

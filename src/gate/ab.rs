@@ -10,7 +10,7 @@
 //! and judged by [`super::compare`] like any two results files.
 
 use super::base_build::BaseBinary;
-use super::child::{self, ChildError};
+use crate::children::supervised::{self as child, ChildError};
 use crate::experiment::config::SweepConfig;
 use crate::experiment::plan::{Case, cases};
 use crate::experiment::results::{CaseRecord, ResultsFile};

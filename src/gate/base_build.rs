@@ -7,7 +7,7 @@
 //! target directory every base build shares (so a second base revision recompiles only what
 //! changed); `worktree-<commit>/` exists only while that commit builds.
 
-use super::child::{self, ChildError};
+use crate::children::supervised::{self as child, ChildError};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;

@@ -20,7 +20,6 @@ pub mod ab;
 pub mod base_build;
 pub mod baselines;
 mod checks;
-pub mod child;
 mod compare;
 mod render;
 #[cfg(test)]

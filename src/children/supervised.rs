@@ -1,8 +1,8 @@
-//! Every process the gate starts (git, cargo, rustc, and both builds' sweeps) runs under a
-//! time limit: a child that hangs becomes an error naming it and its limit, never a gate that
-//! waits forever.
+//! Programs run to their end under a time limit (every process the gate starts: git, cargo,
+//! rustc, both builds' sweeps; a sweep's MPI launches): a child that hangs becomes an error
+//! naming it and its limit, never a command that waits forever.
 //!
-//! Each child runs in a process group of its own ([`crate::children`], as external programs
+//! Each child runs in a process group of its own ([`super::spawn`], as external programs
 //! do), so that at its limit the whole group is signalled (SIGTERM, a grace period, then
 //! SIGKILL): a shell script's `sleep`, or the compilers cargo started, go with it; and the
 //! interrupt handler stops the groups still running before the gate exits.
@@ -47,16 +47,15 @@ pub enum ChildError {
 /// A started child, its process group registered until it has been reaped.
 struct Running {
     child: Child,
-    group: crate::children::Group,
+    group: super::Group,
 }
 
 impl Running {
     fn start(command: &mut Command, what: &str) -> Result<Running, ChildError> {
-        let (child, group) =
-            crate::children::spawn(command).map_err(|source| ChildError::Start {
-                what: what.to_string(),
-                source,
-            })?;
+        let (child, group) = super::spawn(command).map_err(|source| ChildError::Start {
+            what: what.to_string(),
+            source,
+        })?;
         Ok(Running { child, group })
     }
 
