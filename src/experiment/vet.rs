@@ -13,6 +13,9 @@ use serde::{Deserialize, Serialize};
 /// The longest time a step can take, seconds (about 116 days): a longer one is a unit or
 /// parsing error, and would overflow the nanosecond figures derived from it.
 pub const MAX_STEP_S: f64 = 1e7;
+/// The shortest (a picosecond, under one clock cycle): a shorter one is a unit error, and the
+/// rates derived from it (particle-steps per second) would overflow.
+pub const MIN_STEP_S: f64 = 1e-12;
 
 /// A value taken out of a round, and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -32,6 +35,10 @@ pub fn step_time(seconds: f64) -> Result<f64, String> {
         Err("not a finite number".into())
     } else if seconds <= 0.0 {
         Err("a step takes more than zero time".into())
+    } else if seconds < MIN_STEP_S {
+        Err(format!(
+            "shorter than {MIN_STEP_S:e} s per step: a unit or parsing error"
+        ))
     } else if seconds > MAX_STEP_S {
         Err(format!(
             "longer than {MAX_STEP_S:e} s per step: a unit or parsing error"
@@ -134,7 +141,7 @@ mod tests {
     #[test]
     fn impossible_times_and_errors_are_named() {
         assert_eq!(step_time(1e-6), Ok(1e-6));
-        for bad in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e300] {
+        for bad in [f64::NAN, f64::INFINITY, -1.0, 0.0, 1e-300, 1e300] {
             assert!(step_time(bad).is_err(), "{bad}");
         }
         assert!(step_time(-0.0).unwrap_err().contains("more than zero"));
