@@ -40,7 +40,8 @@ pub fn before_sweep(
         (true, Some(path)) if path.exists() => done_in(ResultsFile::load(path)?),
         _ => Done::default(),
     };
-    let planned = cases(config);
+    let planned =
+        nbody_bench::experiment::plan::unique_cases(config).map_err(anyhow::Error::msg)?;
     let probed = estimate::probe(config, &planned)?;
     let calibrate = !args.no_calibration;
     let logical = nbody_bench::run::logical_cpus();

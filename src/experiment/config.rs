@@ -464,7 +464,7 @@ impl SweepConfig {
 
     /// Every value of a list gives its own cases, so a value listed twice would plan one case
     /// twice (measured once, reported as two, resumed forever): refused, naming the value.
-    /// Then every planned case key must be unique (a `[[external]]` named like a kernel, say).
+    /// The planned keys are checked once more by `plan::unique_cases`.
     fn validate_unique(&self, path: &Path) -> Result<(), ConfigError> {
         let bad = |key: &str, problem: String| ConfigError::Invalid {
             path: path.into(),
@@ -502,18 +502,6 @@ impl SweepConfig {
                     format!("lists {value} twice; each value is one set of cases: remove the copy"),
                 ));
             }
-        }
-        let planned = super::plan::cases(self);
-        let mut keys = std::collections::HashSet::new();
-        if let Some(c) = planned.iter().find(|c| !keys.insert(c.key())) {
-            return Err(bad(
-                "external",
-                format!(
-                    "two planned cases share the key `{}` (an [[external]] named like a built-in \
-                     kernel?); give each code its own name",
-                    c.key()
-                ),
-            ));
         }
         Ok(())
     }

@@ -71,6 +71,22 @@ pub fn is_monopole(m: &Multipole) -> bool {
 
 /// The cases of a config, in a fixed order: the externals' first, then per scenario, kernel,
 /// n, threads, seed, θ, multipole.
+/// The cases of `config`, refused when two share a key (an `[[external]]` named like a
+/// built-in kernel, say): one would be measured and reported for both.
+pub fn unique_cases(config: &SweepConfig) -> Result<Vec<Case>, String> {
+    let planned = cases(config);
+    let mut keys = std::collections::HashSet::new();
+    if let Some(c) = planned.iter().find(|c| !keys.insert(c.key())) {
+        return Err(format!(
+            "config `{}`: two planned cases share the key `{}`; give each code its own name \
+             and list each value once",
+            config.name,
+            c.key()
+        ));
+    }
+    Ok(planned)
+}
+
 pub fn cases(config: &SweepConfig) -> Vec<Case> {
     let mut out = Vec::new();
     external_cases(config, &mut out);

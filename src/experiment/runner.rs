@@ -83,6 +83,8 @@ pub enum SweepError {
     External(#[from] super::external::ExternalError),
     #[error("cannot find this program for {{nbody_bench}}: {0}")]
     Exe(std::io::Error),
+    #[error("{0}")]
+    Plan(String),
     #[error(transparent)]
     Lock(#[from] super::lock::LockError),
     #[error("cannot keep {path} as a backup: {source}")]
@@ -149,7 +151,8 @@ pub fn run_sweep<C: Clock>(
     // system cannot be built (a box its precision cannot resolve, too many particles) would
     // otherwise fail only when its turn comes, after the cases before it ran, and again at
     // every --resume.
-    for case in cases(config) {
+    let planned = super::plan::unique_cases(config).map_err(SweepError::Plan)?;
+    for case in planned {
         let setup = case_setup(&case);
         let copies = match case.decomp {
             // Every rank holds all the particles.
