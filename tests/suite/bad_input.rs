@@ -2,30 +2,12 @@
 //! that are directories, devices, inputs or each other, config names and counts of the wrong
 //! form, flags a kernel ignores, and interrupts while files are being written.
 
+use crate::{bin, refused, text};
 use std::io::{BufRead, BufReader};
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_nbody-bench"));
-    c.env_remove("NBODY_BENCH_TEST_SLOWDOWN")
-        .stdin(Stdio::null());
-    c
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
-
 const CSV: &str = "p,time\n1,10.0\n2,5.6\n4,3.3\n8,2.2\n";
-
-/// Exit 2, the message names `what`, no panic.
-fn refused(o: &Output, what: &str) {
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
-    assert!(err.contains(what), "expected `{what}` in: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-}
 
 /// The names of the files in `dir`, sorted.
 fn names(dir: &Path) -> Vec<String> {

@@ -4,21 +4,11 @@
 //! that hangs is stopped at its time limit. Nothing here times a kernel: the A/B runs meet a
 //! fake base binary (a shell script) before anything is measured.
 
+use crate::{bin, refused, text};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Output};
 use std::time::Duration;
 use wait_timeout::ChildExt;
-
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_nbody-bench"));
-    c.env_remove("NBODY_BENCH_TEST_SLOWDOWN")
-        .stdin(Stdio::null());
-    c
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
 
 /// Runs `cmd` to its end, failing the test (and killing it) if it takes more than `limit`: a
 /// guard against a hang, not a timing assertion.
@@ -46,14 +36,6 @@ fn run_guarded(cmd: &mut Command, limit: Duration) -> Output {
 }
 
 const GUARD: Duration = Duration::from_secs(120);
-
-/// Exit 2, the message names `what`, no panic.
-fn refused(o: &Output, what: &str) {
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
-    assert!(err.contains(what), "expected `{what}` in: {err}");
-    assert!(!err.contains("panicked"), "{err}");
-}
 
 /// A copy of the committed baseline with `edit` applied, written to `dir/name`.
 fn edited(dir: &Path, name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> PathBuf {

@@ -3,17 +3,11 @@
 //! outputs never replace inputs or escape through links and devices; duplicated keys, failed
 //! cases, unsupported fits, the wrong run to resume and a weak study's `n` are refused.
 
+use crate::{bin, refused};
 use nbody_bench::experiment::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-
-fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_nbody-bench"));
-    c.env_remove("NBODY_BENCH_TEST_SLOWDOWN")
-        .stdin(Stdio::null());
-    c
-}
 
 fn run(args: &[&str], dir: &Path) -> Output {
     bin().args(args).current_dir(dir).output().unwrap()
@@ -21,14 +15,6 @@ fn run(args: &[&str], dir: &Path) -> Output {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// Exit 2, the message names `what`, no panic.
-fn refused(o: &Output, what: &str) {
-    let err = stderr(o);
-    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
-    assert!(err.contains(what), "expected `{what}` in: {err}");
-    assert!(!err.contains("panicked"), "{err}");
 }
 
 /// A sweep of one tiny built-in case and the given `[[external]]` entries.

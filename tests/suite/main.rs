@@ -33,6 +33,27 @@ mod sweep;
 mod verlet;
 
 use std::path::Path;
+use std::process::{Command, Output, Stdio};
+
+/// This build's binary, without the test-only slowdown and with no standard input.
+pub fn bin() -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_nbody-bench"));
+    c.env_remove("NBODY_BENCH_TEST_SLOWDOWN")
+        .stdin(Stdio::null());
+    c
+}
+
+pub fn text(bytes: &[u8]) -> String {
+    String::from_utf8_lossy(bytes).into_owned()
+}
+
+/// Exit 2, the message names `what`, no panic.
+pub fn refused(o: &Output, what: &str) {
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
+    assert!(err.contains(what), "expected `{what}` in: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+}
 
 /// Copies the files of `from` (recursively) into `to`: tests that regenerate analyses or the
 /// report work on a copy of the committed results, never on the repository's own files.

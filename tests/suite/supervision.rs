@@ -5,6 +5,7 @@
 //! anything runs; configs, results and CSV tables are read from pipes, and a pipe nobody
 //! writes to is given up after a bounded wait. Every child has a timeout.
 
+use crate::{refused, text};
 use nbody_bench::children::{alive, live_members};
 use nbody_bench::experiment::results::ResultsFile;
 use std::path::{Path, PathBuf};
@@ -16,10 +17,8 @@ use wait_timeout::ChildExt;
 const HANG_S: u64 = 120;
 
 fn bin() -> Command {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_nbody-bench"));
-    c.env_remove("NBODY_BENCH_TEST_SLOWDOWN")
-        .env_remove(nbody_bench::input::PIPE_WAIT_ENV)
-        .stdin(Stdio::null())
+    let mut c = crate::bin();
+    c.env_remove(nbody_bench::input::PIPE_WAIT_ENV)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     c
@@ -57,18 +56,6 @@ fn finish(mut child: Child, what: &str) -> Output {
 
 fn run(cmd: &mut Command, what: &str) -> Output {
     finish(cmd.spawn().unwrap(), what)
-}
-
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
-}
-
-/// Exit 2, the message names `what`, no panic.
-fn refused(o: &Output, what: &str) {
-    let err = text(&o.stderr);
-    assert_eq!(o.status.code(), Some(2), "{what}: {err}");
-    assert!(err.contains(what), "expected `{what}` in: {err}");
-    assert!(!err.contains("panicked"), "{err}");
 }
 
 /// A config of one external program `[[external]]` body `ext`, one sample of one round.
