@@ -6,7 +6,7 @@
 //! writes to is given up after a bounded wait. Every child has a timeout.
 
 use crate::{refused, text};
-use nbody_bench::children::{alive, live_members};
+use nbody_bench::children::{alive, members_left};
 use nbody_bench::experiment::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
@@ -184,7 +184,7 @@ time = "wall""#,
         gone(sleeper),
         "the background sleep {sleeper} outlived its program"
     );
-    assert!(live_members(pid_in(&workdir(&out).join("group.pid"))).is_empty());
+    assert!(members_left(pid_in(&workdir(&out).join("group.pid"))).is_empty());
 }
 
 #[test]

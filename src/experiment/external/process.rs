@@ -293,7 +293,7 @@ mod tests {
         .unwrap();
         assert!(killed.status.is_none());
         let group: i32 = killed.stdout.text.trim().parse().unwrap();
-        assert_eq!(crate::children::live_members(group), Vec::<i32>::new());
+        assert_eq!(crate::children::members_left(group), Vec::<i32>::new());
     }
 
     #[test]
