@@ -1,7 +1,10 @@
 //! What happens at the edge of the simulated region.
 
+use crate::par::{chunks_of, pass_chunk, worth_forking};
 use crate::real::{Real, select};
+use crate::simd;
 use crate::state::State;
+use rayon::prelude::*;
 use thiserror::Error;
 
 /// The boundary condition of a scenario.
@@ -13,7 +16,7 @@ pub enum Boundary<T, const D: usize> {
     Open,
 }
 
-#[derive(Debug, Error, PartialEq)]
+#[derive(Clone, Debug, Error, PartialEq)]
 pub enum BoundaryError {
     #[error(
         "step {step}: particle {id} is still outside the box after one reflection \
@@ -33,45 +36,69 @@ pub enum BoundaryError {
 }
 
 impl<T: Real, const D: usize> Boundary<T, D> {
-    /// Applies the boundary after a drift and returns the particles' bounding box.
+    /// Applies the boundary after a drift and returns the particles' bounding box. On the
+    /// pool's threads when the particles are many; the result is the same at any thread count.
     pub fn apply(
         &self,
         state: &mut State<T, D>,
         step: u64,
     ) -> Result<([T; D], [T; D]), BoundaryError> {
+        let n = state.len();
+        let c = if worth_forking(n * D) {
+            pass_chunk(n)
+        } else {
+            n.max(1)
+        };
         match *self {
             Boundary::Reflecting { lo, hi } => {
-                for d in 0..D {
+                let pos = state.pos.each_mut().map(|x| &mut x[..n]);
+                let vel = state.vel.each_mut().map(|v| &mut v[..n]);
+                let pass = |(x, v): ([&mut [T]; D], [&mut [T]; D])| {
+                    simd::dispatch(
+                        #[inline(always)]
+                        || reflect(x, v, lo, hi),
+                    )
+                };
+                let either = |a: [bool; D], b: [bool; D]| std::array::from_fn(|d| a[d] | b[d]);
+                let (xs, vs) = (chunks_of(pos, c), chunks_of(vel, c));
+                let bad = if xs.len() > 1 {
+                    xs.into_par_iter()
+                        .zip(vs)
+                        .map(pass)
+                        .reduce(|| [false; D], either)
+                } else {
+                    xs.into_iter().zip(vs).map(pass).fold([false; D], either)
+                };
+                if let Some(d) = (0..D).find(|&d| bad[d]) {
                     let (lo, hi) = (lo[d], hi[d]);
-                    let two = T::one() + T::one();
-                    let mut bad = false;
-                    for (x, v) in state.pos[d].iter_mut().zip(state.vel[d].iter_mut()) {
-                        // Written with selects, not branches: almost no particle is at a wall.
-                        let below = *x < lo;
-                        let above = *x > hi;
-                        let nx = select(below, two * lo - *x, select(above, two * hi - *x, *x));
-                        *v = select(below | above, -*v, *v);
-                        *x = nx;
-                        bad |= !(nx >= lo && nx <= hi);
-                    }
-                    if bad {
-                        return Err(first_offender(state, step, d, |x| !(x >= lo && x <= hi)));
-                    }
+                    return Err(first_offender(state, step, d, |x| !(x >= lo && x <= hi)));
                 }
                 Ok((lo, hi))
             }
             Boundary::Open => {
-                let (lo, hi) = state.bounding_box();
                 // No particle, nothing to check (a rank of a distributed run may own none).
                 if state.is_empty() {
-                    return Ok((lo, hi));
+                    return Ok(state.bounding_box());
                 }
+                let pos = state.pos.each_ref().map(|x| &x[..n]);
+                let part = |k: usize| {
+                    let r = k * c..((k + 1) * c).min(n);
+                    simd::dispatch(
+                        #[inline(always)]
+                        || extent(pos.each_ref().map(|x| &x[r.clone()])),
+                    )
+                };
+                let chunks = n.div_ceil(c);
+                let (lo, hi, poison) = if chunks > 1 {
+                    (0..chunks)
+                        .into_par_iter()
+                        .map(part)
+                        .reduce(Extent::empty, Extent::join)
+                } else {
+                    part(0)
+                };
                 for d in 0..D {
-                    // min/max skip NaN, so test finiteness separately: x·0 is NaN for NaN and ±∞.
-                    let poison = state.pos[d]
-                        .iter()
-                        .fold(T::zero(), |acc, &x| acc + x * T::zero());
-                    if !(lo[d].is_finite() && hi[d].is_finite() && poison.is_finite()) {
+                    if !(lo[d].is_finite() && hi[d].is_finite() && poison[d].is_finite()) {
                         return Err(first_offender(state, step, d, |x| !x.is_finite()));
                     }
                 }
@@ -79,6 +106,68 @@ impl<T: Real, const D: usize> Boundary<T, D> {
             }
         }
     }
+}
+
+/// Elastic walls for one chunk of particles; per dimension, whether a particle is still
+/// outside after one reflection.
+#[inline(always)]
+fn reflect<T: Real, const D: usize>(
+    x: [&mut [T]; D],
+    v: [&mut [T]; D],
+    lo: [T; D],
+    hi: [T; D],
+) -> [bool; D] {
+    let mut bad = [false; D];
+    for (d, (x, v)) in x.into_iter().zip(v).enumerate() {
+        let (lo, hi) = (lo[d], hi[d]);
+        let two = T::one() + T::one();
+        for (x, v) in x.iter_mut().zip(v.iter_mut()) {
+            // Written with selects, not branches: almost no particle is at a wall.
+            let below = *x < lo;
+            let above = *x > hi;
+            let nx = select(below, two * lo - *x, select(above, two * hi - *x, *x));
+            *v = select(below | above, -*v, *v);
+            *x = nx;
+            bad[d] |= !(nx >= lo && nx <= hi);
+        }
+    }
+    bad
+}
+
+/// Bounding box and a finiteness probe (`Σ x·0`: NaN when some coordinate is NaN or ±∞) of a
+/// chunk of positions; min and max skip NaN.
+type Extent<T, const D: usize> = ([T; D], [T; D], [T; D]);
+
+trait Join: Sized {
+    fn empty() -> Self;
+    fn join(a: Self, b: Self) -> Self;
+}
+
+impl<T: Real, const D: usize> Join for Extent<T, D> {
+    fn empty() -> Self {
+        ([T::infinity(); D], [T::neg_infinity(); D], [T::zero(); D])
+    }
+
+    fn join(a: Self, b: Self) -> Self {
+        (
+            std::array::from_fn(|d| a.0[d].min(b.0[d])),
+            std::array::from_fn(|d| a.1[d].max(b.1[d])),
+            std::array::from_fn(|d| a.2[d] + b.2[d]),
+        )
+    }
+}
+
+#[inline(always)]
+fn extent<T: Real, const D: usize>(pos: [&[T]; D]) -> Extent<T, D> {
+    let mut e = Extent::<T, D>::empty();
+    for (d, x) in pos.into_iter().enumerate() {
+        for &x in x {
+            e.0[d] = e.0[d].min(x);
+            e.1[d] = e.1[d].max(x);
+            e.2[d] += x * T::zero();
+        }
+    }
+    e
 }
 
 /// Names the first particle whose coordinate `d` fails `is_bad` (NaN is reported as non-finite).
@@ -167,6 +256,60 @@ mod tests {
             b.apply(&mut s, 5).unwrap_err(),
             BoundaryError::NonFinite { step: 5, id: 0 }
         );
+    }
+
+    #[test]
+    fn the_chunked_passes_give_the_serial_results() {
+        let n = 60_000;
+        let mut s = State::<f32, 3>::new(n);
+        for i in 0..n {
+            for d in 0..3 {
+                s.pos[d][i] = ((i * (2 * d + 3)) % 1001) as f32 * 1e-3 - 0.01;
+                s.vel[d][i] = (i % 7) as f32 - 3.0;
+            }
+        }
+        s.pos[1][45_678] = 2.5;
+        let walls = Boundary::Reflecting {
+            lo: [0.0; 3],
+            hi: [1.0; 3],
+        };
+        let pool = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+        };
+        let serial = {
+            let mut s = s.clone();
+            let r = walls.apply(&mut s, 1);
+            (r, s.pos, s.vel)
+        };
+        assert!(serial.0.is_err(), "the particle at y = 2.5 stays outside");
+        for threads in [2, 3] {
+            let mut t = s.clone();
+            let r = pool(threads).install(|| walls.apply(&mut t, 1));
+            assert_eq!((r, t.pos, t.vel), serial.clone(), "{threads} threads");
+        }
+        // Open space: the box, and the first non-finite particle named.
+        let open = Boundary::<f32, 3>::Open;
+        let expect = open.apply(&mut s.clone(), 2);
+        s.pos[2][50_001] = f32::NAN;
+        s.pos[2][59_999] = f32::INFINITY;
+        for threads in [1, 2, 3] {
+            let mut t = s.clone();
+            let mut u = s.clone();
+            u.pos[2][50_001] = 0.5;
+            u.pos[2][59_999] = 0.5;
+            let pool = pool(threads);
+            assert_eq!(
+                pool.install(|| open.apply(&mut t, 2)),
+                Err(BoundaryError::NonFinite {
+                    step: 2,
+                    id: 50_001
+                })
+            );
+            assert_eq!(pool.install(|| open.apply(&mut u, 2)), expect);
+        }
     }
 
     #[test]

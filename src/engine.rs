@@ -1,7 +1,7 @@
 //! The simulation loop: one kernel, one system, velocity Verlet, phase timers and counters.
 
 use crate::boundary::{Boundary, BoundaryError};
-use crate::integrator::{drift, kick};
+use crate::integrator::{kick, kick_drift};
 use crate::kernels::{ForceKernel, WorkCounters};
 use crate::real::Real;
 use crate::scenario::System;
@@ -177,8 +177,7 @@ impl<T: Real, const D: usize> Simulation<T, D> {
     pub fn step(&mut self) -> Result<(), BoundaryError> {
         let half = self.dt * T::of(0.5);
         let t0 = Instant::now();
-        kick(&mut self.state, &self.forces, self.external, half);
-        drift(&mut self.state, self.dt);
+        kick_drift(&mut self.state, &self.forces, self.external, half, self.dt);
         let t1 = Instant::now();
         self.bounds = self.boundary.apply(&mut self.state, self.step + 1)?;
         let t2 = Instant::now();

@@ -1,8 +1,15 @@
 //! Velocity Verlet (kick-drift-kick), shared by every scenario:
 //! `v += a·dt/2; x += v·dt; (boundary); a = F(x)/m + g; v += a·dt/2`.
+//!
+//! Each pass runs over chunks of particles on the pool's threads when the particles are many,
+//! each chunk compiled for the selected instruction set. Every particle's arithmetic is the
+//! same whatever the chunks, so the state is bitwise the same at any thread count.
 
+use crate::par::{chunks_of, pass_chunk, worth_forking};
 use crate::real::Real;
+use crate::simd;
 use crate::state::{Field, State};
+use rayon::prelude::*;
 
 /// Half kick: `v += (F/m + external)·dt/2`.
 pub fn kick<T: Real, const D: usize>(
@@ -11,18 +18,96 @@ pub fn kick<T: Real, const D: usize>(
     external: [T; D],
     half_dt: T,
 ) {
-    for d in 0..D {
-        let (g, f) = (external[d], &forces[d]);
-        for ((v, &f), &m) in state.vel[d].iter_mut().zip(f).zip(&state.mass) {
+    let n = state.len();
+    let mass = &state.mass[..n];
+    let vel = state.vel.each_mut().map(|v| &mut v[..n]);
+    let pass = |offset: usize, v: [&mut [T]; D]| {
+        simd::dispatch(
+            #[inline(always)]
+            || kick_chunk(v, forces, &mass[offset..], external, half_dt, offset),
+        )
+    };
+    if worth_forking(n * D) {
+        let c = pass_chunk(n);
+        chunks_of(vel, c)
+            .into_par_iter()
+            .enumerate()
+            .for_each(|(k, v)| pass(k * c, v));
+    } else {
+        pass(0, vel);
+    }
+}
+
+/// Half kick and drift in one pass: `v += (F/m + external)·dt/2; x += v·dt`.
+pub fn kick_drift<T: Real, const D: usize>(
+    state: &mut State<T, D>,
+    forces: &Field<T, D>,
+    external: [T; D],
+    half_dt: T,
+    dt: T,
+) {
+    let n = state.len();
+    let mass = &state.mass[..n];
+    let vel = state.vel.each_mut().map(|v| &mut v[..n]);
+    let pos = state.pos.each_mut().map(|x| &mut x[..n]);
+    let pass = |offset: usize, v: [&mut [T]; D], x: [&mut [T]; D]| {
+        simd::dispatch(
+            #[inline(always)]
+            || {
+                let mut v = v;
+                kick_chunk(
+                    v.each_mut().map(|v| &mut **v),
+                    forces,
+                    &mass[offset..],
+                    external,
+                    half_dt,
+                    offset,
+                );
+                drift_chunk(x, v.each_ref().map(|v| &**v), dt);
+            },
+        )
+    };
+    if worth_forking(n * D) {
+        let c = pass_chunk(n);
+        chunks_of(vel, c)
+            .into_par_iter()
+            .zip(chunks_of(pos, c))
+            .enumerate()
+            .for_each(|(k, (v, x))| pass(k * c, v, x));
+    } else {
+        pass(0, vel, pos);
+    }
+}
+
+/// Drift: `x += v·dt` (the fused pass's reference in tests).
+#[cfg(test)]
+fn drift<T: Real, const D: usize>(state: &mut State<T, D>, dt: T) {
+    let vel = state.vel.each_ref().map(|v| v.as_slice());
+    drift_chunk(state.pos.each_mut().map(|x| x.as_mut_slice()), vel, dt);
+}
+
+/// The kick of the particles `offset..offset + v[0].len()`.
+#[inline(always)]
+fn kick_chunk<T: Real, const D: usize>(
+    v: [&mut [T]; D],
+    forces: &Field<T, D>,
+    mass: &[T],
+    external: [T; D],
+    half_dt: T,
+    offset: usize,
+) {
+    for (d, v) in v.into_iter().enumerate() {
+        let (g, f) = (external[d], &forces[d][offset..offset + v.len()]);
+        for ((v, &f), &m) in v.iter_mut().zip(f).zip(mass) {
             *v += (f / m + g) * half_dt;
         }
     }
 }
 
-/// Drift: `x += v·dt`.
-pub fn drift<T: Real, const D: usize>(state: &mut State<T, D>, dt: T) {
-    for d in 0..D {
-        for (x, &v) in state.pos[d].iter_mut().zip(&state.vel[d]) {
+#[inline(always)]
+fn drift_chunk<T: Real, const D: usize>(x: [&mut [T]; D], v: [&[T]; D], dt: T) {
+    for (x, v) in x.into_iter().zip(v) {
+        for (x, &v) in x.iter_mut().zip(v) {
             *x += v * dt;
         }
     }
@@ -41,12 +126,43 @@ mod tests {
         let f = zero_field::<f64, 2>(1);
         let (g, dt) = ([0.0, -9.81], 0.01);
         for _ in 0..100 {
-            kick(&mut s, &f, g, dt / 2.0);
-            drift(&mut s, dt);
+            kick_drift(&mut s, &f, g, dt / 2.0, dt);
             kick(&mut s, &f, g, dt / 2.0);
         }
         assert!((s.pos[0][0] - 1.0).abs() < 1e-12);
         assert!((s.pos[1][0] + 0.5 * 9.81).abs() < 1e-10);
         assert!((s.vel[1][0] + 9.81).abs() < 1e-10);
+    }
+
+    #[test]
+    fn the_fused_pass_is_the_two_passes_bitwise_at_any_thread_count() {
+        let n = 50_000;
+        let mut s = State::<f32, 3>::new(n);
+        let mut f = zero_field::<f32, 3>(n);
+        for i in 0..n {
+            for d in 0..3 {
+                s.pos[d][i] = (i * (d + 3)) as f32 * 1e-3;
+                s.vel[d][i] = ((i * 7 + d) % 13) as f32 - 6.0;
+                f[d][i] = ((i * 11 + d) % 17) as f32 * 0.37;
+            }
+            s.mass[i] = 1.0 + (i % 5) as f32;
+        }
+        let (g, half, dt) = ([0.0, -0.3, 0.1], 0.005f32, 0.01f32);
+        let mut two = s.clone();
+        kick(&mut two, &f, g, half);
+        drift(&mut two, dt);
+        kick(&mut two, &f, g, half);
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut one = s.clone();
+            pool.install(|| {
+                kick_drift(&mut one, &f, g, half, dt);
+                kick(&mut one, &f, g, half);
+            });
+            assert_eq!((&one.pos, &one.vel), (&two.pos, &two.vel), "{threads}");
+        }
     }
 }

@@ -1,7 +1,7 @@
 //! nbody-bench: an engine of interchangeable N-body force kernels and a harness that measures
 //! how they scale.
 //!
-//! Layers, bottom up: [`real`] and [`simd`] (precision and instruction set), [`state`] and
+//! Layers, bottom up: [`real`], [`simd`] and [`par`] (precision, instruction set, threads), [`state`] and
 //! [`physics`] (particles and pair laws), [`kernels`] (ways of visiting the pairs),
 //! [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
 //! [`run`] and [`validate`] (measured runs and force checks), [`output`]; above them the
@@ -29,6 +29,7 @@ pub mod kernels;
 #[cfg(feature = "mpi")]
 pub mod mpi;
 pub mod output;
+pub mod par;
 pub mod physics;
 pub mod plot;
 pub mod real;

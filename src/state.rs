@@ -77,10 +77,10 @@ impl<T: Real, const D: usize> State<T, D> {
         assert_eq!(order.len(), self.len(), "permutation length must equal n");
         // One scratch array, swapped with each field in turn: the old field becomes the next
         // scratch, so a permutation allocates one array, not one per field.
+        // Each gather runs on the pool's threads when the particles are many.
         let mut scratch: Vec<T> = Vec::with_capacity(order.len());
         let mut gather = |v: &mut Vec<T>| {
-            scratch.clear();
-            scratch.extend(order.iter().map(|&k| v[k as usize]));
+            crate::par::gather(v, order, &mut scratch);
             std::mem::swap(v, &mut scratch);
         };
         for d in 0..D {
@@ -92,8 +92,9 @@ impl<T: Real, const D: usize> State<T, D> {
         }
         gather(&mut self.mass);
         gather(&mut self.source);
-        let old = std::mem::take(&mut self.id);
-        self.id = order.iter().map(|&k| old[k as usize]).collect();
+        let mut id = Vec::with_capacity(order.len());
+        crate::par::gather(&self.id, order, &mut id);
+        self.id = id;
     }
 
     /// Slot of each particle id: `slots[id] = index into the arrays`.

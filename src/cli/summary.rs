@@ -39,7 +39,7 @@ pub fn print_summary(r: &RunOutcome) {
         Duration::from_ns(p.max as f64)
     );
     outln!(
-        "per particle-step {}",
+        "per particle-step {} (mean over the steps)",
         Duration::from_ns(t.ns_per_particle_step)
     );
     outln!(

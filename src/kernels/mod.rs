@@ -7,10 +7,10 @@
 //! monomorphized for the law, precision and dimension.
 
 mod cell_list;
+mod counting_sort;
 pub mod footprint;
 mod naive;
 mod octree;
-mod par;
 mod per_thread;
 pub mod rows;
 mod share;

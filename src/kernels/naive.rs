@@ -1,9 +1,9 @@
 //! `naive`: every target against every other particle, n(n−1) pair evaluations (the form of the
 //! MPI source code). Targets are independent, so it parallelizes over them without races.
 
-use super::par::{chunk_len, for_chunks};
 use super::rows::{Exclude, RowSum, Sources, Target, gather_excluding};
 use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
+use crate::par::{chunk_len, for_chunks};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;

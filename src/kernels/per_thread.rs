@@ -4,9 +4,9 @@
 //! Memory: one buffer of n × D values per thread, allocated on the first step and reused.
 //! Steps too small to pay for a fork/join run the serial symmetric path instead.
 
-use super::par::{chunk_len, for_chunks};
 use super::symmetric::{add_tiles, blocks, pairs_of, split_tiles};
 use super::{ForceKernel, ForceReport, KernelKind, Share, WorkCounters, worth_parallel};
+use crate::par::{chunk_len, for_chunks};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;

@@ -17,7 +17,7 @@ use super::driver::{Driver, Tally};
 use super::error::MpiError;
 use crate::boundary::{Boundary, BoundaryError};
 use crate::decomp::wire::{bytes_of, bytes_of_mut};
-use crate::integrator::{drift, kick};
+use crate::integrator::{kick, kick_drift};
 use crate::kernels::{ForceKernel, KernelKind, Share};
 use crate::real::Real;
 use crate::scenario::System;
@@ -191,8 +191,7 @@ impl<T: Real, const D: usize> Allgather<T, D> {
 impl<T: Real, const D: usize> Driver<T, D> for Allgather<T, D> {
     fn step(&mut self, comm: &mut Comm, step: u64) -> Result<(), MpiError> {
         let half = self.dt * T::of(0.5);
-        kick(&mut self.local, &self.forces, self.external, half);
-        drift(&mut self.local, self.dt);
+        kick_drift(&mut self.local, &self.forces, self.external, half, self.dt);
         let error = self.boundary.apply(&mut self.local, step).err();
         self.share_positions(comm, error, step)?;
         self.compute_forces(comm)?;

@@ -299,6 +299,44 @@ fn run_json_has_the_documented_fields() {
     assert!(v["counters"]["total"]["pair_checks"].as_u64().unwrap() > 0);
 }
 
+#[test]
+fn run_reports_the_mean_step_not_the_median_one() {
+    // The Verlet list rebuilds every few steps: the median step is one without a rebuild, and
+    // a cost per particle-step from it would leave the rebuilds out.
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("r.json");
+    let o = bin(&[
+        "run",
+        "--scenario",
+        "lj-box",
+        "--kernel",
+        "verlet",
+        "-n",
+        "2000",
+        "--steps",
+        "60",
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let t = &v["timing"];
+    let (steps_s, per) = (
+        t["steps_s"].as_f64().unwrap(),
+        t["ns_per_particle_step"].as_f64().unwrap(),
+    );
+    let mean = steps_s * 1e9 / (60.0 * 2000.0);
+    assert!((per - mean).abs() <= 1e-9 * mean, "{per} vs {mean}");
+    assert!(steps_s <= t["total_s"].as_f64().unwrap());
+    assert!(v["counters"]["total"]["rebuilds"].as_u64().unwrap() > 0);
+    let ps = v["throughput"]["particle_steps_per_s"].as_f64().unwrap();
+    assert!(
+        (ps * per * 1e-9 - 1.0).abs() < 1e-9,
+        "{ps} and {per} disagree"
+    );
+}
+
 fn dump(dir: &Path, name: &str, extra: &[&str]) -> String {
     let path = dir.join(name);
     let mut args = vec![

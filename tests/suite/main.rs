@@ -31,6 +31,7 @@ mod runs;
 mod supervision;
 mod sweep;
 mod verlet;
+mod whole_step;
 
 use std::path::Path;
 use std::process::{Command, Output, Stdio};

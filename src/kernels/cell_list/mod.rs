@@ -22,8 +22,8 @@ pub(super) mod strips;
 #[cfg(test)]
 mod tests;
 
-use super::par::{chunk_len, for_chunks};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters, worth_parallel};
+use crate::par::{chunk_len, for_chunks};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -70,19 +70,11 @@ impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
     }
 
     /// Bins `state` and lays out the source strips without computing any force: the build
-    /// phase of [`ForceKernel::compute`] alone, for benchmarks. Serial: a layout strip by strip
-    /// over the pool measured 1.7× slower on one thread (lj-box, n = 1e5) than this
-    /// per-particle one, and slower at two threads than this one followed by the parallel
-    /// force loop.
+    /// phase of [`ForceKernel::compute`] alone, for benchmarks. Per particle, in parallel over
+    /// chunks of particles when they are many.
     pub fn build(&mut self, state: &State<T, D>) {
-        let (strips, rc) = (&mut self.strips, self.rc);
-        simd::dispatch(
-            #[inline(always)]
-            || {
-                strips.sort(state, rc);
-                strips.fill(state);
-            },
-        );
+        self.strips.sort(state, self.rc);
+        self.strips.fill(state);
     }
 }
 
@@ -188,11 +180,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
     }
 
     fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
-        let (strips, rc) = (&mut self.strips, self.rc);
-        simd::dispatch(
-            #[inline(always)]
-            || strips.sort(state, rc),
-        );
+        self.strips.sort(state, self.rc);
         Some(self.strips.order())
     }
 }

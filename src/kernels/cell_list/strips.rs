@@ -13,8 +13,11 @@
 //! bin width, so at least the cutoff, away along axis 0) or sentinels, which contribute zero.
 
 use super::grid::{Grid, bounding_box, sentinel};
+use crate::kernels::counting_sort::{CountingSort, order_of};
 use crate::kernels::rows::LANES;
+use crate::par::{Disjoint, chunk_len, for_chunks, worth_forking};
 use crate::real::Real;
+use crate::simd;
 use crate::state::State;
 
 /// Sentinels after each strip: enough to round any run up to a multiple of `LANES`.
@@ -38,8 +41,11 @@ pub struct Strips<T, const D: usize> {
     pub own: Vec<u32>,
     /// Per particle in state order: its rank among the particles of its bin.
     pub rank: Vec<u32>,
-    /// First sorted slot of each bin (phantom bins included): the counting sort.
+    /// First sorted slot of each bin (phantom bins included), then `n`: the counting sort.
     start: Vec<u32>,
+    /// Per particle in state order: its place in bin order.
+    place: Vec<u32>,
+    sorter: CountingSort,
     /// Per particle in state order: its bin, and its bin coordinate along axis 1.
     bin: Vec<u32>,
     row_y: Vec<u32>,
@@ -58,30 +64,42 @@ impl<T: Real, const D: usize> Strips<T, D> {
             own: Vec::new(),
             rank: Vec::new(),
             start: Vec::new(),
+            place: Vec::new(),
+            sorter: CountingSort::new(),
             bin: Vec::new(),
             row_y: Vec::new(),
             far: None,
         }
     }
 
-    /// Bins the particles of `state` (the counting sort). Buffers only grow, so a run of steps
-    /// of equal size allocates nothing after the first. Inline so that it is compiled inside
-    /// `simd::dispatch` with the wide instruction set, like `fill`.
-    #[inline(always)]
+    /// Bins the particles of `state` (the counting sort), on the pool's threads when they are
+    /// many. Buffers only grow, so a run of steps of equal size allocates nothing after the
+    /// first.
     pub fn sort(&mut self, state: &State<T, D>, rc: f64) {
         let n = state.len();
         assert!(
             n <= MAX_PARTICLES,
             "the cell list handles at most {MAX_PARTICLES} particles (got {n})"
         );
-        let (lo, hi) = bounding_box(state);
+        let (lo, hi) = simd::dispatch(
+            #[inline(always)]
+            || bounding_box(state),
+        );
         self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), rc, n);
         self.far = sentinel(lo, hi, rc);
-        self.count(state);
+        self.bin.resize(n, 0);
+        self.row_y.resize(n, 0);
+        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
+        bin_all(&self.grid, pos, [&mut self.bin[..n], &mut self.row_y[..n]]);
+        self.sorter.sort(
+            &self.bin,
+            self.grid.bins(),
+            &mut self.start,
+            &mut self.place,
+        );
     }
 
     /// Fills the strips with the particles sorted by `sort`.
-    #[inline(always)]
     pub fn fill(&mut self, state: &State<T, D>) {
         // Padding costs `PAD` slots per strip; when strips are nearly empty (a line-like
         // configuration) that would dwarf the particles, so runs are left as they are.
@@ -91,7 +109,10 @@ impl<T: Real, const D: usize> Strips<T, D> {
         } else {
             0
         };
-        self.columns();
+        simd::dispatch(
+            #[inline(always)]
+            || self.columns(),
+        );
         self.place(state);
         if let Some(far) = self.far.filter(|_| self.pad > 0) {
             self.fill_padding(far);
@@ -103,36 +124,6 @@ impl<T: Real, const D: usize> Strips<T, D> {
         let n = self.bin.len() as f64;
         let bins: usize = self.grid.dims.iter().product();
         (n * (n * 3f64.powi(D as i32) / bins as f64).min(n)) as u64
-    }
-
-    /// Bin of every particle (a vectorizable pass), its rank inside the bin while counting
-    /// (a histogram), then the first sorted slot of each bin.
-    #[inline(always)]
-    fn count(&mut self, state: &State<T, D>) {
-        let (g, n) = (&self.grid, state.len());
-        self.bin.resize(n, 0);
-        self.row_y.resize(n, 0);
-        self.rank.resize(n, 0);
-        self.start.clear();
-        self.start.resize(g.bins(), 0);
-        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
-        let (bin, row_y) = (&mut self.bin[..n], &mut self.row_y[..n]);
-        for i in 0..n {
-            let c = g.cell(position(&pos, i));
-            bin[i] = g.bin(&c) as u32;
-            row_y[i] = c.get(1).copied().unwrap_or(0) as u32;
-        }
-        for (&b, rank) in bin.iter().zip(self.rank.iter_mut()) {
-            let count = &mut self.start[b as usize];
-            *rank = *count;
-            *count += 1;
-        }
-        let mut next = 0u32;
-        for s in self.start.iter_mut() {
-            let count = *s;
-            *s = next;
-            next += count;
-        }
     }
 
     /// First strip slot of every column: the strip's base plus, for each of its rows, the
@@ -163,49 +154,36 @@ impl<T: Real, const D: usize> Strips<T, D> {
         self.src.resize(len, T::zero());
     }
 
-    /// Copies every particle into the strips of its own row and of the rows above and below.
-    /// Inside a column the particles are ordered by row, then by rank.
-    #[inline(always)]
+    /// Copies every particle into the strips of its own row and of the rows above and below,
+    /// on the pool's threads when the particles are many. Inside a column the particles are
+    /// ordered by row, then by rank.
     fn place(&mut self, state: &State<T, D>) {
         let n = state.len();
-        let g = &self.grid;
-        let (row_len, ny) = (g.row_len, g.extent(1));
         self.own.resize(n, 0);
-        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
-        let (start, column) = (&self.start, &self.column);
-        // Slices, not `Vec`s: stores through a `Vec` make LLVM reload its header.
-        let mut out_pos: [&mut [T]; D] = self.pos.each_mut().map(|v| v.as_mut_slice());
-        let out_src = self.src.as_mut_slice();
-        let (bin, rank, row_y, own) = (
-            &self.bin[..n],
-            &self.rank[..n],
-            &self.row_y[..n],
-            &mut self.own[..n],
-        );
-        for i in 0..n {
-            let x = position(&pos, i);
-            let s = state.source[i];
-            let y = row_y[i] as usize;
-            let (b, k) = (bin[i] as usize, rank[i]);
-            // Particles of the rows below in the same column of the same strip.
-            let below1 = if y >= 1 { count(start, b - row_len) } else { 0 };
-            let below2 = if y >= 2 {
-                count(start, b - 2 * row_len)
-            } else {
-                0
-            };
-            let slot = column[b] + below1 + k;
-            own[i] = slot;
-            put(&mut out_pos, out_src, slot, &x, s);
-            if y + 1 < ny {
-                // The lowest row of strip y + 1.
-                put(&mut out_pos, out_src, column[b + row_len] + k, &x, s);
-            }
-            if y >= 1 {
-                // The highest row of strip y − 1.
-                let slot = column[b - row_len] + below1 + below2 + k;
-                put(&mut out_pos, out_src, slot, &x, s);
-            }
+        self.rank.resize(n, 0);
+        let to = Layout {
+            grid: &self.grid,
+            start: &self.start,
+            column: &self.column,
+            bin: &self.bin[..n],
+            place: &self.place[..n],
+            row_y: &self.row_y[..n],
+            pos: std::array::from_fn(|d| &state.pos[d][..n]),
+            source: &state.source[..n],
+            out_pos: self.pos.each_mut().map(|v| Disjoint::new(v.as_mut_slice())),
+            out_src: Disjoint::new(self.src.as_mut_slice()),
+        };
+        let run = |offset: usize, out: [&mut [u32]; 2]| {
+            simd::dispatch(
+                #[inline(always)]
+                || to.place(offset, out),
+            )
+        };
+        let out = [&mut self.own[..n], &mut self.rank[..n]];
+        if worth_forking(n * D) {
+            for_chunks(out, 0, chunk_len(n).max(4096), &run);
+        } else {
+            run(0, out);
         }
     }
 
@@ -223,11 +201,75 @@ impl<T: Real, const D: usize> Strips<T, D> {
 
     /// The particles in bin order, as `order[new_slot] = old_slot` (valid after `sort`).
     pub fn order(&self) -> Vec<u32> {
-        let mut order = vec![0u32; self.bin.len()];
-        for (i, (&b, &k)) in self.bin.iter().zip(&self.rank).enumerate() {
-            order[(self.start[b as usize] + k) as usize] = i as u32;
-        }
+        let mut order = Vec::new();
+        order_of(&self.place, &mut order);
         order
+    }
+}
+
+/// What placing the particles in the strips reads, and the strips it writes.
+struct Layout<'a, T, const D: usize> {
+    grid: &'a Grid<D>,
+    start: &'a [u32],
+    column: &'a [u32],
+    bin: &'a [u32],
+    place: &'a [u32],
+    row_y: &'a [u32],
+    pos: [&'a [T]; D],
+    source: &'a [T],
+    out_pos: [Disjoint<'a, T>; D],
+    out_src: Disjoint<'a, T>,
+}
+
+impl<T: Real, const D: usize> Layout<'_, T, D> {
+    /// Places the particles `offset..offset + own.len()`: their own slot and rank go to `own`
+    /// and `rank`, their copies to the strips.
+    #[inline(always)]
+    fn place(&self, offset: usize, [own, rank]: [&mut [u32]; 2]) {
+        let (g, start, column) = (self.grid, self.start, self.column);
+        let (row_len, ny) = (g.row_len, g.extent(1));
+        for k in 0..own.len() {
+            let i = offset + k;
+            let x = position(&self.pos, i);
+            let s = self.source[i];
+            let y = self.row_y[i] as usize;
+            let b = self.bin[i] as usize;
+            let r = self.place[i] - start[b];
+            rank[k] = r;
+            // Particles of the rows below in the same column of the same strip.
+            let below1 = if y >= 1 { count(start, b - row_len) } else { 0 };
+            let below2 = if y >= 2 {
+                count(start, b - 2 * row_len)
+            } else {
+                0
+            };
+            let slot = column[b] + below1 + r;
+            own[k] = slot;
+            self.put(slot, &x, s);
+            if y + 1 < ny {
+                // The lowest row of strip y + 1.
+                self.put(column[b + row_len] + r, &x, s);
+            }
+            if y >= 1 {
+                // The highest row of strip y − 1.
+                self.put(column[b - row_len] + below1 + below2 + r, &x, s);
+            }
+        }
+    }
+
+    /// Stores a particle in strip slot `slot`.
+    #[inline(always)]
+    fn put(&self, slot: u32, x: &[T; D], s: T) {
+        let slot = slot as usize;
+        // SAFETY: every particle has its own slot in each of its three strips (the bins'
+        // counts leave room for exactly their particles, and a particle's rank is its own),
+        // so no slot is written twice.
+        unsafe {
+            for d in 0..D {
+                self.out_pos[d].write(slot, x[d]);
+            }
+            self.out_src.write(slot, s);
+        }
     }
 }
 
@@ -237,20 +279,42 @@ fn count(start: &[u32], b: usize) -> u32 {
     start[b + 1] - start[b]
 }
 
-/// Stores a particle in strip slot `slot`.
-#[inline(always)]
-fn put<T: Real, const D: usize>(
-    pos: &mut [&mut [T]; D],
-    src: &mut [T],
-    slot: u32,
-    x: &[T; D],
-    s: T,
+/// Writes the bin of every particle of `pos` into `out[0]`, and with two outputs its bin
+/// coordinate along axis 1 into `out[1]`; on the pool's threads when the particles are many,
+/// each chunk compiled for the selected instruction set.
+pub fn bin_all<T: Real, const D: usize, const K: usize>(
+    g: &Grid<D>,
+    pos: [&[T]; D],
+    out: [&mut [u32]; K],
 ) {
-    let slot = slot as usize;
-    for d in 0..D {
-        pos[d][slot] = x[d];
+    let n = out[0].len();
+    let run = |offset: usize, out: [&mut [u32]; K]| {
+        simd::dispatch(
+            #[inline(always)]
+            || bins_of(g, &pos, offset, out),
+        )
+    };
+    if worth_forking(n * D) {
+        for_chunks(out, 0, chunk_len(n).max(4096), &run);
+    } else {
+        run(0, out);
     }
-    src[slot] = s;
+}
+
+#[inline(always)]
+fn bins_of<T: Real, const D: usize, const K: usize>(
+    g: &Grid<D>,
+    pos: &[&[T]; D],
+    offset: usize,
+    out: [&mut [u32]; K],
+) {
+    for k in 0..out[0].len() {
+        let c = g.cell(position(pos, offset + k));
+        out[0][k] = g.bin(&c) as u32;
+        if K > 1 {
+            out[1][k] = c.get(1).copied().unwrap_or(0) as u32;
+        }
+    }
 }
 
 /// Position of particle `i` (a loop rather than `State::position`'s `array::from_fn`, whose

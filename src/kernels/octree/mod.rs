@@ -35,8 +35,8 @@ mod walk;
 #[cfg(test)]
 mod tests;
 
-use super::par::chunk_len;
 use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
+use crate::par::chunk_len;
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::state::{Field, State};

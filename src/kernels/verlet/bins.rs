@@ -6,8 +6,11 @@
 //! single run of sorted indices: the stencil of a bin is `3^(D−1)` runs.
 
 use crate::kernels::cell_list::grid::{Grid, bounding_box};
-use crate::kernels::cell_list::strips::position;
+use crate::kernels::cell_list::strips::bin_all;
+use crate::kernels::counting_sort::{CountingSort, order_of};
+use crate::par::gather;
 use crate::real::Real;
+use crate::simd;
 use crate::state::State;
 
 pub struct Bins<T, const D: usize> {
@@ -18,9 +21,10 @@ pub struct Bins<T, const D: usize> {
     pub order: Vec<u32>,
     /// Positions in bin order, so that the search reads its candidates contiguously.
     pub pos: [Vec<T>; D],
-    /// Per slot: its bin, and its rank among the particles of its bin (scratch of the sort).
+    /// Per slot: its bin, and its place in bin order (scratch of the sort).
     bin: Vec<u32>,
-    rank: Vec<u32>,
+    place: Vec<u32>,
+    sorter: CountingSort,
 }
 
 impl<T: Real, const D: usize> Bins<T, D> {
@@ -31,46 +35,30 @@ impl<T: Real, const D: usize> Bins<T, D> {
             order: Vec::new(),
             pos: std::array::from_fn(|_| Vec::new()),
             bin: Vec::new(),
-            rank: Vec::new(),
+            place: Vec::new(),
+            sorter: CountingSort::new(),
         }
     }
 
-    /// Sorts the particles of `state` into bins of side ≥ `radius`. Buffers only grow, so
-    /// rebuilds of a run allocate nothing after the first. Inline so that it is compiled inside
-    /// `simd::dispatch` with the wide instruction set.
-    #[inline(always)]
+    /// Sorts the particles of `state` into bins of side ≥ `radius`, on the pool's threads when
+    /// they are many (the order is the same at any thread count). Buffers only grow, so
+    /// rebuilds of a run allocate nothing after the first.
     pub fn sort(&mut self, state: &State<T, D>, radius: f64) {
         let n = state.len();
-        let (lo, hi) = bounding_box(state);
+        let (lo, hi) = simd::dispatch(
+            #[inline(always)]
+            || bounding_box(state),
+        );
         self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
-        let g = &self.grid;
         self.bin.resize(n, 0);
-        self.rank.resize(n, 0);
-        self.start.clear();
-        self.start.resize(g.bins() + 1, 0);
         let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
-        let bin = &mut self.bin[..n];
-        for i in 0..n {
-            bin[i] = g.bin(&g.cell(position(&pos, i))) as u32;
-        }
-        for (&b, rank) in bin.iter().zip(self.rank.iter_mut()) {
-            let count = &mut self.start[b as usize];
-            *rank = *count;
-            *count += 1;
-        }
-        let mut next = 0u32;
-        for s in self.start.iter_mut() {
-            let count = *s;
-            *s = next;
-            next += count;
-        }
-        self.order.resize(n, 0);
-        for (i, (&b, &k)) in bin.iter().zip(&self.rank).enumerate() {
-            self.order[(self.start[b as usize] + k) as usize] = i as u32;
-        }
+        bin_all(&self.grid, pos, [&mut self.bin[..n]]);
+        let place = &mut self.place;
+        self.sorter
+            .sort(&self.bin, self.grid.bins(), &mut self.start, place);
+        order_of(place, &mut self.order);
         for d in 0..D {
-            self.pos[d].clear();
-            self.pos[d].extend(self.order.iter().map(|&i| pos[d][i as usize]));
+            gather(pos[d], &self.order, &mut self.pos[d]);
         }
     }
 

@@ -34,8 +34,8 @@ mod loops;
 mod tests;
 mod work;
 
-use super::par::{chunk_len, for_chunks};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters};
+use crate::par::{chunk_len, for_chunks, pass_chunk, worth_forking};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -134,10 +134,22 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         }
         let limit = 0.25 * self.skin * self.skin;
         let (now, then) = (&state.pos, &self.at_build);
-        simd::dispatch(
-            #[inline(always)]
-            || work::moved_beyond(now, then, limit),
-        )
+        let part = |r: Range<usize>| {
+            let now: [&[T]; D] = std::array::from_fn(|d| &now[d][r.clone()]);
+            let then: [&[T]; D] = std::array::from_fn(|d| &then[d][r.clone()]);
+            simd::dispatch(
+                #[inline(always)]
+                || work::moved_beyond(now, then, limit),
+            )
+        };
+        if worth_forking(n * D) {
+            let c = pass_chunk(n);
+            (0..n.div_ceil(c))
+                .into_par_iter()
+                .any(|k| part(k * c..((k + 1) * c).min(n)))
+        } else {
+            part(0..n)
+        }
     }
 
     /// Makes the list hold `cover` for `state`, rebuilding it when it holds something else,
@@ -155,11 +167,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         let n = state.len();
         let side = self.radius * (1.0 + LIST_MARGIN);
         if !(self.handed_out && self.bins.adopt(state)) {
-            let bins = &mut self.bins;
-            simd::dispatch(
-                #[inline(always)]
-                || bins.sort(state, side),
-            );
+            self.bins.sort(state, side);
         }
         self.handed_out = false;
         let rows = match &cover {
@@ -357,11 +365,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
         if self.cover.is_some() && !self.handed_out && !self.moved_too_far(state) {
             return None;
         }
-        let (bins, side) = (&mut self.bins, self.radius * (1.0 + LIST_MARGIN));
-        simd::dispatch(
-            #[inline(always)]
-            || bins.sort(state, side),
-        );
+        self.bins.sort(state, self.radius * (1.0 + LIST_MARGIN));
         self.handed_out = true;
         Some(self.bins.order.clone())
     }

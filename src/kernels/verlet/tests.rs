@@ -230,18 +230,22 @@ fn exactly_half_the_skin_keeps_the_list_and_the_forces() {
     assert_eq!(report.work.rebuilds, 0);
 }
 
+fn view(f: &Field<f64, 2>) -> [&[f64]; 2] {
+    [&f[0][..], &f[1][..]]
+}
+
 #[test]
 fn the_displacement_test_is_strict_and_fails_safe() {
     let then: Field<f64, 2> = [vec![0.0; 5000], vec![1.0; 5000]];
     let mut now = then.clone();
     now[0][4321] = 0.5;
-    assert!(!work::moved_beyond(&now, &then, 0.25));
+    assert!(!work::moved_beyond(view(&now), view(&then), 0.25));
     now[1][4321] = 1.0 + 1e-6;
-    assert!(work::moved_beyond(&now, &then, 0.25));
+    assert!(work::moved_beyond(view(&now), view(&then), 0.25));
     let mut nan = then.clone();
     nan[1][17] = f64::NAN;
-    assert!(work::moved_beyond(&nan, &then, 0.25));
-    assert!(!work::moved_beyond(&then, &then, 0.0));
+    assert!(work::moved_beyond(view(&nan), view(&then), 0.25));
+    assert!(!work::moved_beyond(view(&then), view(&then), 0.0));
 }
 
 /// The engine's handshake: an order exactly when a rebuild is due, then a rebuild on the
@@ -373,4 +377,21 @@ fn the_estimate_before_a_first_build_bounds_the_list() {
     assert!(bound >= kernel.entries(), "{bound} < {}", kernel.entries());
     let targets = work::expected_entries(&kernel.bins, &Cover::Targets(0..2000));
     assert!(targets >= 2 * kernel.entries());
+}
+
+/// The sort of a rebuild forks when the particles are many; its order must not depend on the
+/// thread count.
+#[test]
+fn the_order_is_the_same_at_any_thread_count() {
+    let law = lj::<f32>(2.5 * SIGMA);
+    let state = spaced_state::<f32, 2>(30_000, 2.5, 0.8 * SIGMA, SEED_2);
+    let order = |p| {
+        on_threads(p, || {
+            let mut kernel = Verlet::<_, f32, 2>::new(law, SKIN).expect("LJ has a cutoff");
+            kernel.spatial_order(&state).expect("no list yet: sort")
+        })
+    };
+    let one = order(1);
+    assert_eq!(order(2), one);
+    assert_eq!(order(3), one);
 }

@@ -5,7 +5,6 @@ use super::bins::Bins;
 use super::list::Cover;
 use crate::kernels::MIN_PARALLEL_PAIRS;
 use crate::real::Real;
-use crate::state::Field;
 
 /// Parts per thread of a split list: several, so that work stealing evens out parts of unequal
 /// density (the gas of lj-box settles under gravity).
@@ -55,11 +54,7 @@ pub fn expected_entries<T: Real, const D: usize>(bins: &Bins<T, D>, cover: &Cove
 /// counts as far), in f64. Blocks of slots with an early exit: a rebuild that is due does not
 /// wait for the whole scan.
 #[inline(always)]
-pub fn moved_beyond<T: Real, const D: usize>(
-    now: &Field<T, D>,
-    then: &Field<T, D>,
-    limit: f64,
-) -> bool {
+pub fn moved_beyond<T: Real, const D: usize>(now: [&[T]; D], then: [&[T]; D], limit: f64) -> bool {
     const BLOCK: usize = 2048;
     let n = now[0].len();
     let mut start = 0;

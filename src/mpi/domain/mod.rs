@@ -24,7 +24,7 @@ use super::driver::{Driver, Tally};
 use super::error::MpiError;
 use crate::boundary::Boundary;
 use crate::decomp::regions::{Regions, grid_dims, parse_grid};
-use crate::integrator::{drift, kick};
+use crate::integrator::{kick, kick_drift};
 use crate::kernels::ForceKernel;
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -183,8 +183,7 @@ impl<T: Real, const D: usize> Domain<T, D> {
 impl<T: Real, const D: usize> Driver<T, D> for Domain<T, D> {
     fn step(&mut self, comm: &mut Comm, step: u64) -> Result<(), MpiError> {
         let half = self.dt * T::of(0.5);
-        kick(&mut self.owned, &self.forces, self.external, half);
-        drift(&mut self.owned, self.dt);
+        kick_drift(&mut self.owned, &self.forces, self.external, half, self.dt);
         let error = self.boundary.apply(&mut self.owned, step).err();
         let counts = self.migrate(comm, error, step)?;
         if self.should_rebalance(&counts, step) {

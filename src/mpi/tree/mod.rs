@@ -26,7 +26,7 @@ use crate::boundary::{Boundary, BoundaryError};
 use crate::decomp::orb::sample_weights;
 use crate::decomp::stats::MinMeanMax;
 use crate::decomp::wire::{bytes_of, bytes_of_mut, pack_particle, unpack_particles};
-use crate::integrator::{drift, kick};
+use crate::integrator::{kick, kick_drift};
 use crate::kernels::{ForceReport, KernelParams, Octree};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -105,8 +105,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
     /// Half kick, drift and the walls; the wall error, if any, to be shared with every rank.
     pub fn first_half(&mut self, step: u64) -> Option<BoundaryError> {
         let half = self.dt * T::of(0.5);
-        kick(&mut self.owned, &self.forces, self.external, half);
-        drift(&mut self.owned, self.dt);
+        kick_drift(&mut self.owned, &self.forces, self.external, half, self.dt);
         self.boundary.apply(&mut self.owned, step).err()
     }
 

@@ -1,0 +1,155 @@
+//! The whole step on the pool's threads: sizes at which every pass forks (binning, the
+//! re-ordering, kick and drift, walls, the field), and the results those passes must keep.
+//! The cell list gathers each target's force in a fixed order, so a run with it is bitwise the
+//! same at any thread count, re-orderings included; the Verlet list's forces are summed in
+//! per-thread buffers and agree to rounding.
+
+use nbody_bench::engine::Simulation;
+use nbody_bench::kernels::{KernelKind, KernelParams};
+use nbody_bench::physics::PairLaw;
+use nbody_bench::real::Real;
+use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
+use nbody_bench::state::zero_field;
+
+/// Enough particles that every per-particle pass forks (above `par::MIN_FORK_ELEMENTS`).
+const N: usize = 20_000;
+
+fn setup(scenario: ScenarioKind, precision: Precision) -> Setup {
+    let mut s = Setup::new(scenario);
+    s.n = Some(N);
+    s.precision = Some(precision);
+    s.seed = 11;
+    s.allow_fewer = true;
+    s
+}
+
+fn pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+}
+
+/// Positions, velocities and ids (as bits) after `steps` steps of `kernel` on `threads`.
+struct Trajectory {
+    kernel: KernelKind,
+    threads: usize,
+    steps: u64,
+}
+
+impl SystemJob for Trajectory {
+    type Output = Vec<u64>;
+    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> Vec<u64> {
+        let kernel = self
+            .kernel
+            .build::<T, L, D>(sys.law, &KernelParams::default())
+            .unwrap();
+        pool(self.threads).install(|| {
+            let mut sim = Simulation::new(sys, kernel);
+            for _ in 0..self.steps {
+                sim.step().unwrap();
+            }
+            let s = &sim.state;
+            let mut bits: Vec<u64> = s.id.iter().map(|&i| i as u64).collect();
+            for d in 0..D {
+                bits.extend(
+                    s.pos[d]
+                        .iter()
+                        .chain(&s.vel[d])
+                        .map(|x| x.as_f64().to_bits()),
+                );
+            }
+            bits
+        })
+    }
+}
+
+#[test]
+fn a_cell_list_run_is_bitwise_the_same_at_any_thread_count() {
+    // Walls and the field (lj-box), walls alone (lj-liquid).
+    for (scenario, precision) in [
+        (ScenarioKind::LjBox, Precision::F32),
+        (ScenarioKind::LjLiquid, Precision::F64),
+    ] {
+        let run = |threads| {
+            setup(scenario, precision)
+                .dispatch(Trajectory {
+                    kernel: KernelKind::CellList,
+                    threads,
+                    steps: 25,
+                })
+                .unwrap()
+        };
+        let one = run(1);
+        for threads in [2, 3] {
+            assert!(
+                run(threads) == one,
+                "{scenario:?}: the state after 25 steps differs at {threads} threads"
+            );
+        }
+    }
+}
+
+/// The Verlet list's forces at 1 and 2 threads, on the state of a few steps in (sorted by the
+/// kernel, lists rebuilt), against each other and against the cell list's.
+struct Forces {
+    threads: usize,
+}
+
+impl SystemJob for Forces {
+    type Output = (f64, f64);
+    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> (f64, f64) {
+        let params = KernelParams::default();
+        let n = sys.state.len();
+        let law = sys.law;
+        let mut sim = Simulation::new(
+            sys,
+            KernelKind::Verlet.build::<T, L, D>(law, &params).unwrap(),
+        );
+        for _ in 0..12 {
+            sim.step().unwrap();
+        }
+        let state = sim.state.clone();
+        let mut verlet = KernelKind::Verlet.build::<T, L, D>(law, &params).unwrap();
+        let mut cells = KernelKind::CellList.build::<T, L, D>(law, &params).unwrap();
+        let (mut a, mut b, mut c) = (zero_field(n), zero_field(n), zero_field(n));
+        verlet.compute(&state, &mut a, false);
+        pool(self.threads).install(|| {
+            // Twice: the second call runs on the kept list.
+            verlet.compute(&state, &mut b, false);
+            verlet.compute(&state, &mut b, false);
+            cells.compute(&state, &mut c, false);
+        });
+        let (mut worst, mut scale) = (0.0f64, 0.0f64);
+        let mut worst_cells = 0.0f64;
+        for d in 0..D {
+            for i in 0..n {
+                let (x, y, z) = (a[d][i].as_f64(), b[d][i].as_f64(), c[d][i].as_f64());
+                worst = worst.max((x - y).abs());
+                worst_cells = worst_cells.max((y - z).abs());
+                scale = scale.max(x.abs());
+            }
+        }
+        (worst / scale, worst_cells / scale)
+    }
+}
+
+#[test]
+fn verlet_forces_agree_to_rounding_where_the_step_forks() {
+    for (scenario, precision, tol) in [
+        (ScenarioKind::LjBox, Precision::F32, 1e-4),
+        (ScenarioKind::LjLiquid, Precision::F32, 1e-4),
+        (ScenarioKind::LjLiquid, Precision::F64, 1e-11),
+    ] {
+        for threads in [2, 3] {
+            let (threads_err, cells_err) = setup(scenario, precision)
+                .dispatch(Forces { threads })
+                .unwrap();
+            assert!(
+                threads_err <= tol && cells_err <= tol,
+                "{scenario:?} {precision:?} p={threads}: 1 vs {threads} threads {threads_err:e}, \
+                 against the cell list {cells_err:e}"
+            );
+        }
+    }
+}
