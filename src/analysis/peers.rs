@@ -1,8 +1,10 @@
 //! Our kernels next to the external programs measured in the same sweep (the vs-*.toml
-//! configs): for every case of an external program, each built-in kernel's case of the same
-//! scenario, n and worker count, and the ratio of their times with a bootstrap CI; for tree
-//! codes swept over θ, each code's cost interpolated to one median force error, so that cost
-//! is compared at equal accuracy.
+//! configs): each built-in kernel's case against the fastest external case of the same
+//! scenario, n and worker count (and θ) — a peer may be run in several ways, e.g. LAMMPS with
+//! its defaults and tuned, and a comparison counts against its best — with the ratio of their
+//! times and a bootstrap CI, the slower variants kept beside it; for tree codes swept over θ,
+//! each code's cost interpolated to one median force error, so that cost is compared at equal
+//! accuracy.
 
 use super::ThetaAnalysis;
 use super::groups::{Point, workers_suffix};
@@ -15,7 +17,7 @@ pub const EQUAL_ERROR: f64 = 1e-3;
 /// The seed of the ratio bootstraps: the same results give the same intervals.
 const SEED: u64 = 0x9EE2;
 
-/// One of our cases next to one external program's case of the same system and workers.
+/// One of our cases next to the fastest external case of the same system and workers.
 #[derive(Clone, Debug, Serialize)]
 pub struct PeerRatio {
     pub scenario: String,
@@ -37,6 +39,22 @@ pub struct PeerRatio {
     pub ours_error: Option<f64>,
     pub theirs_error: Option<f64>,
     /// Either case ran more workers than logical CPUs.
+    pub oversubscribed: bool,
+    /// The other external cases of the same system and workers (the other ways a peer was
+    /// run, e.g. with its defaults), slower than `theirs`, fastest first.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub others: Vec<PeerVariant>,
+}
+
+/// An external case that was not the fastest of its system and workers, against the same case
+/// of ours.
+#[derive(Clone, Debug, Serialize)]
+pub struct PeerVariant {
+    pub theirs: String,
+    pub theirs_ns: f64,
+    pub theirs_ci_ns: [f64; 2],
+    /// Its time over ours (from the medians).
+    pub speedup: f64,
     pub oversubscribed: bool,
 }
 
@@ -77,37 +95,61 @@ fn ns_per_particle(p: &Point, seconds: f64) -> f64 {
     seconds * 1e9 / p.n.max(1) as f64
 }
 
-/// Every (ours, theirs) pair of cases of one scenario, n and worker count; when the external
-/// case has a θ, only our cases at the same θ.
+/// Whether an external case `t` is the same system and workers as our case `o`: scenario, n,
+/// threads × ranks, and θ when the external case has one.
+fn same_case(o: &Point, t: &Point) -> bool {
+    o.case.scenario == t.case.scenario
+        && o.n == t.n
+        && o.p() == t.p()
+        && (t.theta.is_none() || o.theta == t.theta)
+}
+
+/// Each of our cases against the fastest (lowest median) external case of the same scenario, n
+/// and worker count (when the external case has a θ, the same θ), with the other external cases
+/// of that system beside it; our cases with no external counterpart are left out.
 pub fn ratios(cases: &[Point]) -> Vec<PeerRatio> {
     let (theirs, ours): (Vec<&Point>, Vec<&Point>) =
         cases.iter().partition(|p| p.case.kernel.is_external());
     let mut out = Vec::new();
-    for t in &theirs {
-        for o in ours.iter().filter(|o| {
-            o.case.scenario == t.case.scenario
-                && o.n == t.n
-                && o.p() == t.p()
-                && (t.theta.is_none() || o.theta == t.theta)
-        }) {
-            out.push(PeerRatio {
-                scenario: o.case.scenario.name().into(),
-                n: o.n,
-                workers: o.p(),
-                ours: case_label(o),
-                theirs: case_label(t),
-                ours_ns: ns_per_particle(o, o.median_s),
-                ours_ci_ns: o.ci95_s.map(|s| ns_per_particle(o, s)),
-                theirs_ns: ns_per_particle(t, t.median_s),
-                theirs_ci_ns: t.ci95_s.map(|s| ns_per_particle(t, s)),
-                speedup: t.median_s / o.median_s,
-                speedup_ci: bootstrap_ratio_ci(&o.samples, &t.samples, BOOTSTRAP_RESAMPLES, SEED),
-                ours_error: o.force_error.map(|e| e[0]),
-                theirs_error: t.force_error.map(|e| e[0]),
-                oversubscribed: o.oversubscribed || t.oversubscribed,
-            });
-        }
+    for o in &ours {
+        let mut peers: Vec<&Point> = theirs.iter().copied().filter(|t| same_case(o, t)).collect();
+        // Stable: of equal medians, the first in the file.
+        peers.sort_by(|a, b| a.median_s.total_cmp(&b.median_s));
+        let Some((t, slower)) = peers.split_first() else {
+            continue;
+        };
+        out.push(PeerRatio {
+            scenario: o.case.scenario.name().into(),
+            n: o.n,
+            workers: o.p(),
+            ours: case_label(o),
+            theirs: case_label(t),
+            ours_ns: ns_per_particle(o, o.median_s),
+            ours_ci_ns: o.ci95_s.map(|s| ns_per_particle(o, s)),
+            theirs_ns: ns_per_particle(t, t.median_s),
+            theirs_ci_ns: t.ci95_s.map(|s| ns_per_particle(t, s)),
+            speedup: t.median_s / o.median_s,
+            speedup_ci: bootstrap_ratio_ci(&o.samples, &t.samples, BOOTSTRAP_RESAMPLES, SEED),
+            ours_error: o.force_error.map(|e| e[0]),
+            theirs_error: t.force_error.map(|e| e[0]),
+            oversubscribed: o.oversubscribed || t.oversubscribed,
+            others: slower
+                .iter()
+                .map(|s| PeerVariant {
+                    theirs: case_label(s),
+                    theirs_ns: ns_per_particle(s, s.median_s),
+                    theirs_ci_ns: s.ci95_s.map(|x| ns_per_particle(s, x)),
+                    speedup: s.median_s / o.median_s,
+                    oversubscribed: s.oversubscribed,
+                })
+                .collect(),
+        });
     }
+    // One system's rows together: by scenario, n, workers and θ (stable: our kernels in file
+    // order within each).
+    out.sort_by(|a, b| {
+        (a.scenario.as_str(), a.n, a.workers).cmp(&(b.scenario.as_str(), b.n, b.workers))
+    });
     out
 }
 
@@ -187,6 +229,117 @@ pub fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::experiment::code::Code;
+    use crate::experiment::plan::Case;
+    use crate::kernels::Multipole;
+    use crate::scenario::ScenarioKind;
+
+    /// A complete case of `code` on `scenario` whose samples are `median_s` per step ± 1%.
+    fn point(
+        scenario: ScenarioKind,
+        code: &str,
+        n: usize,
+        t: usize,
+        r: usize,
+        median_s: f64,
+    ) -> Point {
+        let case = Case {
+            scenario,
+            kernel: Code::from_name(code),
+            n,
+            threads: t,
+            ranks: r,
+            theta: None,
+            multipole: Multipole::Monopole,
+            seed: 1,
+            precision: None,
+            time_factor: 1,
+            decomp: None,
+        };
+        Point {
+            key: case.key(),
+            case,
+            n,
+            threads: t,
+            ranks: r,
+            time_factor: 1,
+            theta: None,
+            decomp: None,
+            comm_s_per_step: None,
+            bytes_per_step: None,
+            transfer_s_per_step: None,
+            compute_imbalance: None,
+            samples: vec![median_s * 0.99, median_s, median_s * 1.01],
+            median_s,
+            ci95_s: [median_s * 0.99, median_s * 1.01],
+            oversubscribed: false,
+            ns_per_particle_step: median_s * 1e9 / n as f64,
+            pair_evals_per_s: 0.0,
+            phases: Default::default(),
+            step_ns: Default::default(),
+            force_error: None,
+            max_energy_drift: 0.0,
+            sanity_ok: true,
+        }
+    }
+
+    #[test]
+    fn ours_are_set_against_the_fastest_peer_variant_of_each_case() {
+        use ScenarioKind::{LjBox, LjLiquid};
+        let n = 100_000;
+        // Two LAMMPS variants: the tuned one is faster on one worker, the plain one on two
+        // (ranks against our threads), and only the plain one ran the liquid.
+        let cases = vec![
+            point(LjBox, "verlet", n, 1, 1, 2e-3),
+            point(LjBox, "verlet", n, 2, 1, 1.6e-3),
+            point(LjBox, "lammps", n, 1, 1, 4.5e-3),
+            point(LjBox, "lammps", n, 1, 2, 1.5e-3),
+            point(LjBox, "lammps-tuned", n, 1, 1, 3e-3),
+            point(LjBox, "lammps-tuned", n, 1, 2, 1.8e-3),
+            // Another n: no peer there, no row.
+            point(LjBox, "verlet", 2 * n, 1, 1, 4e-3),
+            point(LjLiquid, "verlet", n, 1, 1, 6e-3),
+            point(LjLiquid, "lammps", n, 1, 1, 9e-3),
+        ];
+        let rows = ratios(&cases);
+        let got: Vec<(&str, usize, &str, Vec<&str>)> = rows
+            .iter()
+            .map(|r| {
+                let others = r.others.iter().map(|o| o.theirs.as_str()).collect();
+                (r.scenario.as_str(), r.workers, r.theirs.as_str(), others)
+            })
+            .collect();
+        assert_eq!(
+            got,
+            vec![
+                ("lj-box", 1, "lammps-tuned", vec!["lammps"]),
+                (
+                    "lj-box",
+                    2,
+                    "lammps, 2 ranks",
+                    vec!["lammps-tuned, 2 ranks"]
+                ),
+                ("lj-liquid", 1, "lammps", vec![]),
+            ]
+        );
+        // The ratio is against the fastest; the plain run keeps its own beside it.
+        let one = &rows[0];
+        assert!((one.speedup - 1.5).abs() < 1e-12, "{}", one.speedup);
+        assert!((one.theirs_ns - 30.0).abs() < 1e-9);
+        assert!((one.others[0].speedup - 2.25).abs() < 1e-12);
+        assert!((one.others[0].theirs_ns - 45.0).abs() < 1e-9);
+        let two = &rows[1];
+        assert_eq!(two.ours, "verlet, 2 threads");
+        assert!((two.speedup - 1.5e-3 / 1.6e-3).abs() < 1e-12);
+        let ci = two.speedup_ci.unwrap();
+        assert!(ci[0] <= two.speedup && two.speedup <= ci[1], "{ci:?}");
+        // The same results in another order choose the same variants.
+        let mut reversed = cases.clone();
+        reversed.reverse();
+        let again: Vec<String> = ratios(&reversed).iter().map(|r| r.theirs.clone()).collect();
+        let first: Vec<String> = rows.iter().map(|r| r.theirs.clone()).collect();
+        assert_eq!(again, first);
+    }
 
     #[test]
     fn cost_at_error_is_exact_on_a_power_law_and_refuses_to_extrapolate() {

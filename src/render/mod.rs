@@ -1,9 +1,10 @@
-//! The presentation layer: an [`Analysis`] as Markdown tables ([`tables`]), the per-sweep
-//! summary ([`summary`]), figures ([`figures`]) and the files of an analysis directory. Every
-//! table of `summary.md` and REPORT.md comes from [`tables`], so the two never disagree; every
+//! The presentation layer: an [`Analysis`] as Markdown tables ([`tables`]), how its external
+//! programs ran ([`runs`]), the per-sweep summary ([`summary`]), figures ([`figures`]) and the
+//! files of an analysis directory. Every table of `summary.md` and REPORT.md comes from [`tables`], so the two never disagree; every
 //! quantity is formatted by `crate::units`.
 
 pub mod figures;
+pub mod runs;
 pub mod summary;
 pub mod tables;
 

@@ -59,7 +59,8 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.peers.is_empty() {
         let _ = writeln!(
             md,
-            "## Against the external programs\n\n{}\n{}",
+            "## Against the external programs\n\n{}\n{}\n{}",
+            super::runs::external_runs(a),
             tables::peers(a),
             tables::peers_equal_error(a)
         );

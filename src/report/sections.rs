@@ -269,19 +269,17 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
             "Each program ran in the same sweep as our kernels, in the same interleaved rounds, from the \
              same particles (`nbody-bench export`). \"theirs ÷ ours\" is the ratio of the median times per \
              particle-step (above 1: ours is faster) with a bootstrap 95% CI over both codes' samples; \
-             workers are threads for our kernels and MPI ranks or threads for the other code. * = \
-             oversubscribed.\n\n",
+             workers are threads for our kernels and MPI ranks or threads for the other code. Where a \
+             program was run in several ways (e.g. LAMMPS with its defaults and tuned), each of our cases \
+             is set against the fastest of them at the same scenario, n and workers, which the table \
+             names, with the other runs and their ratios beside it. * = oversubscribed.\n\n",
         );
     }
     for s in with {
         let a = &s.analysis;
-        let versions: Vec<String> = a
-            .metadata
-            .externals
-            .iter()
-            .map(|v| format!("{}: {}", v.name, v.version))
-            .collect();
-        let _ = writeln!(md, "From `{}` ({}).\n", a.source, versions.join("; "));
+        let _ = writeln!(md, "From `{}`.\n", a.source);
+        md.push_str(&crate::render::runs::external_runs(a));
+        md.push('\n');
         md.push_str(&tables::peers(a));
         md.push('\n');
         let equal = tables::peers_equal_error(a);

@@ -151,20 +151,23 @@ time = "wall"
             ("walled", "(no version command)")
         ]
     );
-    // The analysis sets each program next to the kernel of the same case, with the ratio of
-    // the medians and an interval around it.
+    // The analysis sets the kernel against the faster program of the same case, with the ratio
+    // of the medians and an interval around it, and the slower one beside it.
     let a = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
     let naive = record(&r, "lj-box/naive/n=50/p=1/r=1/seed=1")
         .summary
         .as_ref()
         .unwrap()
         .median_s;
-    let pairs: Vec<(&str, &str)> = a
+    let pairs: Vec<(&str, &str, Vec<&str>)> = a
         .peers
         .iter()
-        .map(|p| (p.ours.as_str(), p.theirs.as_str()))
+        .map(|p| {
+            let others = p.others.iter().map(|o| o.theirs.as_str()).collect();
+            (p.ours.as_str(), p.theirs.as_str(), others)
+        })
         .collect();
-    assert_eq!(pairs, vec![("naive", "printed"), ("naive", "walled")]);
+    assert_eq!(pairs, vec![("naive", "printed", vec!["walled"])]);
     let row = &a.peers[0];
     assert!((row.speedup - 1.5e-3 / naive).abs() <= 1e-12 * row.speedup);
     let ci = row.speedup_ci.unwrap();
@@ -172,6 +175,17 @@ time = "wall"
     assert!((row.theirs_ns - 1.5e-3 * 1e9 / 50.0).abs() < 1e-6);
     let table = nbody_bench::render::tables::peers(&a);
     assert!(table.contains("| lj-box | 50 | 1 | naive |"), "{table}");
+    assert!(
+        table.contains("| printed |") && table.contains("walled: "),
+        "{table}"
+    );
+    // How each program ran comes from the config the results file holds.
+    let runs = nbody_bench::render::runs::external_runs(&a);
+    assert!(runs.contains("- `printed` (printed 2.1): `"), "{runs}");
+    assert!(
+        runs.contains("`walled`") && runs.contains("wall time"),
+        "{runs}"
+    );
 }
 
 #[test]
