@@ -347,23 +347,23 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
         .filter(|_| kernel.is_some());
     let timed_serial = one.and_then(|one| {
         let ph = &one.phases;
-        let (serial, parallel) = if kernel.is_some_and(parallel_interaction) {
-            (
-                vec![ph.force_build, ph.integrate, ph.boundary, ph.output],
-                vec![ph.force_interact],
-            )
-        } else {
-            (
-                vec![
-                    ph.force_build,
-                    ph.force_interact,
-                    ph.integrate,
-                    ph.boundary,
-                    ph.output,
-                ],
-                vec![],
-            )
+        // Which phases ran on the pool's threads: the per-particle passes (kick, drift, walls)
+        // and the cell and Verlet lists' binning fork from a size on; the interactions of
+        // every kernel but `symmetric` do.
+        let passes_fork = one.n * s.key.scenario.dim() >= crate::par::MIN_FORK_ELEMENTS;
+        let build_forks = passes_fork && kernel.is_some_and(KernelKind::parallel_build);
+        let (mut serial, mut parallel) = (vec![ph.output], vec![]);
+        let mut put = |t: f64, forks: bool| {
+            if forks {
+                parallel.push(t)
+            } else {
+                serial.push(t)
+            }
         };
+        put(ph.force_interact, kernel.is_some_and(parallel_interaction));
+        put(ph.force_build, build_forks);
+        put(ph.integrate, passes_fork);
+        put(ph.boundary, passes_fork);
         fit::timed_serial_fraction(&serial, &parallel).ok()
     });
     let serial_comparison = match (&timed_serial, &fit.fit) {

@@ -107,6 +107,12 @@ impl KernelKind {
         !matches!(self, KernelKind::Symmetric)
     }
 
+    /// Whether the build phase (binning and sorting) runs on the pool's threads when the
+    /// particles are many (from `par::MIN_FORK_ELEMENTS` on).
+    pub fn parallel_build(self) -> bool {
+        matches!(self, KernelKind::CellList | KernelKind::Verlet)
+    }
+
     /// Builds the kernel for `law`, or explains which combinations exist.
     pub fn build<T: Real, L: PairLaw<T>, const D: usize>(
         self,

@@ -241,26 +241,31 @@ fn bad_input_exits_2_with_a_message() {
     }
 }
 
-#[test]
-fn run_json_has_the_documented_fields() {
+/// The `run --json` document of a run of `kernel` on lj-box.
+fn run_json(kernel: &str, n: usize, steps: u64) -> serde_json::Value {
     let dir = tempfile::tempdir().unwrap();
     let json = dir.path().join("r.json");
+    let (n, steps) = (n.to_string(), steps.to_string());
     let o = bin(&[
         "run",
         "--scenario",
         "lj-box",
         "--kernel",
-        "cell-list",
+        kernel,
         "-n",
-        "400",
+        &n,
         "--steps",
-        "30",
+        &steps,
         "--json",
         json.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap()
+}
+
+#[test]
+fn run_json_has_the_documented_fields() {
+    let v = run_json("cell-list", 400, 30);
     for path in [
         "/schema",
         "/scenario",
@@ -303,24 +308,7 @@ fn run_json_has_the_documented_fields() {
 fn run_reports_the_mean_step_not_the_median_one() {
     // The Verlet list rebuilds every few steps: the median step is one without a rebuild, and
     // a cost per particle-step from it would leave the rebuilds out.
-    let dir = tempfile::tempdir().unwrap();
-    let json = dir.path().join("r.json");
-    let o = bin(&[
-        "run",
-        "--scenario",
-        "lj-box",
-        "--kernel",
-        "verlet",
-        "-n",
-        "2000",
-        "--steps",
-        "60",
-        "--json",
-        json.to_str().unwrap(),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let v: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let v = run_json("verlet", 2000, 60);
     let t = &v["timing"];
     let (steps_s, per) = (
         t["steps_s"].as_f64().unwrap(),
