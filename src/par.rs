@@ -37,8 +37,8 @@ pub fn chunk_len(n: usize) -> usize {
 }
 
 /// Fewest per-particle elements (one value of one array: a bin, a coordinate) that a pass
-/// over them forks for. A fork and join of the pool costs a few microseconds; a pass over
-/// this many elements takes several times that.
+/// over them forks for. Chosen against the calibrated fork/join of the pool (3 µs with its
+/// threads awake, 11 µs asleep, on the 2-vCPU AMD EPYC 25/17/1), not swept.
 pub const MIN_FORK_ELEMENTS: usize = 16_384;
 
 /// Whether a pass over `elements` per-particle values should run on the pool's threads.
