@@ -24,6 +24,10 @@ step() {
     echo "== $* ($(date -u +%H:%M:%S))" >&2
 }
 
+# No line tables in these builds (the release profile keeps them for profiling): less to
+# compile and link.
+export CARGO_PROFILE_RELEASE_DEBUG=false
+
 step "format and lints, without and with the mpi feature"
 scripts/install-mpi.sh
 cargo fmt --all -- --check

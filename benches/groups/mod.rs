@@ -25,7 +25,10 @@ pub const SCENARIOS: [ScenarioKind; 2] = [ScenarioKind::LjBox, ScenarioKind::Gal
 /// about a millisecond; the O(n) and O(n log n) ones go further.
 pub fn sizes(kernel: KernelKind) -> &'static [usize] {
     match kernel {
-        KernelKind::CellList | KernelKind::Octree | KernelKind::Verlet => &[1000, 4000, 16000],
+        KernelKind::CellList
+        | KernelKind::Octree
+        | KernelKind::Verlet
+        | KernelKind::ClusterPair => &[1000, 4000, 16000],
         KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => &[500, 1000, 2000],
     }
 }

@@ -115,9 +115,9 @@ pub struct KernelArgs {
     /// Most particles in a tree leaf (octree only) [default: 8].
     #[arg(long, value_parser = parse_count)]
     pub leaf_size: Option<usize>,
-    /// Verlet list skin, in the scenario's length unit (verlet only): pairs within the cutoff
-    /// plus the skin are listed, and the list is rebuilt once a particle has moved half the
-    /// skin [default: 0.003, 0.3 sigma].
+    /// Verlet list skin, in the scenario's length unit (verlet and cluster-pair only): pairs
+    /// within the cutoff plus the skin are listed, and the list is rebuilt once a particle has
+    /// moved half the skin [default: 0.003, 0.3 sigma].
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     pub skin: Option<f64>,
     /// Threads in the rayon pool for this run, at most 1024 (the environment's

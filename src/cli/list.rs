@@ -22,8 +22,12 @@ pub fn list() -> anyhow::Result<i32> {
             KernelKind::Verlet => {
                 "half neighbour list, cutoff + --skin, rebuilt when a particle moved skin/2; O(n)"
             }
+            KernelKind::ClusterPair => {
+                "Verlet list of 4x4 particle clusters, one SIMD tile per pair, for dense \
+                 systems; --skin as verlet; O(n)"
+            }
         };
-        outln!("  {:<11} {what}", k.name());
+        outln!("  {:<12} {what}", k.name());
     }
     outln!("\nScenarios:");
     outln!(

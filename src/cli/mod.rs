@@ -73,12 +73,13 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
 /// `--skin` are refused for a kernel that ignores them (as `--density` is for a scenario
 /// without a box), so that nobody believes a setting that changed nothing.
 fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Result<KernelParams> {
-    if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Verlet)
+    if let Some(kernel) =
+        kernel.filter(|&k| !matches!(k, KernelKind::Verlet | KernelKind::ClusterPair))
         && args.skin.is_some()
     {
         anyhow::bail!(
-            "--skin applies to the verlet kernel only; `{}` does not use it: drop it, or pass \
-             --kernel verlet",
+            "--skin applies to the verlet and cluster-pair kernels only; `{}` does not use it: \
+             drop it, or pass --kernel verlet",
             kernel.name()
         );
     }

@@ -242,7 +242,9 @@ pub fn weak_size(
         WeakRule::Linear => b * pf,
         WeakRule::Sqrt => b * pf.sqrt(),
         WeakRule::CostModel => match kernel {
-            None | Some(KernelKind::CellList | KernelKind::Verlet) => b * pf,
+            None | Some(KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair) => {
+                b * pf
+            }
             Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread) => {
                 b * pf.sqrt()
             }

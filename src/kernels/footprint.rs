@@ -19,7 +19,8 @@ fn state_bytes(dim: usize, real_bytes: usize) -> usize {
 
 /// What the kernel keeps beside the state: bins and the sorted order of the cell list, the
 /// nodes of the tree, one f64 force buffer per thread, the Verlet list's entries (about ten
-/// per particle in the liquid), bins and positions at the build.
+/// per particle in the liquid), bins and positions at the build; the cluster-pair list's padded
+/// copy and tiles.
 fn kernel_bytes(kernel: KernelKind, dim: usize, threads: usize) -> usize {
     match kernel {
         KernelKind::Naive | KernelKind::Symmetric => 0,
@@ -27,6 +28,9 @@ fn kernel_bytes(kernel: KernelKind, dim: usize, threads: usize) -> usize {
         KernelKind::CellList => 48,
         KernelKind::Octree => 112,
         KernelKind::Verlet => 170,
+        // Padded slots with their particle, position, strength and force; the positions at
+        // the build; cluster boxes; about three 4-byte tiles per particle in the liquid.
+        KernelKind::ClusterPair => 120,
     }
 }
 

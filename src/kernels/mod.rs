@@ -7,6 +7,7 @@
 //! monomorphized for the law, precision and dimension.
 
 mod cell_list;
+mod cluster_pair;
 mod counting_sort;
 pub mod footprint;
 mod naive;
@@ -18,6 +19,7 @@ mod symmetric;
 pub mod verlet;
 
 pub use cell_list::CellList;
+pub use cluster_pair::ClusterPair;
 pub use naive::Naive;
 pub(crate) use octree::interleave;
 pub use octree::{Multipole, Octree, TreeView, far_from_box};
@@ -33,7 +35,7 @@ use serde::Serialize;
 use std::ops::Range;
 use thiserror::Error;
 
-/// The six kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
+/// The seven kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
 #[derive(
     Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
 )]
@@ -52,16 +54,20 @@ pub enum KernelKind {
     /// Half neighbour list within the cutoff plus a skin, rebuilt from cell-list bins only when
     /// some particle has moved more than half the skin (O(n)).
     Verlet,
+    /// Verlet list of 4 × 4 cluster pairs (GROMACS nbnxm style), one SIMD tile per pair, for
+    /// dense systems (O(n)).
+    ClusterPair,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 6] = [
+    pub const ALL: [KernelKind; 7] = [
         KernelKind::Naive,
         KernelKind::Symmetric,
         KernelKind::PerThread,
         KernelKind::CellList,
         KernelKind::Octree,
         KernelKind::Verlet,
+        KernelKind::ClusterPair,
     ];
 
     pub fn name(self) -> &'static str {
@@ -72,6 +78,7 @@ impl KernelKind {
             KernelKind::CellList => "cell-list",
             KernelKind::Octree => "octree",
             KernelKind::Verlet => "verlet",
+            KernelKind::ClusterPair => "cluster-pair",
         }
     }
 
@@ -84,7 +91,7 @@ impl KernelKind {
     pub fn supports(self, law: LawKind) -> bool {
         match self {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => true,
-            KernelKind::CellList | KernelKind::Verlet => law.has_cutoff(),
+            KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair => law.has_cutoff(),
             KernelKind::Octree => law.is_inverse_square(),
         }
     }
@@ -96,7 +103,9 @@ impl KernelKind {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => {
                 Complexity::Quadratic
             }
-            KernelKind::CellList | KernelKind::Verlet => Complexity::Linear,
+            KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair => {
+                Complexity::Linear
+            }
             KernelKind::Octree => Complexity::NLogN,
         }
     }
@@ -110,7 +119,10 @@ impl KernelKind {
     /// Whether the build phase (binning and sorting) runs on the pool's threads when the
     /// particles are many (from `par::MIN_FORK_ELEMENTS` on).
     pub fn parallel_build(self) -> bool {
-        matches!(self, KernelKind::CellList | KernelKind::Verlet)
+        matches!(
+            self,
+            KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair
+        )
     }
 
     /// Builds the kernel for `law`, or explains which combinations exist.
@@ -139,6 +151,7 @@ impl KernelKind {
                 params.multipole,
             )),
             KernelKind::Verlet => Box::new(Verlet::new(law, params.skin)?),
+            KernelKind::ClusterPair => Box::new(ClusterPair::new(law, params.skin)?),
         })
     }
 }

@@ -296,7 +296,7 @@ fn skin_with_a_kernel_that_ignores_it_or_out_of_range_is_refused() {
     };
     refused(
         &run("cell-list", "0.003"),
-        "--skin applies to the verlet kernel only",
+        "--skin applies to the verlet and cluster-pair kernels only",
     );
     for bad in ["0", "-0.001", "inf", "nan"] {
         let o = run("verlet", bad);

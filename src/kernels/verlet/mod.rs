@@ -124,39 +124,12 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         self.parts.iter().map(|p| p.entries() as u64).sum()
     }
 
-    /// Whether some slot of `state` is more than half the skin away from its position at the
-    /// last build (or the slots changed in number). Computed in f64: a particle that moved
-    /// exactly half the skin keeps the list.
-    fn moved_too_far(&self, state: &State<T, D>) -> bool {
-        let n = state.len();
-        if self.at_build[0].len() != n {
-            return true;
-        }
-        let limit = 0.25 * self.skin * self.skin;
-        let (now, then) = (&state.pos, &self.at_build);
-        let part = |r: Range<usize>| {
-            let now: [&[T]; D] = std::array::from_fn(|d| &now[d][r.clone()]);
-            let then: [&[T]; D] = std::array::from_fn(|d| &then[d][r.clone()]);
-            simd::dispatch(
-                #[inline(always)]
-                || work::moved_beyond(now, then, limit),
-            )
-        };
-        if worth_forking(n * D) {
-            let c = pass_chunk(n);
-            (0..n.div_ceil(c))
-                .into_par_iter()
-                .any(|k| part(k * c..((k + 1) * c).min(n)))
-        } else {
-            part(0..n)
-        }
-    }
-
     /// Makes the list hold `cover` for `state`, rebuilding it when it holds something else,
     /// was handed out for a re-ordering, or some slot moved too far; returns the build's work.
     fn refresh(&mut self, state: &State<T, D>, cover: Cover) -> BuildWork {
-        let kept =
-            self.cover.as_ref() == Some(&cover) && !self.handed_out && !self.moved_too_far(state);
+        let kept = self.cover.as_ref() == Some(&cover)
+            && !self.handed_out
+            && !moved_too_far(state, &self.at_build, self.skin);
         if kept {
             return BuildWork::default();
         }
@@ -362,7 +335,10 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
     /// The bin order, exactly when the list is due for a rebuild; between rebuilds a new order
     /// would only force one.
     fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
-        if self.cover.is_some() && !self.handed_out && !self.moved_too_far(state) {
+        if self.cover.is_some()
+            && !self.handed_out
+            && !moved_too_far(state, &self.at_build, self.skin)
+        {
             return None;
         }
         self.bins.sort(state, self.radius * (1.0 + LIST_MARGIN));
@@ -372,6 +348,38 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
 
     fn sort_every(&self) -> u64 {
         1
+    }
+}
+
+/// Whether some slot of `state` is more than half the skin away from its position in
+/// `at_build` (or the slots changed in number): the test that keeps a list. Computed in f64: a
+/// particle that moved exactly half the skin keeps the list.
+pub(crate) fn moved_too_far<T: Real, const D: usize>(
+    state: &State<T, D>,
+    at_build: &[Vec<T>; D],
+    skin: f64,
+) -> bool {
+    let n = state.len();
+    if at_build[0].len() != n {
+        return true;
+    }
+    let limit = 0.25 * skin * skin;
+    let (now, then) = (&state.pos, at_build);
+    let part = |r: Range<usize>| {
+        let now: [&[T]; D] = std::array::from_fn(|d| &now[d][r.clone()]);
+        let then: [&[T]; D] = std::array::from_fn(|d| &then[d][r.clone()]);
+        simd::dispatch(
+            #[inline(always)]
+            || work::moved_beyond(now, then, limit),
+        )
+    };
+    if worth_forking(n * D) {
+        let c = pass_chunk(n);
+        (0..n.div_ceil(c))
+            .into_par_iter()
+            .any(|k| part(k * c..((k + 1) * c).min(n)))
+    } else {
+        part(0..n)
     }
 }
 

@@ -1,0 +1,315 @@
+//! The clusters: particles counting-sorted into columns (a grid over every axis but the last),
+//! sorted along the last axis within each column, and cut into clusters of `CLUSTER`
+//! consecutive particles. Columns are as wide as a cluster is long at the mean density, so a
+//! cluster is about as wide as it is tall. Each column starts a new cluster; the slots a short
+//! last cluster leaves are padding, which repeats the column's last particle and never acts
+//! (the tiles mask it out).
+//!
+//! Memory, kept between builds: per padded slot its particle and a copy of its position and
+//! strength; per particle its padded slot and the sort's scratch; per cluster its bounding box.
+
+use crate::kernels::cell_list::grid::bounding_box;
+use crate::kernels::counting_sort::{CountingSort, order_of};
+use crate::par::{gather, pass_chunk, worth_forking};
+use crate::real::Real;
+use crate::simd;
+use crate::simd::LANES;
+use crate::state::State;
+use rayon::prelude::*;
+
+/// Particles per cluster.
+pub const CLUSTER: usize = 4;
+/// Clusters whose particles fill the `LANES` of a block: a run of the list.
+pub const GROUP: usize = LANES / CLUSTER;
+const _: () = assert!(GROUP * CLUSTER == LANES);
+
+pub struct Layout<T, const D: usize> {
+    /// The grid of columns: origin, width, and columns along each axis but the last.
+    origin: [f64; D],
+    pub width: f64,
+    pub columns: [usize; D],
+    /// First cluster of every column, then the number of clusters.
+    pub column_start: Vec<u32>,
+    /// The particles in cluster order (`order[k]` = state slot), padding left out: the order
+    /// `spatial_order` hands out.
+    pub order: Vec<u32>,
+    /// Per padded slot, its particle's state slot; per state slot, its padded slot.
+    pub slot_of: Vec<u32>,
+    pub padded_of: Vec<u32>,
+    /// Per column, the extent of its particles along each axis (in f64).
+    pub column_lo: [Vec<f64>; D],
+    pub column_hi: [Vec<f64>; D],
+    /// Per cluster: real particles (`CLUSTER` at most; 0 for the empty ones at the end), and
+    /// bounding box (in f64).
+    pub count: Vec<u8>,
+    pub lo: [Vec<f64>; D],
+    pub hi: [Vec<f64>; D],
+    /// Positions and strengths per padded slot, as of the last refresh.
+    pub pos: [Vec<T>; D],
+    pub src: Vec<T>,
+    column: Vec<u32>,
+    place: Vec<u32>,
+    start: Vec<u32>,
+    sorter: CountingSort,
+}
+
+impl<T: Real, const D: usize> Layout<T, D> {
+    pub fn new() -> Self {
+        Layout {
+            origin: [0.0; D],
+            width: 1.0,
+            columns: [1; D],
+            column_start: Vec::new(),
+            order: Vec::new(),
+            slot_of: Vec::new(),
+            padded_of: Vec::new(),
+            count: Vec::new(),
+            column_lo: std::array::from_fn(|_| Vec::new()),
+            column_hi: std::array::from_fn(|_| Vec::new()),
+            lo: std::array::from_fn(|_| Vec::new()),
+            hi: std::array::from_fn(|_| Vec::new()),
+            pos: std::array::from_fn(|_| Vec::new()),
+            src: Vec::new(),
+            column: Vec::new(),
+            place: Vec::new(),
+            start: Vec::new(),
+            sorter: CountingSort::new(),
+        }
+    }
+
+    pub fn clusters(&self) -> usize {
+        self.count.len()
+    }
+
+    /// Column of a position: its grid cell over the axes but the last.
+    #[inline(always)]
+    fn column_of(&self, x: [f64; D]) -> usize {
+        let mut c = 0;
+        for d in (0..D.saturating_sub(1)).rev() {
+            let k = ((x[d] - self.origin[d]) / self.width).max(0.0) as usize;
+            c = c * self.columns[d] + k.min(self.columns[d] - 1);
+        }
+        c
+    }
+
+    /// The columns along axis `d` that the interval `lo..=hi` overlaps, clamped to the grid.
+    pub fn column_range(&self, d: usize, lo: f64, hi: f64) -> (usize, usize) {
+        let last = self.columns[d] - 1;
+        let a = ((lo - self.origin[d]) / self.width).max(0.0) as usize;
+        let b = ((hi - self.origin[d]) / self.width).max(0.0) as usize;
+        (a.min(last), b.min(last))
+    }
+
+    /// Sorts `state` into clusters, with columns no narrower than a quarter of `radius` (so a
+    /// search spans a few columns at most), and fills the padded copy.
+    pub fn build(&mut self, state: &State<T, D>, radius: f64) {
+        let n = state.len();
+        let (lo, hi) = simd::dispatch(
+            #[inline(always)]
+            || bounding_box(state),
+        );
+        self.grid(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
+        self.sort(state);
+        self.cut(state);
+        self.refresh(state);
+        self.boxes();
+        self.column_extents();
+    }
+
+    /// Chooses the columns: as wide as a cluster is long at the box's mean density, and at most
+    /// a few per particle (an elongated box or a sparse one widens them).
+    fn grid(&mut self, lo: [f64; D], hi: [f64; D], radius: f64, n: usize) {
+        let extent: [f64; D] = std::array::from_fn(|d| (hi[d] - lo[d]).max(0.0));
+        let volume: f64 = extent.iter().map(|e| e.max(radius * 1e-3)).product();
+        let mut width = (CLUSTER as f64 * volume / n.max(1) as f64)
+            .powf(1.0 / D as f64)
+            .max(0.25 * radius);
+        if !width.is_finite() {
+            width = radius;
+        }
+        let cap = 4 * n + 64;
+        loop {
+            let mut total = 1usize;
+            for d in 0..D {
+                self.columns[d] = if d + 1 < D {
+                    (extent[d] / width) as usize + 1
+                } else {
+                    1
+                };
+                total = total.saturating_mul(self.columns[d]);
+            }
+            if total <= cap {
+                break;
+            }
+            width *= 2.0;
+        }
+        self.origin = lo;
+        self.width = width;
+    }
+
+    /// Counting sort by column, then each column sorted along the last axis (ties by slot, so
+    /// the order does not depend on the thread count).
+    fn sort(&mut self, state: &State<T, D>) {
+        let n = state.len();
+        let columns: usize = self.columns.iter().product();
+        let mut column = std::mem::take(&mut self.column);
+        column.resize(n, 0);
+        let fill = |offset: usize, out: &mut [u32]| {
+            for (k, c) in out.iter_mut().enumerate() {
+                let x = std::array::from_fn(|d| state.pos[d][offset + k].as_f64());
+                *c = self.column_of(x) as u32;
+            }
+        };
+        if worth_forking(n * D) {
+            let chunk = pass_chunk(n);
+            column
+                .par_chunks_mut(chunk)
+                .enumerate()
+                .for_each(|(k, out)| fill(k * chunk, out));
+        } else {
+            fill(0, &mut column);
+        }
+        self.column = column;
+        self.sorter
+            .sort(&self.column, columns, &mut self.start, &mut self.place);
+        order_of(&self.place, &mut self.order);
+        let last = &state.pos[D - 1];
+        let by_last = |run: &mut [u32]| {
+            run.sort_unstable_by(|&a, &b| {
+                let (x, y) = (last[a as usize].as_f64(), last[b as usize].as_f64());
+                x.total_cmp(&y).then(a.cmp(&b))
+            })
+        };
+        let mut runs = Vec::with_capacity(columns);
+        let mut rest = &mut self.order[..];
+        for c in 0..columns {
+            let len = (self.start[c + 1] - self.start[c]) as usize;
+            let (run, tail) = rest.split_at_mut(len);
+            runs.push(run);
+            rest = tail;
+        }
+        if worth_forking(n) {
+            runs.into_par_iter().for_each(by_last);
+        } else {
+            runs.into_iter().for_each(by_last);
+        }
+    }
+
+    /// Cuts each column into clusters: the padded slots, their particles and counts; then
+    /// `GROUP - 1` empty clusters, so that a run of `GROUP` clusters may start at any one.
+    fn cut(&mut self, state: &State<T, D>) {
+        let n = state.len();
+        let columns: usize = self.columns.iter().product();
+        self.column_start.clear();
+        self.slot_of.clear();
+        self.count.clear();
+        self.padded_of.resize(n, 0);
+        for c in 0..columns {
+            self.column_start.push(self.count.len() as u32);
+            let run = &self.order[self.start[c] as usize..self.start[c + 1] as usize];
+            for cluster in run.chunks(CLUSTER) {
+                for &s in cluster {
+                    self.padded_of[s as usize] = self.slot_of.len() as u32;
+                    self.slot_of.push(s);
+                }
+                let last = *cluster.last().expect("chunks are not empty");
+                self.slot_of
+                    .extend(std::iter::repeat_n(last, CLUSTER - cluster.len()));
+                self.count.push(cluster.len() as u8);
+            }
+        }
+        self.column_start.push(self.count.len() as u32);
+        let last = self.slot_of.last().copied().unwrap_or(0);
+        self.slot_of
+            .extend(std::iter::repeat_n(last, (GROUP - 1) * CLUSTER));
+        self.count.extend(std::iter::repeat_n(0, GROUP - 1));
+    }
+
+    /// The clusters that hold particles (the empty ones after them left out).
+    pub fn filled(&self) -> usize {
+        self.column_start.last().map_or(0, |&c| c as usize)
+    }
+
+    /// Copies the positions and strengths of `state` into the padded slots.
+    pub fn refresh(&mut self, state: &State<T, D>) {
+        for d in 0..D {
+            gather(&state.pos[d], &self.slot_of, &mut self.pos[d]);
+        }
+        gather(&state.source, &self.slot_of, &mut self.src);
+    }
+
+    /// Each cluster's bounding box, from the padded copy (padding repeats a real particle).
+    fn boxes(&mut self) {
+        let m = self.clusters();
+        for d in 0..D {
+            let pos = &self.pos[d];
+            let corner = |c: usize, pick: fn(f64, f64) -> f64| {
+                let p = &pos[c * CLUSTER..(c + 1) * CLUSTER];
+                p.iter().map(|x| x.as_f64()).reduce(pick).unwrap_or(0.0)
+            };
+            self.lo[d].clear();
+            self.hi[d].clear();
+            if worth_forking(m * CLUSTER) {
+                (0..m)
+                    .into_par_iter()
+                    .map(|c| corner(c, f64::min))
+                    .collect_into_vec(&mut self.lo[d]);
+                (0..m)
+                    .into_par_iter()
+                    .map(|c| corner(c, f64::max))
+                    .collect_into_vec(&mut self.hi[d]);
+            } else {
+                self.lo[d].extend((0..m).map(|c| corner(c, f64::min)));
+                self.hi[d].extend((0..m).map(|c| corner(c, f64::max)));
+            }
+        }
+    }
+
+    /// Each column's extent, from its clusters' boxes.
+    fn column_extents(&mut self) {
+        let columns = self.column_start.len() - 1;
+        for d in 0..D {
+            let (lo, hi) = (&self.lo[d], &self.hi[d]);
+            self.column_lo[d].clear();
+            self.column_hi[d].clear();
+            for c in 0..columns {
+                let r = self.column_start[c] as usize..self.column_start[c + 1] as usize;
+                self.column_lo[d].push(lo[r.clone()].iter().copied().fold(f64::INFINITY, f64::min));
+                self.column_hi[d].push(hi[r].iter().copied().fold(f64::NEG_INFINITY, f64::max));
+            }
+        }
+    }
+
+    /// Rewrites the layout for a state permuted by `order` (`state'[k] = state[order[k]]`), as
+    /// the engine does with the order `spatial_order` hands out: the clusters stay, their
+    /// particles' slots change. Returns false (nothing changed) unless the positions of
+    /// `state` are exactly those the layout expects.
+    pub fn adopt(&mut self, state: &State<T, D>) -> bool {
+        let n = state.len();
+        if self.order.len() != n {
+            return false;
+        }
+        let matches = (0..D).all(|d| {
+            self.order
+                .iter()
+                .enumerate()
+                .all(|(k, &s)| state.pos[d][k] == self.pos[d][self.padded_of[s as usize] as usize])
+        });
+        if !matches {
+            return false;
+        }
+        // The old slot `order[k]` is now slot `k`.
+        for (k, &s) in self.order.iter().enumerate() {
+            self.place[s as usize] = k as u32;
+        }
+        for s in self.slot_of.iter_mut() {
+            *s = self.place[*s as usize];
+        }
+        let old = std::mem::take(&mut self.padded_of);
+        self.padded_of = self.order.iter().map(|&s| old[s as usize]).collect();
+        for (k, o) in self.order.iter_mut().enumerate() {
+            *o = k as u32;
+        }
+        true
+    }
+}

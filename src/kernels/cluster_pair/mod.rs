@@ -1,0 +1,315 @@
+//! `cluster-pair`: the Verlet list of a dense system, made of clusters of four particles rather
+//! than of particles (the scheme of GROMACS's nbnxm). Particles are sorted into clusters of
+//! neighbours ([`layout`]); the list holds pairs of clusters whose bounding boxes come within
+//! the cutoff plus a skin ([`list`]); each pair is one SIMD tile of 4 × 4 particle pairs
+//! ([`tile`]). It is kept, like the `verlet` list, until some particle has moved more than half
+//! the skin since the build, so the forces are exact at every step.
+//!
+//! Against a list of particle pairs it computes more pairs (those of a tile beyond the cutoff)
+//! but each far more cheaply: four contiguous loads instead of gathers, the i-cluster's forces
+//! in registers across its list, no branch per pair. The dense liquid, with about eight
+//! partners per particle, is its case; in a dilute gas most tiles are nearly empty and
+//! `verlet` is the better list.
+//!
+//! - Half list: each cluster pair once (j at or after i), both ends updated; a cluster's tile
+//!   with itself keeps the pairs `j > i` of its lanes.
+//! - On several threads each part of the list (a range of i-clusters, several per thread)
+//!   adds into a buffer over the clusters it touches, and the buffers are summed.
+//! - At a rebuild the particles are re-sorted into cluster order ([`ForceKernel::sort_every`]
+//!   is 1, [`ForceKernel::spatial_order`] answers exactly when a rebuild is due), so the copy of
+//!   the positions into the padded slots reads the state in order.
+//!
+//! Memory, kept between rebuilds: per padded slot (at most one slot of padding per column) its
+//! particle, position, strength and force; per particle its position at the build and its
+//! slot; per cluster its box; 4 bytes per cluster pair.
+
+mod layout;
+mod list;
+#[cfg(test)]
+mod tests;
+mod tile;
+
+use super::verlet::moved_too_far;
+use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters, worth_parallel};
+use crate::par::{chunk_len, for_chunks, gather};
+use crate::physics::PairLaw;
+use crate::real::Real;
+use crate::simd;
+use crate::simd::LANES;
+use crate::state::{Field, State};
+use layout::CLUSTER;
+use layout::Layout;
+use list::Part;
+use rayon::prelude::*;
+use std::time::Instant;
+use tile::{Clusters, TileSum, part_forces};
+
+/// Relative margin of the list radius (as the `verlet` list's): boxes are compared in f64 at
+/// the build and pairs rounded in `T` at every step.
+const LIST_MARGIN: f64 = 1e-5;
+
+/// Parts per thread of a split list, so that work stealing evens out parts of unequal density.
+const PARTS_PER_THREAD: usize = 4;
+
+/// Cost of one run (`CLUSTER × LANES` pair evaluations and the reactions) in naive pair
+/// evaluations, the unit of `worth_parallel`.
+const RUN_COST: u64 = (CLUSTER * LANES) as u64;
+
+pub struct ClusterPair<L, T, const D: usize> {
+    law: L,
+    skin: f64,
+    /// The cutoff plus the skin, and its square with the margin.
+    radius: f64,
+    radius2: f64,
+    layout: Layout<T, D>,
+    parts: Vec<Part>,
+    /// Whether the list matches the layout (false before the first build).
+    built: bool,
+    /// `spatial_order` handed out the layout's order: the next build starts from it.
+    handed_out: bool,
+    /// Each state slot's position at the last build.
+    at_build: [Vec<T>; D],
+    /// Forces per padded slot, and the buffers of the parallel parts.
+    force: [Vec<T>; D],
+    buffers: Vec<[Vec<T>; D]>,
+}
+
+impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
+    pub fn new(law: L, skin: f64) -> Result<Self, KernelError> {
+        let rc = match law.cutoff() {
+            Some(rc) if rc.is_finite() && rc > T::zero() => rc.as_f64(),
+            Some(rc) => {
+                return Err(KernelError::BadParam(format!(
+                    "the cluster-pair list needs a finite positive cutoff (got {rc})"
+                )));
+            }
+            None => {
+                return Err(KernelError::BadParam(format!(
+                    "the cluster-pair list needs a law with a cutoff; {} has none",
+                    law.kind().name()
+                )));
+            }
+        };
+        if !(skin.is_finite() && skin > 0.0) {
+            return Err(KernelError::BadParam(format!(
+                "the cluster-pair skin must be a finite number > 0 (got {skin})"
+            )));
+        }
+        if !(1..=3).contains(&D) {
+            return Err(KernelError::BadParam(format!(
+                "the cluster-pair list works in 1 to 3 dimensions (got {D})"
+            )));
+        }
+        let radius = rc + skin;
+        Ok(ClusterPair {
+            law,
+            skin,
+            radius,
+            radius2: radius * radius * (1.0 + LIST_MARGIN),
+            layout: Layout::new(),
+            parts: Vec::new(),
+            built: false,
+            handed_out: false,
+            at_build: std::array::from_fn(|_| Vec::new()),
+            force: std::array::from_fn(|_| Vec::new()),
+            buffers: Vec::new(),
+        })
+    }
+
+    /// Runs of the current list.
+    pub fn runs(&self) -> u64 {
+        self.parts.iter().map(|p| p.runs() as u64).sum()
+    }
+
+    fn due(&self, state: &State<T, D>) -> bool {
+        !self.built || moved_too_far(state, &self.at_build, self.skin)
+    }
+
+    /// Brings the list up to date with `state`; returns the boxes compared by a rebuild, or
+    /// `None` when the list was kept (the padded copy is refreshed either way).
+    fn refresh(&mut self, state: &State<T, D>) -> Option<u64> {
+        if self.handed_out {
+            self.handed_out = false;
+            if !self.layout.adopt(state) {
+                self.layout.build(state, self.radius);
+            }
+            self.layout.refresh(state);
+            return Some(self.rebuild(state));
+        }
+        if self.due(state) {
+            self.layout.build(state, self.radius);
+            return Some(self.rebuild(state));
+        }
+        self.layout.refresh(state);
+        None
+    }
+
+    /// Builds the list over the current layout, in parts on the pool's threads.
+    fn rebuild(&mut self, state: &State<T, D>) -> u64 {
+        let m = self.layout.filled();
+        // The previous list's size tells the new one's; before the first build, a guess of
+        // four runs per cluster.
+        let runs = if self.built {
+            self.runs()
+        } else {
+            4 * m as u64
+        };
+        let work = runs * RUN_COST + state.len() as u64;
+        let count = if worth_parallel(work) {
+            PARTS_PER_THREAD * rayon::current_num_threads()
+        } else {
+            1
+        };
+        self.parts.resize_with(count, Part::default);
+        let (layout, radius, radius2) = (&self.layout, self.radius, self.radius2);
+        let build = |(k, part): (usize, &mut Part)| {
+            let range = k * m / count..(k + 1) * m / count;
+            list::build(layout, radius, radius2, range, part)
+        };
+        let compared = if count > 1 {
+            self.parts.par_iter_mut().enumerate().map(build).sum()
+        } else {
+            build((0, &mut self.parts[0]))
+        };
+        for d in 0..D {
+            self.at_build[d].clear();
+            self.at_build[d].extend_from_slice(&state.pos[d]);
+        }
+        self.built = true;
+        compared
+    }
+
+    /// The forces per padded slot, from every part on this thread.
+    fn serial<const PROBE: bool>(&mut self) -> TileSum {
+        let slots = self.layout.clusters() * CLUSTER;
+        let mut force = std::mem::replace(&mut self.force, std::array::from_fn(|_| Vec::new()));
+        for f in force.iter_mut() {
+            f.clear();
+            f.resize(slots, T::zero());
+        }
+        let mut out = force.each_mut().map(|f| f.as_mut_slice());
+        let (law, clusters) = (&self.law, Clusters::of(&self.layout));
+        let mut sum = TileSum::default();
+        for part in &self.parts {
+            let s = simd::dispatch(
+                #[inline(always)]
+                || part_forces::<T, L, D, PROBE>(law, &clusters, part, &mut out, 0),
+            );
+            sum.energy += s.energy;
+            sum.interacting += s.interacting;
+        }
+        self.force = force;
+        sum
+    }
+
+    /// The forces per padded slot, each part adding into its own buffer on the pool's threads,
+    /// then the buffers summed.
+    fn parallel(&mut self) {
+        self.buffers
+            .resize_with(self.parts.len(), || std::array::from_fn(|_| Vec::new()));
+        let (law, clusters) = (&self.law, Clusters::of(&self.layout));
+        self.parts
+            .par_iter()
+            .zip(self.buffers.par_iter_mut())
+            .for_each(|(part, buf)| {
+                let base = part.clusters.start * CLUSTER;
+                for b in buf.iter_mut() {
+                    b.clear();
+                    b.resize(part.end * CLUSTER - base, T::zero());
+                }
+                let mut out = buf.each_mut().map(|b| b.as_mut_slice());
+                simd::dispatch(
+                    #[inline(always)]
+                    || part_forces::<T, L, D, false>(law, &clusters, part, &mut out, base),
+                );
+            });
+        let slots = self.layout.clusters() * CLUSTER;
+        for f in self.force.iter_mut() {
+            f.resize(slots, T::zero());
+        }
+        let (parts, buffers) = (&self.parts, &self.buffers);
+        let out = self.force.each_mut().map(|f| &mut f[..slots]);
+        for_chunks(out, 0, chunk_len(slots).max(4096), &|offset, chunk| {
+            let here = offset..offset + chunk[0].len();
+            for d in 0..D {
+                chunk[d].fill(T::zero());
+            }
+            for (part, buf) in parts.iter().zip(buffers) {
+                let from = part.clusters.start * CLUSTER;
+                let (lo, hi) = (here.start.max(from), here.end.min(part.end * CLUSTER));
+                if lo >= hi {
+                    continue;
+                }
+                for d in 0..D {
+                    let dst = &mut chunk[d][lo - offset..hi - offset];
+                    for (x, y) in dst.iter_mut().zip(&buf[d][lo - from..hi - from]) {
+                        *x += *y;
+                    }
+                }
+            }
+        });
+    }
+}
+
+impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L, T, D> {
+    fn kind(&self) -> KernelKind {
+        KernelKind::ClusterPair
+    }
+
+    fn compute(
+        &mut self,
+        state: &State<T, D>,
+        forces: &mut Field<T, D>,
+        probe: bool,
+    ) -> ForceReport {
+        let n = state.len();
+        if n == 0 {
+            return ForceReport {
+                energy: probe.then_some(0.0),
+                ..Default::default()
+            };
+        }
+        let clock = Instant::now();
+        let compared = self.refresh(state);
+        let build_s = clock.elapsed().as_secs_f64();
+        let runs = self.runs();
+        let parallel = !probe && self.parts.len() > 1 && rayon::current_num_threads() > 1;
+        let sum = if parallel {
+            self.parallel();
+            TileSum::default()
+        } else if probe {
+            self.serial::<true>()
+        } else {
+            self.serial::<false>()
+        };
+        for d in 0..D {
+            gather(&self.force[d], &self.layout.padded_of, &mut forces[d]);
+        }
+        ForceReport {
+            energy: probe.then_some(sum.energy),
+            build_s,
+            work: WorkCounters {
+                pair_checks: runs * RUN_COST + compared.unwrap_or(0),
+                pairs_interacting: sum.interacting,
+                rebuilds: u64::from(compared.is_some()),
+                list_entries: runs,
+                ..Default::default()
+            },
+        }
+    }
+
+    /// The cluster order, exactly when the list is due for a rebuild; between rebuilds a new
+    /// order would only force one.
+    fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
+        if !self.due(state) && !self.handed_out {
+            return None;
+        }
+        self.layout.build(state, self.radius);
+        self.handed_out = true;
+        Some(self.layout.order.clone())
+    }
+
+    fn sort_every(&self) -> u64 {
+        1
+    }
+}
