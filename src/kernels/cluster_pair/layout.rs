@@ -27,6 +27,8 @@ pub struct Layout<T, const D: usize> {
     /// The grid of columns: origin, width, and columns along each axis but the last.
     origin: [f64; D],
     pub width: f64,
+    /// The box's extent along the last axis.
+    extent_last: f64,
     pub columns: [usize; D],
     /// First cluster of every column, then the number of clusters.
     pub column_start: Vec<u32>,
@@ -58,6 +60,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
         Layout {
             origin: [0.0; D],
             width: 1.0,
+            extent_last: 0.0,
             columns: [1; D],
             column_start: Vec::new(),
             order: Vec::new(),
@@ -145,40 +148,69 @@ impl<T: Real, const D: usize> Layout<T, D> {
         }
         self.origin = lo;
         self.width = width;
+        self.extent_last = extent[D - 1];
     }
 
-    /// Counting sort by column, then each column sorted along the last axis (ties by slot, so
-    /// the order does not depend on the thread count).
+    /// Counting sort by cell (a column cut along the last axis into cells half as long as the
+    /// column is wide), then each column sorted along the last axis by insertion, which moves
+    /// a particle only within its cell (ties by slot, so the order does not depend on the
+    /// thread count).
     fn sort(&mut self, state: &State<T, D>) {
         let n = state.len();
         let columns: usize = self.columns.iter().product();
-        let mut column = std::mem::take(&mut self.column);
-        column.resize(n, 0);
+        let cell = 0.5 * self.width;
+        let (base, extent) = (self.origin[D - 1], self.extent_last);
+        let cells = ((extent / cell) as usize + 1)
+            .min((4 * n + 64) / columns.max(1))
+            .max(1);
+        let mut key = std::mem::take(&mut self.column);
+        key.resize(n, 0);
         let fill = |offset: usize, out: &mut [u32]| {
             for (k, c) in out.iter_mut().enumerate() {
-                let x = std::array::from_fn(|d| state.pos[d][offset + k].as_f64());
-                *c = self.column_of(x) as u32;
+                let x: [f64; D] = std::array::from_fn(|d| state.pos[d][offset + k].as_f64());
+                let along = (((x[D - 1] - base) / cell).max(0.0) as usize).min(cells - 1);
+                *c = (self.column_of(x) * cells + along) as u32;
             }
         };
         if worth_forking(n * D) {
             let chunk = pass_chunk(n);
-            column
-                .par_chunks_mut(chunk)
+            key.par_chunks_mut(chunk)
                 .enumerate()
                 .for_each(|(k, out)| fill(k * chunk, out));
         } else {
-            fill(0, &mut column);
+            fill(0, &mut key);
         }
-        self.column = column;
-        self.sorter
-            .sort(&self.column, columns, &mut self.start, &mut self.place);
+        self.column = key;
+        self.sorter.sort(
+            &self.column,
+            columns * cells,
+            &mut self.start,
+            &mut self.place,
+        );
         order_of(&self.place, &mut self.order);
+        // Column `c` is the cells `c * cells..(c + 1) * cells`.
+        let bounds: Vec<u32> = (0..=columns).map(|c| self.start[c * cells]).collect();
+        self.start.clear();
+        self.start.extend_from_slice(&bounds);
         let last = &state.pos[D - 1];
         let by_last = |run: &mut [u32]| {
-            run.sort_unstable_by(|&a, &b| {
-                let (x, y) = (last[a as usize].as_f64(), last[b as usize].as_f64());
-                x.total_cmp(&y).then(a.cmp(&b))
-            })
+            let key = |s: u32| (last[s as usize].as_f64(), s);
+            for i in 1..run.len() {
+                let v = run[i];
+                let kv = key(v);
+                let mut j = i;
+                while j > 0
+                    && kv
+                        .0
+                        .total_cmp(&key(run[j - 1]).0)
+                        .then(kv.1.cmp(&run[j - 1]))
+                        .is_lt()
+                {
+                    run[j] = run[j - 1];
+                    j -= 1;
+                }
+                run[j] = v;
+            }
         };
         let mut runs = Vec::with_capacity(columns);
         let mut rest = &mut self.order[..];

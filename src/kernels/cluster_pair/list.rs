@@ -8,7 +8,6 @@
 
 use super::layout::{CLUSTER, GROUP, Layout};
 use crate::real::Real;
-use crate::simd::LANES;
 use std::ops::Range;
 
 /// The list of a range of i-clusters, built and evaluated as a unit (one per chunk of work a
@@ -36,17 +35,24 @@ impl Part {
 /// The lanes of a run from cluster `j0` that act for particle `a` of i-cluster `c`: clusters
 /// below `end`, their real particles, and in the i-cluster itself only the particles after `a`.
 pub fn run_masks(count: &[u8], c: usize, j0: usize, end: usize) -> [u16; CLUSTER] {
+    let mut valid = 0u16;
+    for q in 0..GROUP {
+        let j = j0 + q;
+        if j < end {
+            valid |= ((1u16 << count[j]) - 1) << (CLUSTER * q);
+        }
+    }
     std::array::from_fn(|a| {
-        let mut bits = 0u16;
         if a >= count[c] as usize {
             return 0;
         }
-        for l in 0..LANES {
-            let (j, b) = (j0 + l / CLUSTER, l % CLUSTER);
-            let keep = j < end && b < count[j] as usize && (j != c || b > a);
-            bits |= u16::from(keep) << l;
+        if (j0..j0 + GROUP).contains(&c) {
+            // In the i-cluster's own lanes, particles `b <= a` do not act.
+            let upto_a = (2u16 << a) - 1;
+            valid & !(upto_a << (CLUSTER * (c - j0)))
+        } else {
+            valid
         }
-        bits
     })
 }
 
@@ -80,9 +86,12 @@ pub fn build<T: Real, const D: usize>(
     };
     // The column of the first i-cluster, then stepped along with it.
     let mut own = starts.partition_point(|&s| s as usize <= clusters.start) - 1;
+    // Per column searched from the current column: its window for the last i-cluster.
+    let mut cursors: Vec<(usize, usize, usize)> = Vec::new();
     for c in clusters {
         while starts[own + 1] as usize <= c {
             own += 1;
+            cursors.clear();
         }
         let lo_i: [f64; D] = std::array::from_fn(|d| lo[d][c]);
         let hi_i: [f64; D] = std::array::from_fn(|d| hi[d][c]);
@@ -116,12 +125,38 @@ pub fn build<T: Real, const D: usize>(
                 let reach = (radius2 - gap2).sqrt();
                 let (s, e) = (starts[column] as usize, starts[column + 1] as usize);
                 let (below, above) = (lo_i[last] - reach, hi_i[last] + reach);
-                let from = if column == own {
-                    c
-                } else {
-                    s + hi[last][s..e].partition_point(|&h| h < below)
+                // The window of the last i-cluster of this column in `column`, moved to this
+                // one's: the i-clusters of a column come in order along the last axis, so the
+                // windows move a few clusters at a time.
+                let at = cursors.iter().position(|w| w.0 == column);
+                let (mut from, mut end) = match at {
+                    Some(k) => (cursors[k].1, cursors[k].2),
+                    None => {
+                        let from = s + hi[last][s..e].partition_point(|&h| h < below);
+                        (from, from)
+                    }
                 };
-                let end = from + lo[last][from..e].partition_point(|&l| l <= above);
+                while from > s && hi[last][from - 1] >= below {
+                    from -= 1;
+                }
+                while from < e && hi[last][from] < below {
+                    from += 1;
+                }
+                end = end.max(from);
+                while end > from && lo[last][end - 1] > above {
+                    end -= 1;
+                }
+                while end < e && lo[last][end] <= above {
+                    end += 1;
+                }
+                match at {
+                    Some(k) => cursors[k] = (column, from, end),
+                    None => cursors.push((column, from, end)),
+                }
+                if column == own {
+                    from = from.max(c);
+                    end = end.max(from);
+                }
                 searched += 1;
                 emit(c, from, end, part);
             }
@@ -134,6 +169,7 @@ pub fn build<T: Real, const D: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::simd::LANES;
 
     #[test]
     fn a_run_keeps_its_window_real_particles_and_each_pair_once() {
