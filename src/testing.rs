@@ -5,6 +5,15 @@ use crate::state::State;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
+/// Runs `f` on a fresh rayon pool of `p` threads.
+pub fn on_threads<R: Send>(p: usize, f: impl FnOnce() -> R + Send) -> R {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(p)
+        .build()
+        .expect("thread pool")
+        .install(f)
+}
+
 pub const SEED_1: u64 = 0x5eed_0001;
 pub const SEED_2: u64 = 0x5eed_0002;
 

@@ -94,6 +94,19 @@ impl Exclude {
     }
 }
 
+/// Sum of the lanes, as a tree (four dependent additions, not sixteen).
+#[inline(always)]
+pub fn lane_sum<T: Real>(mut v: [T; LANES]) -> T {
+    let mut width = LANES / 2;
+    while width > 0 {
+        for l in 0..width {
+            v[l] += v[l + width];
+        }
+        width /= 2;
+    }
+    v[0]
+}
+
 /// One pair: separation, squared distance and coefficient (the tail of a run).
 #[inline(always)]
 fn pair<T: Real, L: PairLaw<T>, const D: usize>(

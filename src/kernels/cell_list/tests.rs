@@ -5,7 +5,7 @@ use super::*;
 use crate::kernels::Naive;
 use crate::physics::{Coulomb, LennardJones};
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, random_state, spaced_state};
+use crate::testing::{SEED_1, SEED_2, on_threads, random_state, spaced_state};
 
 const SIGMA: f64 = 0.01;
 
@@ -19,14 +19,6 @@ fn tol<T: Real>() -> f64 {
 }
 
 /// Runs `f` on a rayon pool of `p` threads.
-fn on_threads<R: Send>(p: usize, f: impl FnOnce() -> R + Send) -> R {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(p)
-        .build()
-        .expect("thread pool")
-        .install(f)
-}
-
 /// Compares forces, energy and interacting pairs of `kernel` with the naive kernel on `state`,
 /// at 1 and 2 threads, both the timed and the probe path.
 fn agrees_with<T: Real, const D: usize>(

@@ -29,9 +29,9 @@ mod list;
 mod tests;
 mod tile;
 
-use super::verlet::moved_too_far;
+use super::verlet::{list_cutoff, moved_too_far};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters, worth_parallel};
-use crate::par::{chunk_len, for_chunks, gather};
+use crate::par::{gather, sum_spans};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -76,30 +76,7 @@ pub struct ClusterPair<L, T, const D: usize> {
 
 impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
     pub fn new(law: L, skin: f64) -> Result<Self, KernelError> {
-        let rc = match law.cutoff() {
-            Some(rc) if rc.is_finite() && rc > T::zero() => rc.as_f64(),
-            Some(rc) => {
-                return Err(KernelError::BadParam(format!(
-                    "the cluster-pair list needs a finite positive cutoff (got {rc})"
-                )));
-            }
-            None => {
-                return Err(KernelError::BadParam(format!(
-                    "the cluster-pair list needs a law with a cutoff; {} has none",
-                    law.kind().name()
-                )));
-            }
-        };
-        if !(skin.is_finite() && skin > 0.0) {
-            return Err(KernelError::BadParam(format!(
-                "the cluster-pair skin must be a finite number > 0 (got {skin})"
-            )));
-        }
-        if !(1..=3).contains(&D) {
-            return Err(KernelError::BadParam(format!(
-                "the cluster-pair list works in 1 to 3 dimensions (got {D})"
-            )));
-        }
+        let rc = list_cutoff::<T, L, D>(&law, skin, "the cluster-pair list")?;
         let radius = rc + skin;
         Ok(ClusterPair {
             law,
@@ -227,27 +204,13 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         for f in self.force.iter_mut() {
             f.resize(slots, T::zero());
         }
-        let (parts, buffers) = (&self.parts, &self.buffers);
+        let spans: Vec<_> = self
+            .parts
+            .iter()
+            .map(|p| p.clusters.start * CLUSTER..p.end * CLUSTER)
+            .collect();
         let out = self.force.each_mut().map(|f| &mut f[..slots]);
-        for_chunks(out, 0, chunk_len(slots).max(4096), &|offset, chunk| {
-            let here = offset..offset + chunk[0].len();
-            for d in 0..D {
-                chunk[d].fill(T::zero());
-            }
-            for (part, buf) in parts.iter().zip(buffers) {
-                let from = part.clusters.start * CLUSTER;
-                let (lo, hi) = (here.start.max(from), here.end.min(part.end * CLUSTER));
-                if lo >= hi {
-                    continue;
-                }
-                for d in 0..D {
-                    let dst = &mut chunk[d][lo - offset..hi - offset];
-                    for (x, y) in dst.iter_mut().zip(&buf[d][lo - from..hi - from]) {
-                        *x += *y;
-                    }
-                }
-            }
-        });
+        sum_spans(out, &spans, &self.buffers);
     }
 }
 

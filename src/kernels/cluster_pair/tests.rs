@@ -6,7 +6,7 @@ use super::*;
 use crate::kernels::Naive;
 use crate::physics::LennardJones;
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, spaced_state};
+use crate::testing::{SEED_1, SEED_2, on_threads, spaced_state};
 
 const SIGMA: f64 = 0.01;
 const SKIN: f64 = 0.3 * SIGMA;
@@ -18,14 +18,6 @@ fn lj<T: Real>(rc: f64) -> LennardJones<T> {
 /// Relative force tolerance (of the largest force) for a precision: summation order differs.
 fn tol<T: Real>() -> f64 {
     if T::EPSILON_F64 > 1e-10 { 1e-4 } else { 1e-10 }
-}
-
-fn on_threads<R: Send>(p: usize, f: impl FnOnce() -> R + Send) -> R {
-    rayon::ThreadPoolBuilder::new()
-        .num_threads(p)
-        .build()
-        .expect("thread pool")
-        .install(f)
 }
 
 /// The largest |a − b| over particles over the largest |b|.

@@ -8,6 +8,7 @@
 
 use super::layout::{CLUSTER, Layout};
 use super::list::Part;
+use crate::kernels::rows::lane_sum;
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
 use crate::simd::LANES;
@@ -114,17 +115,4 @@ pub fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
         energy: energy.iter().map(|e| e.as_f64()).sum(),
         interacting: interacting.iter().map(|&c| c as u64).sum(),
     }
-}
-
-/// Sum of the lanes, as a tree.
-#[inline(always)]
-fn lane_sum<T: Real>(mut v: [T; LANES]) -> T {
-    let mut width = LANES / 2;
-    while width > 0 {
-        for l in 0..width {
-            v[l] += v[l + width];
-        }
-        width /= 2;
-    }
-    v[0]
 }

@@ -15,7 +15,7 @@
 //! - [`target_rows`]: every partner of each target (a full list: no reactions).
 
 use super::list::Part;
-use crate::kernels::rows::{LANES, RowSum};
+use crate::kernels::rows::{LANES, RowSum, lane_sum};
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
 use crate::state::State;
@@ -136,19 +136,6 @@ fn evaluate<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
         }
     }
     f
-}
-
-/// Sum of the lanes, as a tree (four dependent additions, not sixteen).
-#[inline(always)]
-fn lane_sum<T: Real>(mut v: [T; LANES]) -> T {
-    let mut width = LANES / 2;
-    while width > 0 {
-        for l in 0..width {
-            v[l] += v[l + width];
-        }
-        width /= 2;
-    }
-    v[0]
 }
 
 /// The entries `e..e + LANES` of `v` as a block (the padding keeps it in range).

@@ -35,7 +35,7 @@ mod tests;
 mod work;
 
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters};
-use crate::par::{chunk_len, for_chunks, pass_chunk, worth_forking};
+use crate::par::{pass_chunk, sum_spans, worth_forking};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -73,30 +73,7 @@ pub struct Verlet<L, T, const D: usize> {
 
 impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
     pub fn new(law: L, skin: f64) -> Result<Self, KernelError> {
-        let rc = match law.cutoff() {
-            Some(rc) if rc.is_finite() && rc > T::zero() => rc.as_f64(),
-            Some(rc) => {
-                return Err(KernelError::BadParam(format!(
-                    "the Verlet list needs a finite positive cutoff (got {rc})"
-                )));
-            }
-            None => {
-                return Err(KernelError::BadParam(format!(
-                    "the Verlet list needs a law with a cutoff; {} has none",
-                    law.kind().name()
-                )));
-            }
-        };
-        if !(skin.is_finite() && skin > 0.0) {
-            return Err(KernelError::BadParam(format!(
-                "the Verlet skin must be a finite number > 0 (got {skin})"
-            )));
-        }
-        if !(1..=3).contains(&D) {
-            return Err(KernelError::BadParam(format!(
-                "the Verlet list works in 1 to 3 dimensions (got {D})"
-            )));
-        }
+        let rc = list_cutoff::<T, L, D>(&law, skin, "the Verlet list")?;
         let radius = rc + skin;
         Ok(Verlet {
             law,
@@ -224,32 +201,9 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
                     || loops::half_pairs::<T, L, D, false>(law, &slots, part, &mut out, base),
                 );
             });
-        let (parts, buffers) = (&self.parts, &self.buffers);
+        let spans: Vec<_> = self.parts.iter().map(|p| p.span.clone()).collect();
         let out = forces.each_mut().map(|f| f.as_mut_slice());
-        for_chunks(
-            out,
-            0,
-            chunk_len(state.len()).max(4096),
-            &|offset, chunk| {
-                let here = offset..offset + chunk[0].len();
-                for d in 0..D {
-                    chunk[d].fill(T::zero());
-                }
-                for (part, buf) in parts.iter().zip(buffers) {
-                    let (lo, hi) = (here.start.max(part.span.start), here.end.min(part.span.end));
-                    if lo >= hi {
-                        continue;
-                    }
-                    let from = part.span.start;
-                    for d in 0..D {
-                        let dst = &mut chunk[d][lo - offset..hi - offset];
-                        for (x, y) in dst.iter_mut().zip(&buf[d][lo - from..hi - from]) {
-                            *x += *y;
-                        }
-                    }
-                }
-            },
-        );
+        sum_spans(out, &spans, &self.buffers);
     }
 }
 
@@ -349,6 +303,40 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
     fn sort_every(&self) -> u64 {
         1
     }
+}
+
+/// The cutoff of `law` for a neighbour list (`what`) with this skin in `D` dimensions, or why
+/// the combination has none.
+pub(crate) fn list_cutoff<T: Real, L: PairLaw<T>, const D: usize>(
+    law: &L,
+    skin: f64,
+    what: &str,
+) -> Result<f64, KernelError> {
+    let rc = match law.cutoff() {
+        Some(rc) if rc.is_finite() && rc > T::zero() => rc.as_f64(),
+        Some(rc) => {
+            return Err(KernelError::BadParam(format!(
+                "{what} needs a finite positive cutoff (got {rc})"
+            )));
+        }
+        None => {
+            return Err(KernelError::BadParam(format!(
+                "{what} needs a law with a cutoff; {} has none",
+                law.kind().name()
+            )));
+        }
+    };
+    if !(skin.is_finite() && skin > 0.0) {
+        return Err(KernelError::BadParam(format!(
+            "the skin of {what} must be a finite number > 0 (got {skin})"
+        )));
+    }
+    if !(1..=3).contains(&D) {
+        return Err(KernelError::BadParam(format!(
+            "{what} works in 1 to 3 dimensions (got {D})"
+        )));
+    }
+    Ok(rc)
 }
 
 /// Whether some slot of `state` is more than half the skin away from its position in
