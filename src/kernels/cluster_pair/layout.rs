@@ -10,7 +10,7 @@
 
 use crate::kernels::cell_list::grid::bounding_box;
 use crate::kernels::counting_sort::{CountingSort, order_of};
-use crate::par::{gather, pass_chunk, worth_forking};
+use crate::par::{Disjoint, gather, pass_chunk, worth_forking};
 use crate::real::Real;
 use crate::simd;
 use crate::simd::LANES;
@@ -113,7 +113,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
         );
         self.grid(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
         self.sort(state);
-        self.cut(state);
+        self.cut();
         self.refresh(state);
         self.boxes();
         self.column_extents();
@@ -229,32 +229,59 @@ impl<T: Real, const D: usize> Layout<T, D> {
 
     /// Cuts each column into clusters: the padded slots, their particles and counts; then
     /// `GROUP - 1` empty clusters, so that a run of `GROUP` clusters may start at any one.
-    fn cut(&mut self, state: &State<T, D>) {
-        let n = state.len();
+    fn cut(&mut self) {
+        let n = self.order.len();
         let columns: usize = self.columns.iter().product();
         self.column_start.clear();
-        self.slot_of.clear();
-        self.count.clear();
-        self.padded_of.resize(n, 0);
+        let mut clusters = 0;
         for c in 0..columns {
-            self.column_start.push(self.count.len() as u32);
-            let run = &self.order[self.start[c] as usize..self.start[c + 1] as usize];
-            for cluster in run.chunks(CLUSTER) {
-                for &s in cluster {
-                    self.padded_of[s as usize] = self.slot_of.len() as u32;
-                    self.slot_of.push(s);
+            self.column_start.push(clusters as u32);
+            clusters += ((self.start[c + 1] - self.start[c]) as usize).div_ceil(CLUSTER);
+        }
+        self.column_start.push(clusters as u32);
+        self.slot_of.resize((clusters + GROUP - 1) * CLUSTER, 0);
+        self.count.resize(clusters + GROUP - 1, 0);
+        self.padded_of.resize(n, 0);
+        // Each column's clusters, as their own slices, filled on the pool's threads.
+        let mut pieces = Vec::with_capacity(columns);
+        let mut slots = &mut self.slot_of[..clusters * CLUSTER];
+        let mut counts = &mut self.count[..clusters];
+        for c in 0..columns {
+            let m = (self.column_start[c + 1] - self.column_start[c]) as usize;
+            let (s, rest) = std::mem::take(&mut slots).split_at_mut(m * CLUSTER);
+            slots = rest;
+            let (k, rest) = std::mem::take(&mut counts).split_at_mut(m);
+            counts = rest;
+            pieces.push((c, s, k));
+        }
+        let padded_of = Disjoint::new(&mut self.padded_of);
+        let (order, start, column_start) = (&self.order, &self.start, &self.column_start);
+        let fill = |(c, slots, counts): (usize, &mut [u32], &mut [u8])| {
+            let run = &order[start[c] as usize..start[c + 1] as usize];
+            let base = column_start[c] as usize * CLUSTER;
+            for (q, cluster) in run.chunks(CLUSTER).enumerate() {
+                let at = q * CLUSTER;
+                for (m, &s) in cluster.iter().enumerate() {
+                    slots[at + m] = s;
+                    // SAFETY: every particle is in one cluster of one column.
+                    unsafe { padded_of.write(s as usize, (base + at + m) as u32) };
                 }
                 let last = *cluster.last().expect("chunks are not empty");
-                self.slot_of
-                    .extend(std::iter::repeat_n(last, CLUSTER - cluster.len()));
-                self.count.push(cluster.len() as u8);
+                slots[at + cluster.len()..at + CLUSTER].fill(last);
+                counts[q] = cluster.len() as u8;
             }
+        };
+        if worth_forking(n) {
+            pieces.into_par_iter().for_each(fill);
+        } else {
+            pieces.into_iter().for_each(fill);
         }
-        self.column_start.push(self.count.len() as u32);
-        let last = self.slot_of.last().copied().unwrap_or(0);
-        self.slot_of
-            .extend(std::iter::repeat_n(last, (GROUP - 1) * CLUSTER));
-        self.count.extend(std::iter::repeat_n(0, GROUP - 1));
+        let last = match clusters {
+            0 => 0,
+            _ => self.slot_of[clusters * CLUSTER - 1],
+        };
+        self.slot_of[clusters * CLUSTER..].fill(last);
+        self.count[clusters..].fill(0);
     }
 
     /// The clusters that hold particles (the empty ones after them left out).
@@ -315,32 +342,53 @@ impl<T: Real, const D: usize> Layout<T, D> {
     /// Rewrites the layout for a state permuted by `order` (`state'[k] = state[order[k]]`), as
     /// the engine does with the order `spatial_order` hands out: the clusters stay, their
     /// particles' slots change. Returns false (nothing changed) unless the positions of
-    /// `state` are exactly those the layout expects.
+    /// `state` are exactly those the layout expects. On the pool's threads when worth it.
     pub fn adopt(&mut self, state: &State<T, D>) -> bool {
         let n = state.len();
         if self.order.len() != n {
             return false;
         }
-        let matches = (0..D).all(|d| {
-            self.order
-                .iter()
-                .enumerate()
-                .all(|(k, &s)| state.pos[d][k] == self.pos[d][self.padded_of[s as usize] as usize])
-        });
+        let (order, padded_of, pos) = (&self.order, &self.padded_of, &self.pos);
+        let same = |k: usize| {
+            let p = padded_of[order[k] as usize] as usize;
+            (0..D).all(|d| state.pos[d][k] == pos[d][p])
+        };
+        let matches = if worth_forking(n * D) {
+            (0..n).into_par_iter().with_min_len(4096).all(same)
+        } else {
+            (0..n).all(same)
+        };
         if !matches {
             return false;
         }
-        // The old slot `order[k]` is now slot `k`.
-        for (k, &s) in self.order.iter().enumerate() {
-            self.place[s as usize] = k as u32;
-        }
-        for s in self.slot_of.iter_mut() {
-            *s = self.place[*s as usize];
-        }
-        let old = std::mem::take(&mut self.padded_of);
-        self.padded_of = self.order.iter().map(|&s| old[s as usize]).collect();
-        for (k, o) in self.order.iter_mut().enumerate() {
-            *o = k as u32;
+        // Slot `k` now holds the particle of the old slot `order[k]`. The padding keeps its
+        // old slots: any particle serves it, its lanes never act.
+        let mut moved = Vec::new();
+        gather(&self.padded_of, &self.order, &mut moved);
+        self.padded_of = moved;
+        let slot_of = Disjoint::new(&mut self.slot_of);
+        let write = |k: usize, &p: &u32| {
+            // SAFETY: every particle has its own padded slot.
+            unsafe { slot_of.write(p as usize, k as u32) }
+        };
+        let identity = |(k, o): (usize, &mut u32)| *o = k as u32;
+        if worth_forking(n) {
+            self.padded_of
+                .par_iter()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(|(k, p)| write(k, p));
+            self.order
+                .par_iter_mut()
+                .enumerate()
+                .with_min_len(4096)
+                .for_each(identity);
+        } else {
+            self.padded_of
+                .iter()
+                .enumerate()
+                .for_each(|(k, p)| write(k, p));
+            self.order.iter_mut().enumerate().for_each(identity);
         }
         true
     }
