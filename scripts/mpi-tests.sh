@@ -120,7 +120,7 @@ refuses 2 "needs --kernel cell-list or verlet" run --decomp domain --scenario lj
 refuses 2 "--decomp tree distributes the Barnes-Hut tree and needs --kernel octree" run --decomp tree --scenario galaxy --kernel naive -n 100
 refuses 2 "--decomp octants distributes the Barnes-Hut tree and needs --kernel octree" run --decomp octants --scenario galaxy --kernel cell-list -n 100
 refuses 2 "--rank-grid applies to --decomp domain only" run --decomp tree --scenario galaxy --kernel octree -n 100 --rank-grid 2x1
-refuses 2 "--skin applies to the verlet kernel only" run --decomp allgather --scenario lj-box --kernel cell-list -n 100 --skin 0.003
+refuses 2 "--skin applies to the verlet and cluster-pair kernels only" run --decomp allgather --scenario lj-box --kernel cell-list -n 100 --skin 0.003
 refuses 1 "needs at least 2 ranks" mpi-bench --out "$TMP/bench.json"
 refuses 3 "still outside the box after one reflection" \
     run --decomp domain --scenario lj-box --kernel cell-list -n 60 --density 20 --dt 0.1 --steps 20

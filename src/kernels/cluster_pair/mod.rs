@@ -168,10 +168,16 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         let (law, clusters) = (&self.law, Clusters::of(&self.layout));
         let mut sum = TileSum::default();
         for part in &self.parts {
-            let s = simd::dispatch(
-                #[inline(always)]
-                || part_forces::<T, L, D, PROBE>(law, &clusters, part, &mut out, 0),
-            );
+            // Probe steps are not timed: their loop is compiled once, for the baseline
+            // instruction set, rather than once per set (less to compile).
+            let s = if PROBE {
+                part_forces::<T, L, D, true>(law, &clusters, part, &mut out, 0)
+            } else {
+                simd::dispatch(
+                    #[inline(always)]
+                    || part_forces::<T, L, D, false>(law, &clusters, part, &mut out, 0),
+                )
+            };
             sum.energy += s.energy;
             sum.interacting += s.interacting;
         }
