@@ -23,8 +23,8 @@ pub fn list() -> anyhow::Result<i32> {
                 "half neighbour list, cutoff + --skin, rebuilt when a particle moved skin/2; O(n)"
             }
             KernelKind::ClusterPair => {
-                "Verlet list of 4x4 particle clusters, one SIMD tile per pair, for dense \
-                 systems; --skin as verlet; O(n)"
+                "Verlet list of 4-particle clusters against 16-particle runs, one SIMD block \
+                 each, for dense systems; --skin as verlet; O(n)"
             }
         };
         outln!("  {:<12} {what}", k.name());

@@ -29,7 +29,7 @@ fn kernel_bytes(kernel: KernelKind, dim: usize, threads: usize) -> usize {
         KernelKind::Octree => 112,
         KernelKind::Verlet => 170,
         // Padded slots with their particle, position, strength and force; the positions at
-        // the build; cluster boxes; about three 4-byte tiles per particle in the liquid.
+        // the build; cluster boxes; about 0.7 runs of 12 bytes per particle in the liquid.
         KernelKind::ClusterPair => 120,
     }
 }

@@ -54,8 +54,8 @@ pub enum KernelKind {
     /// Half neighbour list within the cutoff plus a skin, rebuilt from cell-list bins only when
     /// some particle has moved more than half the skin (O(n)).
     Verlet,
-    /// Verlet list of 4 × 4 cluster pairs (GROMACS nbnxm style), one SIMD tile per pair, for
-    /// dense systems (O(n)).
+    /// Verlet list of 4-particle clusters (GROMACS nbnxm style), each against runs of 16
+    /// particles in one SIMD block, for dense systems (O(n)).
     ClusterPair,
 }
 

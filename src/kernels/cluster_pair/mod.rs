@@ -1,18 +1,19 @@
 //! `cluster-pair`: the Verlet list of a dense system, made of clusters of four particles rather
 //! than of particles (the scheme of GROMACS's nbnxm). Particles are sorted into clusters of
-//! neighbours ([`layout`]); the list holds pairs of clusters whose bounding boxes come within
-//! the cutoff plus a skin ([`list`]); each pair is one SIMD tile of 4 × 4 particle pairs
-//! ([`tile`]). It is kept, like the `verlet` list, until some particle has moved more than half
-//! the skin since the build, so the forces are exact at every step.
+//! neighbours ([`layout`]); the list holds, for each cluster, runs of four consecutive clusters
+//! that cover those whose bounding boxes come within the cutoff plus a skin ([`list`]); each
+//! particle of the cluster meets a run's 16 particles in one SIMD block ([`tile`]). It is kept,
+//! like the `verlet` list, until some particle has moved more than half the skin since the
+//! build, so the forces are exact at every step.
 //!
-//! Against a list of particle pairs it computes more pairs (those of a tile beyond the cutoff)
-//! but each far more cheaply: four contiguous loads instead of gathers, the i-cluster's forces
+//! Against a list of particle pairs it computes more pairs (those of a run beyond the cutoff)
+//! but each far more cheaply: one contiguous load per array instead of gathers, the i-cluster's forces
 //! in registers across its list, no branch per pair. The dense liquid, with about eight
-//! partners per particle, is its case; in a dilute gas most tiles are nearly empty and
+//! partners per particle, is its case; in a dilute gas most lanes are empty and
 //! `verlet` is the better list.
 //!
-//! - Half list: each cluster pair once (j at or after i), both ends updated; a cluster's tile
-//!   with itself keeps the pairs `j > i` of its lanes.
+//! - Half list: each cluster pair once (j at or after i), both ends updated; within the
+//!   cluster itself only the pairs `j > i` act (lane masks, see [`list`]).
 //! - On several threads each part of the list (a range of i-clusters, several per thread)
 //!   adds into a buffer over the clusters it touches, and the buffers are summed.
 //! - At a rebuild the particles are re-sorted into cluster order ([`ForceKernel::sort_every`]
@@ -21,7 +22,7 @@
 //!
 //! Memory, kept between rebuilds: per padded slot (at most one slot of padding per column) its
 //! particle, position, strength and force; per particle its position at the build and its
-//! slot; per cluster its box; 4 bytes per cluster pair.
+//! slot; per cluster its box; per run 12 bytes (its first cluster and four lane masks).
 
 mod layout;
 mod list;
