@@ -109,7 +109,7 @@ pub struct KernelArgs {
     /// when s/d < theta [default: 0.5].
     #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub theta: Option<f64>,
-    /// Expansion order of the tree nodes the octree accepts (octree only) [default: monopole].
+    /// Expansion order of the tree nodes the octree accepts (octree only) [default: quadrupole].
     #[arg(long, value_enum)]
     pub multipole: Option<Multipole>,
     /// Most particles in a tree leaf (octree only) [default: 8].

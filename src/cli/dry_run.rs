@@ -237,7 +237,9 @@ pub fn refuse_long_run(
         threads: kernel_args.threads,
         ranks: 1,
         theta: kernel_args.theta,
-        multipole: kernel_args.multipole.unwrap_or_default(),
+        multipole: kernel_args
+            .multipole
+            .unwrap_or(nbody_bench::kernels::KernelParams::default().multipole),
         seed: setup.seed,
         precision: setup.precision,
         time_factor: 1,

@@ -244,7 +244,7 @@ fn default_theta() -> Vec<f64> {
     vec![0.5]
 }
 fn default_multipole() -> Vec<crate::kernels::Multipole> {
-    vec![crate::kernels::Multipole::Monopole]
+    vec![crate::kernels::KernelParams::default().multipole]
 }
 fn default_out() -> PathBuf {
     PathBuf::from("results")

@@ -98,7 +98,9 @@ pub fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> 
     if let Some(theta) = case.theta {
         a.extend(["--theta".to_string(), theta.to_string()]);
     }
-    if case.multipole != crate::kernels::Multipole::Monopole {
+    // Whenever there is a θ (an octree case): the binary's default order is not the one of
+    // every case.
+    if case.theta.is_some() {
         a.extend(["--multipole".to_string(), case.multipole.name().to_string()]);
     }
     if let Some(p) = case.precision {

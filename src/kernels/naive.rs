@@ -1,7 +1,8 @@
 //! `naive`: every target against every other particle, n(n−1) pair evaluations (the form of the
 //! MPI source code). Targets are independent, so it parallelizes over them without races.
 
-use super::rows::{Exclude, RowSum, Sources, Target, gather_excluding};
+use super::broadcast::{Tile, tile_forces};
+use super::rows::{Exclude, LANES, RowSum, Sources, Target, gather_excluding};
 use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
 use crate::par::{chunk_len, for_chunks};
 use crate::physics::PairLaw;
@@ -47,6 +48,27 @@ fn rows<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
         total.interacting += sum.interacting;
     }
     total
+}
+
+/// The timed path of [`rows`]: the targets `offset..offset + out.len()` in tiles of `LANES`,
+/// each against every particle.
+#[inline(always)]
+fn tiles<T: Real, L: PairLaw<T>, const D: usize>(
+    law: &L,
+    state: &State<T, D>,
+    offset: usize,
+    out: [&mut [T]; D],
+) {
+    let all = Sources::range(&state.pos, &state.source, 0, state.len());
+    for lo in (0..out[0].len()).step_by(LANES) {
+        let len = LANES.min(out[0].len() - lo);
+        let i = offset + lo;
+        let tile = Tile::load(&state.pos, &state.source, i, i + len);
+        let force = tile_forces(law, &tile, &all, i);
+        for d in 0..D {
+            out[d][lo..lo + len].copy_from_slice(&force[d][..len]);
+        }
+    }
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
@@ -101,14 +123,14 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
                 &|offset, chunk| {
                     simd::dispatch(
                         #[inline(always)]
-                        || rows::<T, L, D, false>(law, state, offset, chunk),
+                        || tiles(law, state, offset, chunk),
                     );
                 },
             );
         } else {
             simd::dispatch(
                 #[inline(always)]
-                || rows::<T, L, D, false>(law, state, targets.start, out),
+                || tiles(law, state, targets.start, out),
             );
         }
         ForceReport {

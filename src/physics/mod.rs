@@ -110,6 +110,13 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     /// Force coefficient at squared distance `r2`; zero for pairs that do not interact.
     fn coeff(&self, r2: T, si: T, sj: T) -> T;
 
+    /// [`PairLaw::coeff`] as the textbook writes it (a square root and a division where the
+    /// kernels use [`Real::rsqrt`]): what the f64 reference sum computes, so that the kernels
+    /// are checked against a formula they do not share.
+    fn reference_coeff(&self, r2: T, si: T, sj: T) -> T {
+        self.coeff(r2, si, sj)
+    }
+
     /// Potential energy of the pair at squared distance `r2`; zero for pairs that do not interact.
     fn energy(&self, r2: T, si: T, sj: T) -> T;
 
@@ -139,7 +146,7 @@ pub fn pair_force<T: Real, L: PairLaw<T>, const D: usize>(
     for d in 0..D {
         r2 += dx[d] * dx[d];
     }
-    let c = law.coeff(r2, si, sj);
+    let c = law.reference_coeff(r2, si, sj);
     std::array::from_fn(|d| c * dx[d])
 }
 

@@ -92,9 +92,12 @@ impl SystemJob for Prepare {
                     KernelKind::CellList => {
                         Box::new(CellList::new(system.law).map_err(|e| kernel_error(&e))?)
                     }
-                    KernelKind::Octree => {
-                        Box::new(Octree::new(system.law, params.theta, params.leaf_size))
-                    }
+                    KernelKind::Octree => Box::new(Octree::with_multipole(
+                        system.law,
+                        params.theta,
+                        params.leaf_size,
+                        params.multipole,
+                    )),
                     KernelKind::Verlet => Box::new(
                         Verlet::new(system.law, params.skin).map_err(|e| kernel_error(&e))?,
                     ),

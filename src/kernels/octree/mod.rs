@@ -72,7 +72,9 @@ pub const GROUP_SIZE: usize = 32;
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum Multipole {
-    /// Total strength at the centre of strength: the node acts as one particle.
+    /// Total strength at the centre of strength: the node acts as one particle. The default
+    /// when reading files written before the order was recorded (the default order of a new
+    /// run is `KernelParams`'s).
     #[default]
     Monopole,
     /// Monopole plus the second moments about the centre (the dipole vanishes there).

@@ -122,7 +122,9 @@ impl<T: Real, const D: usize> NodeList<T, D> {
             let mut inv2 = [T::zero(); LANES];
             for l in 0..LANES {
                 c1[l] = law.coeff(r2[l], t.s, one);
-                inv2[l] = one / (r2[l] + eps2);
+                // The same reciprocal square root as the law's (LLVM computes it once).
+                let inv = (r2[l] + eps2).rsqrt();
+                inv2[l] = inv * inv;
             }
             // Q y, yᵀQy − ε²T, and the scalar factor of y.
             let mut qy = [[T::zero(); LANES]; D];

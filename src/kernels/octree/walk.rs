@@ -3,13 +3,12 @@
 //!
 //! The list is a small SoA array of sources: the group's own particles first, then, in walk
 //! order, the centres and total strengths of accepted nodes (a monopole acts exactly like one
-//! particle there) and the particles of opened leaves. One `rows::gather` per target over this list does
-//! both the particle-node and particle-particle work in full SIMD blocks. On the timed path the
-//! list is padded to a multiple of `LANES` with zero-strength sources outside the bounding cube,
-//! and the target's own slot is swapped for such a source while it gathers, so the self-pair is
-//! excluded without a scalar tail. (A zero-strength source exerts no force: the law is linear in
-//! the source strength, which the monopole approximation already relies on.) The probe path
-//! instead splits the run around the target, so the interaction counts see only real sources.
+//! particle there) and the particles of opened leaves. On the timed path the group's particles
+//! are taken in tiles of `LANES` targets, and each list entry is broadcast to a whole tile
+//! (`broadcast::tile_forces`), which does both the particle-node and the particle-particle
+//! work; lane l skips the list slot that holds its own particle. The probe path gathers one
+//! target at a time (`rows::gather`), splitting the run around the target, so the interaction
+//! counts see only real sources.
 //!
 //! At quadrupole order the walk (monomorphized with `QUAD`) writes the accepted nodes' arena
 //! indices instead, and each group's node list (`nodes::NodeList`) is filled from them; every
@@ -18,6 +17,7 @@
 use super::nodes::NodeList;
 use super::tree::{Group, Tree};
 use crate::kernels::WorkCounters;
+use crate::kernels::broadcast::{Tile, tile_forces};
 use crate::kernels::rows::{LANES, Sources, Target, gather};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -63,17 +63,6 @@ impl<T: Real, const D: usize> Scratch<T, D> {
         }
     }
 
-    /// Writes a source at the end of the list and keeps it if `keep` (branch-free).
-    #[inline(always)]
-    fn push_if(&mut self, x: [T; D], s: T, keep: bool) {
-        let k = self.len;
-        for d in 0..D {
-            self.pos[d][k] = x[d];
-        }
-        self.src[k] = s;
-        self.len += keep as usize;
-    }
-
     /// Appends sorted particles `lo..hi` of the tree.
     #[inline(always)]
     fn push_range(&mut self, tree: &Tree<T, D>, lo: usize, hi: usize) {
@@ -90,17 +79,6 @@ impl<T: Real, const D: usize> Scratch<T, D> {
     #[inline(always)]
     fn sources(&self, lo: usize, hi: usize) -> Sources<'_, T, D> {
         Sources::range(&self.pos, &self.src, lo, hi)
-    }
-
-    /// Swaps slot `k` with `(x, s)`, returning what was there.
-    #[inline(always)]
-    fn swap(&mut self, k: usize, x: [T; D], s: T) -> ([T; D], T) {
-        let old = (std::array::from_fn(|d| self.pos[d][k]), self.src[k]);
-        for d in 0..D {
-            self.pos[d][k] = x[d];
-        }
-        self.src[k] = s;
-        old
     }
 }
 
@@ -281,34 +259,72 @@ fn eval_order<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const Q
                 c.store(each, Ordering::Relaxed);
             }
         }
-        if !PROBE {
-            let padded = real.next_multiple_of(LANES);
-            list.reserve(padded - real);
-            while list.len < padded {
-                list.push_if(tree.dummy, T::zero(), true);
-            }
-        }
         let out = out.each_mut().map(|o| &mut o[start - offset..end - offset]);
-        let (energy, interacting) = simd::dispatch(
-            #[inline(always)]
-            || group_forces::<T, L, D, PROBE, QUAD>(law, tree, start, real, list, out),
-        );
-        totals.energy += energy;
-        totals.interacting += interacting;
+        if PROBE {
+            let (energy, interacting) = simd::dispatch(
+                #[inline(always)]
+                || probe_forces::<T, L, D, QUAD>(law, tree, start, real, list, out),
+            );
+            totals.energy += energy;
+            totals.interacting += interacting;
+        } else {
+            simd::dispatch(
+                #[inline(always)]
+                || group_forces::<T, L, D, QUAD>(law, tree, start, list, out),
+            );
+        }
     }
     totals
 }
 
 /// Forces on the group's particles (sorted slots `start..start + out.len()`, list slots
-/// `0..out.len()`) from the first `real` entries of its list (and with `QUAD` its node list);
-/// returns the energy and the interacting count when probing.
+/// `0..out.len()`) from its list (and with `QUAD` its node list): the particles in tiles of
+/// `LANES`, each source of the list broadcast to a whole tile (`broadcast::tile_forces`).
 #[inline(always)]
-fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const QUAD: bool>(
+fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const QUAD: bool>(
+    law: &L,
+    tree: &Tree<T, D>,
+    start: usize,
+    list: &Scratch<T, D>,
+    out: [&mut [T]; D],
+) {
+    let sources = list.sources(0, list.len);
+    for lo in (0..out[0].len()).step_by(LANES) {
+        let len = LANES.min(out[0].len() - lo);
+        let tile = Tile::load(&tree.pos, &tree.src, start + lo, start + lo + len);
+        // The group's own particles are the list's first entries: lane l sits at slot lo + l.
+        let force = tile_forces(law, &tile, &sources, lo);
+        for d in 0..D {
+            out[d][lo..lo + len].copy_from_slice(&force[d][..len]);
+        }
+    }
+    if QUAD {
+        // The nodes in the gather form, one target at a time: with each node broadcast to a
+        // tile instead (its ten values each), the loop measured 10–15 % slower.
+        for k in 0..out[0].len() {
+            let i = start + k;
+            let t = Target {
+                x: std::array::from_fn(|d| tree.pos[d][i]),
+                s: tree.src[i],
+            };
+            let sum = list.nodes.gather::<L, false>(law, &t);
+            for d in 0..D {
+                out[d][k] += sum.force[d];
+            }
+        }
+    }
+}
+
+/// The probe's [`group_forces`]: one target at a time with the gather form, the run split
+/// around the target so that the interaction counts see only real sources; returns the
+/// energy and the interacting count.
+#[inline(always)]
+fn probe_forces<T: Real, L: PairLaw<T>, const D: usize, const QUAD: bool>(
     law: &L,
     tree: &Tree<T, D>,
     start: usize,
     real: usize,
-    list: &mut Scratch<T, D>,
+    list: &Scratch<T, D>,
     out: [&mut [T]; D],
 ) -> (f64, u64) {
     let (mut energy, mut interacting) = (0.0, 0);
@@ -318,32 +334,20 @@ fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const
             x: std::array::from_fn(|d| tree.pos[d][i]),
             s: tree.src[i],
         };
-        let mut sum = if PROBE {
-            // Split the run around the target: only real sources are counted.
-            let mut sum = gather::<T, L, D, true>(law, &t, &list.sources(0, k));
-            sum.add(&gather::<T, L, D, true>(
-                law,
-                &t,
-                &list.sources(k + 1, real),
-            ));
-            sum
-        } else {
-            // Full blocks only: the target's own slot holds a zero-strength source meanwhile.
-            let own = list.swap(k, tree.dummy, T::zero());
-            let sum = gather::<T, L, D, false>(law, &t, &list.sources(0, list.len));
-            list.swap(k, own.0, own.1);
-            sum
-        };
+        let mut sum = gather::<T, L, D, true>(law, &t, &list.sources(0, k));
+        sum.add(&gather::<T, L, D, true>(
+            law,
+            &t,
+            &list.sources(k + 1, real),
+        ));
         if QUAD {
-            sum.add(&list.nodes.gather::<L, PROBE>(law, &t));
+            sum.add(&list.nodes.gather::<L, true>(law, &t));
         }
         for d in 0..D {
             out[d][k] = sum.force[d];
         }
-        if PROBE {
-            energy += sum.energy.as_f64();
-            interacting += sum.interacting;
-        }
+        energy += sum.energy.as_f64();
+        interacting += sum.interacting;
     }
     (energy, interacting)
 }
