@@ -4,8 +4,8 @@
 //! Each step: Morton keys over the current bounding cube, one sort, and a compressed tree in a
 //! flat arena ([`tree`]); then a grouped walk ([`walk`]): each group of up to [`GROUP_SIZE`]
 //! neighbouring particles builds one interaction list (accepted nodes as monopoles, opened
-//! leaves as particles) and each of its particles gathers from it with the shared SIMD pair
-//! loop (`rows::gather`). At quadrupole order the accepted nodes go to a separate node list
+//! leaves as particles), which the group's particles take in tiles of SIMD lanes with every entry
+//! broadcast (`broadcast::tile_forces`). At quadrupole order the accepted nodes go to a separate node list
 //! ([`nodes`]) with their second moments ([`moments`], computed at every build), evaluated by
 //! a loop of its own; opened leaves stay in the particle list. A node of side `s` is accepted when `s/d < θ`, with `d` the distance
 //! from its centre of strength to the nearest point of the group's bounding box, so θ = 0 gives
