@@ -1,5 +1,5 @@
-//! `octree`: Barnes-Hut with opening angle θ (an octree in 3-D, a quadtree in 2-D), monopoles
-//! at the centre of strength or, as an option ([`Multipole`]), quadrupoles, O(n log n).
+//! `octree`: Barnes-Hut with opening angle θ (an octree in 3-D, a quadtree in 2-D), nodes as
+//! quadrupoles by default or as monopoles at the centre of strength ([`Multipole`]), O(n log n).
 //!
 //! Each step: Morton keys over the current bounding cube, one sort, and a compressed tree in a
 //! flat arena ([`tree`]); then a grouped walk ([`walk`]): each group of up to [`GROUP_SIZE`]
