@@ -49,6 +49,15 @@ pub fn write_fmt(args: std::fmt::Arguments<'_>) {
     }
 }
 
+/// Prints `error: {message}` and a newline to stderr in one write. Under mpirun the ranks
+/// share one stream, and `eprintln!` writes a formatted line piece by piece, so two ranks'
+/// messages could come out interleaved mid-sentence; one write of a line shorter than the
+/// pipe's atomic size stays whole.
+pub fn print_error(message: impl std::fmt::Display) {
+    let line = format!("error: {message}\n");
+    let _ = std::io::stderr().lock().write_all(line.as_bytes());
+}
+
 /// Flushes stdout and turns a failed write into an error for the exit code: `Ok` when all was
 /// written or the reader closed the pipe.
 pub fn finish() -> Result<(), String> {

@@ -23,14 +23,14 @@ fn main() -> ExitCode {
     let code = match cli::dispatch(cli) {
         Ok(code) => code,
         Err(err) => {
-            eprintln!("error: {}", cli::error_chain(&err));
+            nbody_bench::console::print_error(cli::error_chain(&err));
             2
         }
     };
     // A closed pipe on stdout ends the output quietly; any other failed write is an error.
     match nbody_bench::console::finish() {
         Err(why) => {
-            eprintln!("error: {why}");
+            nbody_bench::console::print_error(why);
             ExitCode::from(2)
         }
         Ok(()) => ExitCode::from(code as u8),

@@ -67,10 +67,7 @@ mod with_mpi {
     /// Prints an error on the ranks that should, and gives exit code 2.
     fn fail(rank: usize, err: MpiError) -> i32 {
         if err.printed_by(rank) {
-            eprintln!(
-                "error: {}",
-                crate::cli::error_chain(&anyhow::Error::from(err))
-            );
+            nbody_bench::console::print_error(crate::cli::error_chain(&anyhow::Error::from(err)));
         }
         2
     }

@@ -60,7 +60,7 @@ impl Mpi {
             if let MpiError::JobMismatch(m) = &err
                 && m.printed()
             {
-                eprintln!("error: {m}");
+                crate::console::print_error(m);
             }
             // Dropping `mpi` finalizes MPI, on every rank together.
             return Err(err);
