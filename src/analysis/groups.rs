@@ -76,6 +76,9 @@ pub struct SeriesKey {
     /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
     #[serde(skip_serializing_if = "crate::experiment::plan::is_monopole")]
     pub multipole: Multipole,
+    /// The fmm's expansion order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
     pub n: Option<usize>,
     pub threads: Option<usize>,
     pub ranks: Option<usize>,
@@ -91,6 +94,9 @@ impl SeriesKey {
         }
         if self.multipole != Multipole::Monopole {
             s.push_str(&format!(" {}", self.multipole.name()));
+        }
+        if let Some(p) = self.order {
+            s.push_str(&format!(" p={p}"));
         }
         if let Some(d) = self.decomp {
             s.push_str(&format!(" ({})", d.name()));
@@ -161,6 +167,7 @@ pub fn group(results: &ResultsFile) -> Groups {
         precision: precision_of(r),
         theta: c.theta,
         multipole: r.case.multipole,
+        order: r.case.order,
         n: Some(c.n),
         threads: Some(c.threads),
         ranks: Some(c.ranks),
@@ -221,7 +228,9 @@ pub fn group(results: &ResultsFile) -> Groups {
     let theta = series(&|k| k.theta = None, &by_theta)
         .into_iter()
         .filter(|s| {
-            (s.key.kernel == KernelKind::Octree || s.key.kernel.is_external())
+            (s.key.kernel == KernelKind::Octree
+                || s.key.kernel == KernelKind::Fmm
+                || s.key.kernel.is_external())
                 && distinct(s, &by_theta) >= 2
         })
         .collect();

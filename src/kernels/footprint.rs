@@ -31,6 +31,9 @@ fn kernel_bytes(kernel: KernelKind, dim: usize, threads: usize) -> usize {
         // Padded slots with their particle, position, strength and force; the positions at
         // the build; cluster boxes; about 0.7 runs of 12 bytes per particle in the liquid.
         KernelKind::ClusterPair => 120,
+        // The octree's tree, padded sorted copies and forces, and per cell the expansions
+        // (two of 165 f64 at the highest order) and the cell pairs of the walk.
+        KernelKind::Fmm => 300,
     }
 }
 
