@@ -81,6 +81,7 @@ fn energy_drift_is_bounded_for_every_scenario() {
             None,
             1e-3,
         ),
+        (ScenarioKind::Galaxy, KernelKind::Fmm, 1000, 300, None, 1e-3),
         // At the source's dt = 1e-5 the closest opposite charges collapse within ~100 steps and
         // cross the quench radius, where the zeroed force does not conserve energy; a smaller
         // step keeps the check about the integrator.
@@ -124,7 +125,12 @@ fn two_body_circular_orbit_stays_circular() {
         density: None,
         box_side: None,
     };
-    for kernel in [KernelKind::Naive, KernelKind::Symmetric, KernelKind::Octree] {
+    for kernel in [
+        KernelKind::Naive,
+        KernelKind::Symmetric,
+        KernelKind::Octree,
+        KernelKind::Fmm,
+    ] {
         let system = System {
             state: state.clone(),
             law: Gravity::<f64>::new(1.0, 0.0),
