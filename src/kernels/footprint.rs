@@ -6,7 +6,9 @@
 //! `run --steps 1 --threads 2` at two n (the difference, so the executable and the pools do not
 //! count): naive 60 B (2-D f32) and 97 B (3-D f64); cell list 110 B and 129 B; octree 88 B and
 //! 186 B; per-thread buffers 2 × D f64 more per thread; the Verlet list (2-D only, n = 1e5 and
-//! 4e5, default skin) 202 B on the liquid in f32 and 251 B in f64, 130 B and 210 B on the gas.
+//! 4e5, default skin) 202 B on the liquid in f32 and 251 B in f64, 130 B and 210 B on the gas;
+//! the fmm (n = 1e5 and 3e5, 3-D f64) 608 B and 720 B on the galaxy at orders 4 and 8, 781 B
+//! and 1196 B on Coulomb's uniform charges, whose cells hold few particles and many cell pairs.
 //! The model below is at or above each. The Verlet list's entries grow with the density and
 //! with (cutoff + skin)^D: a denser system or a wider `--skin` needs more than the model says.
 
@@ -31,9 +33,10 @@ fn kernel_bytes(kernel: KernelKind, dim: usize, threads: usize) -> usize {
         // Padded slots with their particle, position, strength and force; the positions at
         // the build; cluster boxes; about 0.7 runs of 12 bytes per particle in the liquid.
         KernelKind::ClusterPair => 120,
-        // The octree's tree, padded sorted copies and forces, and per cell the expansions
-        // (two of 165 f64 at the highest order) and the cell pairs of the walk.
-        KernelKind::Fmm => 300,
+        // The octree's tree and sorted forces; per cell the centre, radius, box and two
+        // expansions (2 × 165 f64 at order 8), and the walk's pairs of cells and of leaves
+        // with their per-cell lists: most with small cells at a high order.
+        KernelKind::Fmm => 1100,
     }
 }
 
@@ -145,6 +148,10 @@ mod tests {
             (KernelKind::Verlet, 2, 8, 2, 251),
             (KernelKind::Verlet, 2, 4, 2, 130),
             (KernelKind::Verlet, 2, 8, 2, 210),
+            (KernelKind::Fmm, 3, 8, 2, 608),
+            (KernelKind::Fmm, 3, 8, 2, 720),
+            (KernelKind::Fmm, 3, 8, 2, 781),
+            (KernelKind::Fmm, 3, 8, 2, 1196),
         ];
         for (kernel, dim, real, threads, bytes) in measured {
             let model = run_bytes(kernel, 1_000_000, dim, real, threads) as f64 / 1e6;
