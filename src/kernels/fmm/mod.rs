@@ -4,12 +4,12 @@
 //! Each step: the octree's Morton tree over all sources in one class (leaves of at most
 //! `fmm_leaf_size` particles; charges of both signs share the tree), then per cell an
 //! expansion centre, a radius and a Cartesian multipole of order p ([`tree`], [`expansion`]);
-//! a mutual dual-tree walk ([`walk`]) that lists well-separated pairs of cells
-//! (`r_A + r_B < θ |z_A − z_B|`) for cell–cell interactions (M2L, both cells' local
-//! expansions updated from one derivative tensor) and pairs of near leaves for direct
-//! particle–particle sums ([`near`], also mutual); then the local expansions are carried down
-//! the tree (L2L) and evaluated at the particles (L2P). Newton's third law holds for cells as
-//! for particles, so the total force is zero to rounding.
+//! a mutual dual-tree walk ([`walk`]) that finds each pair of cells once: well-separated ones
+//! (`r_A + r_B < θ |z_A − z_B|`) become cell–cell interactions (M2L, into both cells' local
+//! expansions, from derivative tensors at ±R that are the same bits up to sign), pairs of near
+//! leaves direct particle–particle sums ([`near`], into both leaves); then the local
+//! expansions are carried down the tree (L2L) and evaluated at the particles (L2P). Newton's
+//! third law holds for cells as for particles, so the total force is zero to rounding.
 //!
 //! The force error falls as θ^p; θ = 0 accepts no cell pair and gives the direct sum. θ must
 //! stay below 1 (the expansions converge only there).
@@ -26,7 +26,8 @@
 //!
 //! Memory, reused from step to step: the tree's (as the octree's at monopole order), sorted
 //! forces, and per cell a centre, a radius, bounds and 2 (p+1)(p+2)(p+3)/6 expansion
-//! coefficients (70 at p = 4); the interaction lists, 8 B per pair of cells or leaves.
+//! coefficients (70 at p = 4); the interaction lists, 16 B per pair of cells or leaves (the
+//! pair and its entry in both cells' lists). `footprint` has the measured totals.
 
 mod expansion;
 mod near;

@@ -223,98 +223,62 @@ fn quadrupole_potential(y: &[[f64; 3]], s: &[f64], eps2: f64, r: [f64; 3]) -> f6
 /// opposite.
 #[test]
 fn a_far_particle_feels_the_clusters_multipole_field() {
+    let masses = [1.0, 2.0, 0.5, 1.5];
+    cluster_field("gravity", Gravity::new(1.0, 0.0), 0.0, -1.0, masses);
+    cluster_field("softened", Gravity::new(1.0, 0.3), 0.09, -1.0, masses);
+    cluster_field("coulomb", coulomb(), 0.0, 1.0, [1.0, -1.0, 1.0, 0.5]);
+}
+
+/// The check above for one law: `eps2` its softening squared, `kappa` its sign and scale
+/// (the energy of a pair is `κ s_i s_j / r_s`).
+fn cluster_field<L: PairLaw<f64>>(what: &str, law: L, eps2: f64, kappa: f64, strengths: [f64; 4]) {
     let y = [
         [0.09, 0.0, 0.02],
         [-0.05, 0.07, 0.0],
         [0.0, -0.06, 0.08],
         [-0.04, -0.01, -0.1],
     ];
-    let cases: [(
-        &str,
-        Box<dyn Fn(&mut State<f64, 3>) -> Field<f64, 3>>,
-        f64,
-        f64,
-        [f64; 4],
-    ); 3] = [
-        (
-            "gravity",
-            Box::new(|s| {
-                forces_of(
-                    &mut Fmm::new(Gravity::<f64>::new(1.0, 0.0), 0.5, 3, 4),
-                    s,
-                    false,
-                )
-                .0
-            }),
-            0.0,
-            -1.0,
-            [1.0, 2.0, 0.5, 1.5],
-        ),
-        (
-            "softened",
-            Box::new(|s| {
-                forces_of(
-                    &mut Fmm::new(Gravity::<f64>::new(1.0, 0.3), 0.5, 3, 4),
-                    s,
-                    false,
-                )
-                .0
-            }),
-            0.09,
-            -1.0,
-            [1.0, 2.0, 0.5, 1.5],
-        ),
-        (
-            "coulomb",
-            Box::new(|s| forces_of(&mut Fmm::new(coulomb::<f64>(), 0.5, 3, 4), s, false).0),
-            0.0,
-            1.0,
-            [1.0, -1.0, 1.0, 0.5],
-        ),
-    ];
-    for (what, fmm, eps2, kappa, strengths) in cases {
-        let mut s = State::<f64, 3>::new(5);
-        let target = [3.1, -1.7, 2.3];
-        for d in 0..3 {
-            for (k, yk) in y.iter().enumerate() {
-                s.pos[d][k] = yk[d];
-            }
-            s.pos[d][4] = target[d];
+    let mut s = State::<f64, 3>::new(5);
+    let target = [3.1, -1.7, 2.3];
+    for d in 0..3 {
+        for (k, yk) in y.iter().enumerate() {
+            s.pos[d][k] = yk[d];
         }
-        s.source[..4].copy_from_slice(&strengths);
-        s.source[4] = 0.7;
-        let f = fmm(&mut s);
+        s.pos[d][4] = target[d];
+    }
+    s.source[..4].copy_from_slice(&strengths);
+    s.source[4] = 0.7;
+    let f = forces_of(&mut Fmm::new(law, 0.5, 3, 4), &s, false).0;
 
-        // The cluster's expansion centre (the |s|-weighted centre) and the offsets from it.
-        let w: f64 = strengths.iter().map(|x| x.abs()).sum();
-        let z: [f64; 3] =
-            std::array::from_fn(|d| (0..4).map(|k| strengths[k].abs() * y[k][d]).sum::<f64>() / w);
-        let off: Vec<[f64; 3]> = y
-            .iter()
-            .map(|p| std::array::from_fn(|d| p[d] - z[d]))
-            .collect();
-        let r: [f64; 3] = std::array::from_fn(|d| target[d] - z[d]);
-        let h = 1e-5;
-        for d in 0..3 {
-            let (mut up, mut down) = (r, r);
-            up[d] += h;
-            down[d] -= h;
-            let grad = (quadrupole_potential(&off, &strengths, eps2, up)
-                - quadrupole_potential(&off, &strengths, eps2, down))
-                / (2.0 * h);
-            let want = -kappa * s.source[4] * grad;
-            let got = f[d][4];
-            assert!(
-                (got - want).abs() <= 1e-8 * want.abs().max(1e-3),
-                "{what} component {d}: {got:e} vs {want:e}"
-            );
-            let on_cluster: f64 = (0..4).map(|k| f[d][k]).sum::<f64>();
-            // The cluster's internal forces cancel; what is left is the far particle's.
-            assert!(
-                (on_cluster + got).abs() <= 1e-12 * got.abs(),
-                "{what}: reaction"
-            );
-        }
+    // The cluster's expansion centre (the |s|-weighted centre) and the offsets from it.
+    let w: f64 = strengths.iter().map(|x| x.abs()).sum();
+    let z: [f64; 3] =
+        std::array::from_fn(|d| (0..4).map(|k| strengths[k].abs() * y[k][d]).sum::<f64>() / w);
+    let off: Vec<[f64; 3]> = y
+        .iter()
+        .map(|p| std::array::from_fn(|d| p[d] - z[d]))
+        .collect();
+    let r: [f64; 3] = std::array::from_fn(|d| target[d] - z[d]);
+    let h = 1e-5;
+    for d in 0..3 {
+        let (mut up, mut down) = (r, r);
+        up[d] += h;
+        down[d] -= h;
+        let grad = (quadrupole_potential(&off, &strengths, eps2, up)
+            - quadrupole_potential(&off, &strengths, eps2, down))
+            / (2.0 * h);
+        let want = -kappa * s.source[4] * grad;
+        let got = f[d][4];
+        assert!(
+            (got - want).abs() <= 1e-8 * want.abs().max(1e-3),
+            "{what} component {d}: {got:e} vs {want:e}"
+        );
+        let on_cluster: f64 = (0..4).map(|k| f[d][k]).sum::<f64>();
+        // The cluster's internal forces cancel; what is left is the far particle's.
+        assert!(
+            (on_cluster + got).abs() <= 1e-12 * got.abs(),
+            "{what}: reaction"
+        );
     }
 }
 

@@ -133,7 +133,9 @@ fn separated<L: PairLaw<f64>>(cells: &Cells, a: usize, b: usize, theta2: f64, la
     let (za, zb) = (cells.centre[a], cells.centre[b]);
     let r2: f64 = (0..3).map(|d| (za[d] - zb[d]).powi(2)).sum();
     let reach = cells.radius[a] + cells.radius[b];
-    if !(reach * reach < theta2 * r2) {
+    // A NaN distance fails the test, so the pair is split.
+    let close = reach * reach < theta2 * r2;
+    if !close {
         return false;
     }
     let gap = r2.sqrt() - reach;
