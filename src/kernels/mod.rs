@@ -302,9 +302,10 @@ impl KernelParams {
     fn validate_fmm<const D: usize>(&self) -> Result<(), KernelError> {
         if self.theta >= 1.0 {
             return Err(KernelError::BadParam(format!(
-                "theta must be below 1 for the fmm kernel (got {}): its expansions converge \
-                 only for cells closer to each other than theta times their distance; 0.5 is \
-                 the usual choice",
+                "theta must be below 1 for the fmm kernel (got {}): two cells interact through \
+                 their expansions when their radii add up to less than theta times their \
+                 distance, and the expansions converge only where that sum is below the \
+                 distance; 0.5 is the usual choice",
                 self.theta
             )));
         }
