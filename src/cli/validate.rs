@@ -63,14 +63,28 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         .flat_map(|c| {
             c.kernels
                 .iter()
-                .filter(|k| !k.passed)
+                .filter(|k| !k.passed && !k.skipped)
+                .map(move |k| format!("{}/{}", c.scenario, k.kernel))
+        })
+        .collect();
+    let skipped: Vec<String> = results
+        .iter()
+        .flat_map(|c| {
+            c.kernels
+                .iter()
+                .filter(|k| k.skipped)
                 .map(move |k| format!("{}/{}", c.scenario, k.kernel))
         })
         .collect();
     if args.json {
         outln!("{}", serde_json::to_string_pretty(&results)?);
-    } else if failed.is_empty() {
+    } else if failed.is_empty() && skipped.is_empty() {
         outln!("all kernels agree with the reference");
+    } else if failed.is_empty() {
+        outln!(
+            "all kernels checked agree with the reference; skipped: {}",
+            skipped.join(", ")
+        );
     } else {
         outln!("FAILED: {}", failed.join(", "));
     }
@@ -145,6 +159,17 @@ fn print_check(c: &ScenarioCheck) {
         "result"
     );
     for k in &c.kernels {
+        if k.skipped {
+            outln!(
+                "  {:<11} {:>12} {:>12}  {:<6} {}",
+                k.kernel,
+                "-",
+                "-",
+                "skip",
+                k.criterion
+            );
+            continue;
+        }
         outln!(
             "  {:<11} {:>12.3e} {:>12.3e}  {:<6} {}",
             k.kernel,

@@ -297,10 +297,15 @@ impl KernelParams {
 }
 
 impl KernelParams {
+    /// Whether θ is below 1, where the fmm's expansions converge (the fmm refuses the rest).
+    pub fn fmm_converges(&self) -> bool {
+        self.theta < 1.0
+    }
+
     /// What the fast multipole kernel needs beyond [`KernelParams::validate`]: θ below 1 (the
     /// expansions converge only there) and three dimensions (its expansions are 3-D).
     fn validate_fmm<const D: usize>(&self) -> Result<(), KernelError> {
-        if self.theta >= 1.0 {
+        if !self.fmm_converges() {
             return Err(KernelError::BadParam(format!(
                 "theta must be below 1 for the fmm kernel (got {}): two cells interact through \
                  their expansions when their radii add up to less than theta times their \

@@ -2,7 +2,7 @@
 //! (tiny and odd included), thread counts (2 and 3 oversubscribe a 2-CPU machine) and both
 //! precisions; the octree's error shrinks with θ and is exact at θ = 0, at both expansion
 //! orders, the quadrupole's below the monopole's; the fmm is exact at θ = 0 and within its
-//! tolerance on the scenarios.
+//! tolerance on the scenarios, and `validate` skips it, visibly, at θ ≥ 1.
 
 use nbody_bench::kernels::{KernelKind, KernelParams, Multipole};
 use nbody_bench::physics::PairLaw;
@@ -337,4 +337,38 @@ fn fmm_is_exact_at_theta_zero_and_within_its_tolerance() {
             );
         }
     }
+}
+
+/// At θ = 1 the fmm refuses to run (its expansions diverge there) but the octree does not:
+/// `validate` checks the other kernels, shows the fmm as skipped on each long-range scenario,
+/// and passes.
+#[test]
+fn validate_at_theta_one_skips_the_fmm_and_passes() {
+    let o = crate::bin()
+        .args(["validate", "-n", "300", "--theta", "1"])
+        .output()
+        .unwrap();
+    let out = crate::text(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}\n{}",
+        crate::text(&o.stderr)
+    );
+    let skips: Vec<&str> = out.lines().filter(|l| l.contains("skip")).collect();
+    // One row per long-range scenario, and the closing line.
+    assert_eq!(skips.len(), 3, "{out}");
+    for row in &skips[..2] {
+        assert!(row.trim_start().starts_with("fmm"), "{row}");
+        assert!(row.contains("skipped (fmm needs theta below 1)"), "{row}");
+    }
+    assert!(
+        out.contains("skipped: coulomb/fmm, galaxy/fmm") && !out.contains("FAIL"),
+        "{out}"
+    );
+    // The octree still ran at θ = 1.
+    assert!(
+        out.lines().any(|l| l.trim_start().starts_with("octree")),
+        "{out}"
+    );
 }
