@@ -33,10 +33,14 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         // The trees and the Verlet list hold the most memory of the kernels checked, the O(n²)
         // direct sums take the time: the f64 reference and the three quadratic kernels, one
         // force computation each.
-        nbody_bench::run::check_memory(&s, KernelKind::Octree, args.kernel_args.threads, 1)?;
-        nbody_bench::run::check_memory(&s, KernelKind::Fmm, args.kernel_args.threads, 1)?;
-        nbody_bench::run::check_memory(&s, KernelKind::Verlet, args.kernel_args.threads, 1)?;
-        nbody_bench::run::check_memory(&s, KernelKind::PerThread, args.kernel_args.threads, 1)?;
+        for kernel in [
+            KernelKind::Octree,
+            KernelKind::Fmm,
+            KernelKind::Verlet,
+            KernelKind::PerThread,
+        ] {
+            nbody_bench::run::check_memory(&s, kernel, &params, args.kernel_args.threads, 1)?;
+        }
         if !args.yes {
             refuse_long_check(&s, params, args.kernel_args.threads)?;
         }
