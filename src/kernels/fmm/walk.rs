@@ -143,9 +143,11 @@ fn separated<L: PairLaw<f64>>(cells: &Cells, a: usize, b: usize, theta2: f64, la
 }
 
 /// For every cell, the cells of the interactions it takes part in: `of(c)`, in walk order.
+/// The cells are u32 like the tree's nodes; the positions in the lists are usize, as twice
+/// the pairs of cells or leaves can pass u32 where the cells do not.
 #[derive(Default)]
 pub(super) struct Lists {
-    start: Vec<u32>,
+    start: Vec<usize>,
     items: Vec<u32>,
 }
 
@@ -165,13 +167,13 @@ impl Lists {
             self.start[c + 1] += self.start[c];
         }
         self.items.clear();
-        self.items.resize(self.start[cells] as usize, 0);
+        self.items.resize(self.start[cells], 0);
         let mut next = self.start.clone();
         for &[a, b] in pairs {
-            self.items[next[a as usize] as usize] = b;
+            self.items[next[a as usize]] = b;
             next[a as usize] += 1;
             if a != b {
-                self.items[next[b as usize] as usize] = a;
+                self.items[next[b as usize]] = a;
                 next[b as usize] += 1;
             }
         }
@@ -179,6 +181,6 @@ impl Lists {
 
     /// The partners of cell `c`.
     pub fn of(&self, c: usize) -> &[u32] {
-        &self.items[self.start[c] as usize..self.start[c + 1] as usize]
+        &self.items[self.start[c]..self.start[c + 1]]
     }
 }
