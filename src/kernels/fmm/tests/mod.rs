@@ -1,6 +1,9 @@
 //! The fast multipole kernel against the direct sum: exact at θ = 0, errors falling with the
 //! order and with θ, momentum conserved to rounding, the multipole field of a cluster against
-//! its closed form, the same bits at every thread count, and the parameters it refuses.
+//! its closed form, the same bits at every thread count, and the parameters it refuses;
+//! the expansion operators alone in [`operators`].
+
+mod operators;
 
 use super::*;
 use crate::kernels::{KernelError, KernelKind, KernelParams, Naive};
