@@ -320,6 +320,36 @@ fn bad_parameters_and_systems_are_refused() {
     assert!(err.to_string().contains("lennard-jones"), "{err}");
 }
 
+/// No particle, and one alone: nothing to compute, and no force (and no energy) at the
+/// default θ and leaf size as at any.
+#[test]
+fn no_particle_or_one_alone_feels_nothing() {
+    for n in [0, 1] {
+        let s = random_state::<f64, 3>(n, 1.0, false, SEED_1);
+        let c = random_state::<f64, 3>(n, 1.0, true, SEED_2);
+        for leaf in [1, 64] {
+            for probe in [false, true] {
+                let what = format!("n={n} leaf={leaf} probe={probe}");
+                let mut k = Fmm::new(gravity::<f64>(), 0.5, 4, leaf);
+                let (f, r) = on_threads(2, || forces_of(&mut k, &s, probe));
+                assert!(f.iter().all(|c| c.iter().all(|x| *x == 0.0)), "{what}");
+                assert_eq!(r.energy, probe.then_some(0.0), "{what}");
+                assert_eq!(
+                    (r.work.pair_checks, r.work.nodes_accepted),
+                    (0, 0),
+                    "{what}"
+                );
+                let mut k = Fmm::new(coulomb::<f64>(), 0.5, 8, leaf);
+                let (f, _) = forces_of(&mut k, &c, probe);
+                assert!(
+                    f.iter().all(|c| c.iter().all(|x| *x == 0.0)),
+                    "coulomb {what}"
+                );
+            }
+        }
+    }
+}
+
 #[test]
 fn degenerate_configurations_terminate() {
     for n in [2, 100, 3000] {
