@@ -267,8 +267,10 @@ impl KernelParams {
         }
         if self.leaf_size == 0 || self.leaf_size > 4096 {
             return Err(KernelError::BadParam(format!(
-                "leaf size must be between 1 and 4096 (got {})",
-                self.leaf_size
+                "--leaf-size must be between 1 and 4096 for the octree kernel (got {}); {} is \
+                 its default",
+                self.leaf_size,
+                KernelParams::default().leaf_size
             )));
         }
         if !(1..=fmm::MAX_ORDER).contains(&self.order) {
@@ -281,8 +283,10 @@ impl KernelParams {
         }
         if self.fmm_leaf_size == 0 || self.fmm_leaf_size > 4096 {
             return Err(KernelError::BadParam(format!(
-                "fmm leaf size must be between 1 and 4096 (got {})",
-                self.fmm_leaf_size
+                "--leaf-size must be between 1 and 4096 for the fmm kernel (got {}); {} is its \
+                 default",
+                self.fmm_leaf_size,
+                default_fmm_leaf_size()
             )));
         }
         if !(self.skin.is_finite() && self.skin > 0.0) {

@@ -301,7 +301,10 @@ fn bad_parameters_and_systems_are_refused() {
         ..ok
     })
     .unwrap_err();
-    assert!(err.to_string().contains("leaf size"), "{err}");
+    assert!(
+        err.to_string().contains("--leaf-size") && err.to_string().contains("64 is its default"),
+        "{err}"
+    );
     // A 2-D system, and a short-range law (the 2-D LJ scenarios).
     let err = KernelKind::Fmm
         .build::<f64, _, 2>(gravity::<f64>(), &ok)
