@@ -108,9 +108,10 @@ impl Batch {
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
-    /// Takes `0 ≤ theta < 1`, `1 ≤ order ≤ MAX_ORDER` and `leaf_size ≥ 1` as given:
-    /// `KernelKind::build` checks them first (`KernelParams::validate`).
-    pub fn new(law: L, theta: f64, order: usize, leaf_size: usize) -> Self {
+    /// Takes `0 ≤ theta < 1`, `1 ≤ order ≤ MAX_ORDER` and `leaf_size ≥ 1` as given (a bad
+    /// order panics): `KernelKind::build` checks them first (`KernelParams::validate`), and
+    /// users outside the crate go through it, as this is the crate's own.
+    pub(crate) fn new(law: L, theta: f64, order: usize, leaf_size: usize) -> Self {
         Fmm {
             law,
             wide: law.widen(),
