@@ -11,10 +11,13 @@
 //! - a cell's local expansion about its centre is `L_m = ∂^m ψ(z)`, the Taylor coefficients of
 //!   the far field ψ, so that `ψ(z + r) = Σ_m L_m r^m / m!`;
 //! - M2L from cell B onto cell A, `R = z_A − z_B`: `L_A[m] += Σ_{|n| ≤ p − |m|} M_B[n] T[n + m]`
-//!   with `T[k] = ∂^k G(R)`, and the reaction onto B uses the same tensor at −R,
-//!   `T[k](−R) = (−1)^{|k|} T[k](R)`: one tensor per pair of cells, both cells updated.
-//!   Truncating at `|n| + |m| ≤ p` makes the force of A on B the exact opposite of the force
-//!   of B on A (Dehnen 2000), so momentum is conserved to rounding whatever the centres.
+//!   with `T[k] = ∂^k G(R)`, and the reaction onto B is the same at −R, where
+//!   `T[k](−R) = (−1)^{|k|} T[k](R)`. The kernel computes the tensor twice, once in each cell's
+//!   list of partners (its own R, the same bits up to sign): each cell sums its own list, so
+//!   the results do not depend on the thread count, at twice the tensor work of one tensor per
+//!   pair updating both cells. Truncating at `|n| + |m| ≤ p` makes the force of A on B the
+//!   exact opposite of the force of B on A (Dehnen 2000), so momentum is conserved to
+//!   rounding whatever the centres.
 //!
 //! The Green's function is the law's: `G(x) = g(|x|²)` with `g = κ (r² + ε²)^{-1/2}`, κ and
 //! the sign convention taken from the law's own coefficient (see [`scaled_derivatives`]). Its

@@ -5,8 +5,9 @@
 //! `fmm_leaf_size` particles; charges of both signs share the tree), then per cell an
 //! expansion centre, a radius and a Cartesian multipole of order p ([`tree`], [`expansion`]);
 //! a mutual dual-tree walk ([`walk`]) that finds each pair of cells once: well-separated ones
-//! (`r_A + r_B < θ |z_A − z_B|`) become cell–cell interactions (M2L, into both cells' local
-//! expansions, from derivative tensors at ±R that are the same bits up to sign), pairs of near
+//! (`r_A + r_B < θ |z_A − z_B|`) become cell–cell interactions (M2L into both cells' local
+//! expansions, each cell computing the derivative tensor at its own ±R from its own list: the
+//! same bits up to sign, twice the tensor work for thread-independent sums), pairs of near
 //! leaves direct particle–particle sums ([`near`], into both leaves); then the local
 //! expansions are carried down the tree (L2L) and evaluated at the particles (L2P). Newton's
 //! third law holds for cells as for particles, so the total force is zero to rounding.
@@ -243,8 +244,9 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
 }
 
 /// The local expansion of cell `c` from its M2L `partners`, `LANES` at a time, into `local`
-/// (overwritten). Each lane sums its partners in list order, and the lanes are added in lane
-/// order at the end: a fixed order whatever runs it.
+/// (overwritten). Each lane sums its partners in list order, and the lanes are added at the
+/// end by [`lane_sum`](crate::kernels::rows::lane_sum)'s pairwise tree: a fixed order
+/// whatever runs it.
 #[inline(always)]
 fn far_of_cell<W: PairLaw<f64>>(
     exp: &Expansion,
