@@ -145,6 +145,12 @@ impl Expansion {
         }
     }
 
+    /// The multiply-adds of one M2L's contraction: one per pair of indices `(n, m)` with
+    /// `|n| + |m| ≤ p`, `(p+1)(p+2)...(p+6)/6!` (210 at order 4).
+    pub fn m2l_terms(&self) -> usize {
+        self.row_len.iter().sum()
+    }
+
     /// `out[n] = v^n / n!` for the first `out.len()` indices (all of order ≤ q when
     /// `out.len() = terms(q)`).
     #[inline(always)]

@@ -362,8 +362,10 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ForceKernel<T, D> for Fmm<L, T, D> 
             })
             .sum();
         let pairs = (seen - n as u64) / 2;
-        // A cell pair costs about as much as a few hundred particle pairs at order 4.
-        self.last_work = Some(pairs + 200 * counts.m2l);
+        // A cell pair counts as many particle pairs as its contraction has terms (210 at order
+        // 4, about what one costs there; 7 at order 1, 3003 at order 8): its work grows with
+        // the order as they do.
+        self.last_work = Some(pairs + self.exp.m2l_terms() as u64 * counts.m2l);
         ForceReport {
             // Every pair is seen from both ends, near or far.
             energy: probe.then_some(0.5 * (near_energy + potential)),

@@ -32,6 +32,15 @@ fn p2m_about(exp: &Expansion, sources: &[([f64; 3], f64)], z: [f64; 3]) -> Vec<f
     m
 }
 
+/// The M2L's terms, which the fork decision counts: the pairs `(n, m)` with `|n| + |m| ≤ p`.
+#[test]
+fn m2l_terms_count_the_pairs_of_indices() {
+    for p in 1..=MAX_ORDER {
+        let want: usize = (1..=6).map(|k| p + k).product::<usize>() / 720;
+        assert_eq!(Expansion::new(p).m2l_terms(), want, "order {p}");
+    }
+}
+
 #[test]
 fn m2m_of_the_childrens_p2m_is_the_parents_p2m() {
     let mut rng = Pcg64Mcg::seed_from_u64(SEED_1);
