@@ -95,8 +95,9 @@ impl SeriesKey {
         if self.multipole != Multipole::Monopole {
             s.push_str(&format!(" {}", self.multipole.name()));
         }
+        // "order", not "p=": the case keys' p= is the threads.
         if let Some(p) = self.order {
-            s.push_str(&format!(" p={p}"));
+            s.push_str(&format!(" order {p}"));
         }
         if let Some(d) = self.decomp {
             s.push_str(&format!(" ({})", d.name()));
@@ -305,7 +306,27 @@ fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64)
 
 #[cfg(test)]
 mod tests {
-    use super::{workers_noun, workers_suffix};
+    use super::{SeriesKey, workers_noun, workers_suffix};
+    use crate::experiment::code::Code;
+    use crate::kernels::{KernelKind, Multipole};
+    use crate::scenario::{Precision, ScenarioKind};
+
+    #[test]
+    fn the_fmm_order_is_named_apart_from_the_threads() {
+        let key = SeriesKey {
+            scenario: ScenarioKind::Coulomb,
+            kernel: Code::Kernel(KernelKind::Fmm),
+            precision: Precision::F64,
+            theta: Some(0.5),
+            multipole: Multipole::Monopole,
+            order: Some(4),
+            n: None,
+            threads: Some(2),
+            ranks: Some(1),
+            decomp: None,
+        };
+        assert_eq!(key.label(), "fmm θ=0.5 order 4, 2 threads");
+    }
 
     #[test]
     fn workers_are_named_in_labels() {

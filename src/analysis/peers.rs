@@ -88,7 +88,7 @@ pub fn case_label(p: &Point) -> String {
         s.push_str(&format!(" {}", p.case.multipole.name()));
     }
     if let Some(order) = p.case.order {
-        s.push_str(&format!(" p={order}"));
+        s.push_str(&format!(" order {order}"));
     }
     s.push_str(&workers_suffix(p.threads, p.ranks));
     s

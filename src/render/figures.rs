@@ -320,7 +320,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                     name.push_str(&format!(" {}", t.series.multipole.name()));
                 }
                 if let Some(p) = t.series.order {
-                    name.push_str(&format!(" p={p}"));
+                    name.push_str(&format!(" order {p}"));
                 }
                 name
             },

@@ -190,11 +190,11 @@ pub fn weak(a: &Analysis) -> String {
 }
 
 /// θ of an octree or fmm case, with the expansion order when it is not the octree's
-/// default monopole (the fmm's p always).
+/// default monopole (the fmm's order always).
 fn theta_cell(p: &crate::analysis::groups::Point) -> String {
     let theta = p.theta.map_or(NONE.to_string(), |t| t.to_string());
     match (p.case.multipole, p.case.order) {
-        (_, Some(order)) => format!("{theta} (p={order})"),
+        (_, Some(order)) => format!("{theta} (order {order})"),
         (crate::kernels::Multipole::Monopole, None) => theta,
         (m, None) => format!("{theta} ({})", m.name()),
     }
