@@ -1,7 +1,9 @@
-//! Shared fixtures for tests and benches: seeded random configurations.
+//! Shared fixtures for tests and benches: seeded random configurations, and the comparisons
+//! of force fields that the kernels' tests make against the direct sum.
 
+use crate::kernels::{ForceKernel, ForceReport};
 use crate::real::Real;
-use crate::state::State;
+use crate::state::{Field, State, zero_field};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
@@ -100,4 +102,45 @@ pub fn plummer_state<T: Real, const D: usize>(n: usize, seed: u64) -> State<T, D
         s.mass[i] = s.source[i];
     }
     s
+}
+
+/// Forces (and the report, with the energy when `probe`) of a kernel on a state.
+pub fn forces_of<T: Real, const D: usize>(
+    k: &mut dyn ForceKernel<T, D>,
+    s: &State<T, D>,
+    probe: bool,
+) -> (Field<T, D>, ForceReport) {
+    let mut f = zero_field(s.len());
+    let r = k.compute(s, &mut f, probe);
+    (f, r)
+}
+
+/// |f_i|.
+pub fn norm<T: Real, const D: usize>(f: &Field<T, D>, i: usize) -> f64 {
+    (0..D).map(|d| f[d][i].as_f64().powi(2)).sum::<f64>().sqrt()
+}
+
+/// |a_i − b_i|.
+pub fn diff<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>, i: usize) -> f64 {
+    (0..D)
+        .map(|d| (a[d][i].as_f64() - b[d][i].as_f64()).powi(2))
+        .sum::<f64>()
+        .sqrt()
+}
+
+/// max_i |a_i − b_i| / max_i |b_i|.
+pub fn max_rel_diff<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
+    let n = a[0].len();
+    let scale = (0..n).map(|i| norm(b, i)).fold(0.0, f64::max).max(1e-300);
+    (0..n).map(|i| diff(a, b, i)).fold(0.0, f64::max) / scale
+}
+
+/// Median over particles of |a_i − b_i| / |b_i|.
+pub fn median_rel_err<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
+    let n = a[0].len();
+    let mut errs: Vec<f64> = (0..n)
+        .map(|i| diff(a, b, i) / norm(b, i).max(1e-300))
+        .collect();
+    errs.sort_by(f64::total_cmp);
+    errs[n / 2]
 }

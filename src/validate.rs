@@ -27,6 +27,15 @@ pub fn octree_tolerance(law: crate::physics::LawKind, theta: f64) -> f64 {
     }
 }
 
+/// Largest median relative error the fmm may have at opening angle θ and order p: `0.25 θ^p`.
+///
+/// Its error falls as θ^p: the measured median error over θ^p was at most 0.14 (galaxy and
+/// coulomb at n = 5000, θ 0.3 to 0.8, p 1 to 8; the largest at p = 1, falling to 4e-3 and
+/// 1e-2 at p = 8). At θ = 0 the fmm is exact and is held to the exact-kernel bound instead.
+pub fn fmm_tolerance(theta: f64, order: usize) -> f64 {
+    0.25 * theta.powi(order as i32)
+}
+
 /// Agreement of one kernel with the reference.
 #[derive(Clone, Debug, Serialize)]
 pub struct KernelCheck {
@@ -38,8 +47,26 @@ pub struct KernelCheck {
     /// difference relative to the rounding scale.
     pub max_rounding_ratio: f64,
     pub passed: bool,
+    /// Not run because the kernel refuses these parameters (the fmm at θ ≥ 1): neither passed
+    /// nor failed, the errors NaN (null in JSON), the reason in `criterion`.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub skipped: bool,
     /// Why it passed or failed, in words.
     pub criterion: String,
+}
+
+impl KernelCheck {
+    fn skipped(kind: KernelKind, why: &str) -> Self {
+        KernelCheck {
+            kernel: kind.name(),
+            max_rel_error: f64::NAN,
+            median_rel_error: f64::NAN,
+            max_rounding_ratio: f64::NAN,
+            passed: false,
+            skipped: true,
+            criterion: format!("skipped ({why})"),
+        }
+    }
 }
 
 /// What `validate` found for one scenario.
@@ -96,6 +123,12 @@ impl SystemJob for ValidateJob {
             .into_iter()
             .filter(|k| k.supports(system.law.kind()))
         {
+            // The fmm's expansions diverge at θ ≥ 1, where the octree still runs: the other
+            // kernels are still worth checking at that θ.
+            if kind == KernelKind::Fmm && !self.params.fmm_converges() {
+                checks.push(KernelCheck::skipped(kind, "fmm needs theta below 1"));
+                continue;
+            }
             let mut kernel: Box<dyn ForceKernel<T, D>> =
                 kind.build::<T, L, D>(system.law, &self.params)?;
             let mut forces = zero_field::<T, D>(n);
@@ -103,7 +136,7 @@ impl SystemJob for ValidateJob {
             checks.push(check(
                 kind,
                 system.law.kind(),
-                self.params.theta,
+                &self.params,
                 &forces,
                 &naive,
                 &reference,
@@ -167,12 +200,13 @@ fn norm<const D: usize>(v: [f64; D]) -> f64 {
 fn check<T: Real, const D: usize>(
     kind: KernelKind,
     law: crate::physics::LawKind,
-    theta: f64,
+    params: &KernelParams,
     forces: &Field<T, D>,
     naive: &Field<T, D>,
     reference: &Field<f64, D>,
     abs_sum: &[f64],
 ) -> KernelCheck {
+    let theta = params.theta;
     let n = abs_sum.len();
     let ref_norm: Vec<f64> = (0..n)
         .map(|i| norm::<D>(std::array::from_fn(|d| reference[d][i])))
@@ -209,10 +243,16 @@ fn check<T: Real, const D: usize>(
             ),
         )
     } else {
-        let tol = octree_tolerance(law, theta);
+        let (tol, setting) = match kind {
+            KernelKind::Fmm => (
+                fmm_tolerance(theta, params.order),
+                format!("theta = {theta}, order {}", params.order),
+            ),
+            _ => (octree_tolerance(law, theta), format!("theta = {theta}")),
+        };
         (
             median_rel <= tol,
-            format!("approximate: median relative error <= {tol:.1e} at theta = {theta}"),
+            format!("approximate: median relative error <= {tol:.1e} at {setting}"),
         )
     };
     KernelCheck {
@@ -221,6 +261,7 @@ fn check<T: Real, const D: usize>(
         median_rel_error: median_rel,
         max_rounding_ratio: max_ratio,
         passed,
+        skipped: false,
         criterion,
     }
 }

@@ -1,5 +1,6 @@
 //! The build phase alone: cell-list binning and strip layout, the octree (Morton keys, sort,
-//! nodes, groups) and the Verlet list (binning and the half list), over a few n.
+//! nodes, groups), the fmm (the same tree, centres, radii and multipoles) and the Verlet list
+//! (binning and the half list), over a few n.
 
 use super::{SCENARIOS, criterion, kernels_for, setup, sizes};
 use criterion::{BenchmarkId, Criterion, Throughput};
@@ -11,7 +12,7 @@ fn build(c: &mut Criterion) {
         for kernel in kernels_for(scenario).filter(|k| {
             matches!(
                 k,
-                KernelKind::CellList | KernelKind::Octree | KernelKind::Verlet
+                KernelKind::CellList | KernelKind::Octree | KernelKind::Verlet | KernelKind::Fmm
             )
         }) {
             let mut group =

@@ -28,7 +28,8 @@ pub fn sizes(kernel: KernelKind) -> &'static [usize] {
         KernelKind::CellList
         | KernelKind::Octree
         | KernelKind::Verlet
-        | KernelKind::ClusterPair => &[1000, 4000, 16000],
+        | KernelKind::ClusterPair
+        | KernelKind::Fmm => &[1000, 4000, 16000],
         KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => &[500, 1000, 2000],
     }
 }

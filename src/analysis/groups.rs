@@ -76,6 +76,9 @@ pub struct SeriesKey {
     /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
     #[serde(skip_serializing_if = "crate::experiment::plan::is_monopole")]
     pub multipole: Multipole,
+    /// The fmm's expansion order.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
     pub n: Option<usize>,
     pub threads: Option<usize>,
     pub ranks: Option<usize>,
@@ -91,6 +94,10 @@ impl SeriesKey {
         }
         if self.multipole != Multipole::Monopole {
             s.push_str(&format!(" {}", self.multipole.name()));
+        }
+        // "order", not "p=": the case keys' p= is the threads.
+        if let Some(p) = self.order {
+            s.push_str(&format!(" order {p}"));
         }
         if let Some(d) = self.decomp {
             s.push_str(&format!(" ({})", d.name()));
@@ -161,6 +168,7 @@ pub fn group(results: &ResultsFile) -> Groups {
         precision: precision_of(r),
         theta: c.theta,
         multipole: r.case.multipole,
+        order: r.case.order,
         n: Some(c.n),
         threads: Some(c.threads),
         ranks: Some(c.ranks),
@@ -221,7 +229,9 @@ pub fn group(results: &ResultsFile) -> Groups {
     let theta = series(&|k| k.theta = None, &by_theta)
         .into_iter()
         .filter(|s| {
-            (s.key.kernel == KernelKind::Octree || s.key.kernel.is_external())
+            (s.key.kernel == KernelKind::Octree
+                || s.key.kernel == KernelKind::Fmm
+                || s.key.kernel.is_external())
                 && distinct(s, &by_theta) >= 2
         })
         .collect();
@@ -296,7 +306,27 @@ fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64)
 
 #[cfg(test)]
 mod tests {
-    use super::{workers_noun, workers_suffix};
+    use super::{SeriesKey, workers_noun, workers_suffix};
+    use crate::experiment::code::Code;
+    use crate::kernels::{KernelKind, Multipole};
+    use crate::scenario::{Precision, ScenarioKind};
+
+    #[test]
+    fn the_fmm_order_is_named_apart_from_the_threads() {
+        let key = SeriesKey {
+            scenario: ScenarioKind::Coulomb,
+            kernel: Code::Kernel(KernelKind::Fmm),
+            precision: Precision::F64,
+            theta: Some(0.5),
+            multipole: Multipole::Monopole,
+            order: Some(4),
+            n: None,
+            threads: Some(2),
+            ranks: Some(1),
+            decomp: None,
+        };
+        assert_eq!(key.label(), "fmm θ=0.5 order 4, 2 threads");
+    }
 
     #[test]
     fn workers_are_named_in_labels() {

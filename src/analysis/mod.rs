@@ -388,9 +388,15 @@ fn cost_class(kernel: &Code, rule: Option<WeakRule>) -> ComplexityClass {
         (Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread), _) => {
             ComplexityClass::N2
         }
-        (Some(KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair), _) => {
-            ComplexityClass::N
-        }
+        (
+            Some(
+                KernelKind::CellList
+                | KernelKind::Verlet
+                | KernelKind::ClusterPair
+                | KernelKind::Fmm,
+            ),
+            _,
+        ) => ComplexityClass::N,
         (Some(KernelKind::Octree), _) => ComplexityClass::NLogN,
         (None, Some(WeakRule::Sqrt)) => ComplexityClass::N2,
         (None, _) => ComplexityClass::N,

@@ -87,6 +87,9 @@ pub fn case_label(p: &Point) -> String {
     if p.case.multipole != crate::kernels::Multipole::Monopole {
         s.push_str(&format!(" {}", p.case.multipole.name()));
     }
+    if let Some(order) = p.case.order {
+        s.push_str(&format!(" order {order}"));
+    }
     s.push_str(&workers_suffix(p.threads, p.ranks));
     s
 }
@@ -251,6 +254,7 @@ mod tests {
             ranks: r,
             theta: None,
             multipole: Multipole::Monopole,
+            order: None,
             seed: 1,
             precision: None,
             time_factor: 1,

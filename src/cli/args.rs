@@ -105,14 +105,20 @@ pub struct SystemArgs {
 /// Kernel tuning options.
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
-    /// Barnes-Hut opening angle (octree only): a node of side s at distance d is used whole
-    /// when s/d < theta [default: 0.5].
+    /// Opening angle (octree and fmm): the octree uses a node of side s at distance d whole
+    /// when s/d < theta; the fmm lets two cells of radii r1, r2 at distance d interact through
+    /// their expansions when r1 + r2 < theta d (fmm: below 1) [default: 0.5].
     #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true)]
     pub theta: Option<f64>,
     /// Expansion order of the tree nodes the octree accepts (octree only) [default: quadrupole].
     #[arg(long, value_enum)]
     pub multipole: Option<Multipole>,
-    /// Most particles in a tree leaf (octree only) [default: 8].
+    /// Expansion order p of the fmm's cells, 1 to 8 (fmm only): the force error falls as
+    /// theta^p [default: 4].
+    #[arg(long, value_parser = parse_count_at_most::<{ nbody_bench::kernels::MAX_FMM_ORDER }>)]
+    pub order: Option<usize>,
+    /// Most particles in a tree leaf (octree and fmm) [default: 8 for the octree, 64 for
+    /// the fmm].
     #[arg(long, value_parser = parse_count)]
     pub leaf_size: Option<usize>,
     /// Verlet list skin, in the scenario's length unit (verlet and cluster-pair only): pairs

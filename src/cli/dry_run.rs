@@ -240,6 +240,11 @@ pub fn refuse_long_run(
         multipole: kernel_args
             .multipole
             .unwrap_or(nbody_bench::kernels::KernelParams::default().multipole),
+        order: (kernel == nbody_bench::kernels::KernelKind::Fmm).then(|| {
+            kernel_args
+                .order
+                .unwrap_or(nbody_bench::kernels::KernelParams::default().order)
+        }),
         seed: setup.seed,
         precision: setup.precision,
         time_factor: 1,

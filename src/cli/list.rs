@@ -26,6 +26,10 @@ pub fn list() -> anyhow::Result<i32> {
                 "Verlet list of 4-particle clusters against 16-particle runs, one SIMD block \
                  each, for dense systems; --skin as verlet; O(n)"
             }
+            KernelKind::Fmm => {
+                "fast multipole (3-D): mutual cell-cell expansions of --order 1..8 between \
+                 cells with r1 + r2 < --theta x distance, near leaves directly; O(n)"
+            }
         };
         outln!("  {:<12} {what}", k.name());
     }

@@ -69,9 +69,11 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
     }
 }
 
-/// The kernel parameters given, over the defaults; `--theta`, `--multipole`, `--leaf-size` and
-/// `--skin` are refused for a kernel that ignores them (as `--density` is for a scenario
-/// without a box), so that nobody believes a setting that changed nothing.
+/// The kernel parameters given, over the defaults; `--theta`, `--multipole`, `--order`,
+/// `--leaf-size` and `--skin` are refused for a kernel that ignores them (as `--density` is
+/// for a scenario without a box), so that nobody believes a setting that changed nothing.
+/// `--leaf-size` sets the leaf size of the kernel run (the octree's or the fmm's, which
+/// default differently), and of both trees when no kernel is named (`validate`).
 fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Result<KernelParams> {
     if let Some(kernel) =
         kernel.filter(|&k| !matches!(k, KernelKind::Verlet | KernelKind::ClusterPair))
@@ -83,27 +85,43 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
             kernel.name()
         );
     }
-    if let Some(kernel) = kernel.filter(|&k| k != KernelKind::Octree) {
-        for (flag, given) in [
-            ("--theta", args.theta.is_some()),
-            ("--multipole", args.multipole.is_some()),
-            ("--leaf-size", args.leaf_size.is_some()),
+    let trees = [KernelKind::Octree, KernelKind::Fmm];
+    if let Some(kernel) = kernel {
+        for (flag, given, users) in [
+            ("--theta", args.theta.is_some(), &trees[..]),
+            ("--leaf-size", args.leaf_size.is_some(), &trees[..]),
+            ("--multipole", args.multipole.is_some(), &trees[..1]),
+            ("--order", args.order.is_some(), &trees[1..]),
         ] {
-            if given {
+            if given && !users.contains(&kernel) {
+                let names: Vec<&str> = users.iter().map(|k| k.name()).collect();
                 anyhow::bail!(
-                    "{flag} applies to the octree kernel only; `{}` does not use it: drop it, or \
-                     pass --kernel octree",
-                    kernel.name()
+                    "{flag} applies to the {} kernel{} only; `{}` does not use it: drop it, or \
+                     pass --kernel {}",
+                    names.join(" and "),
+                    if names.len() > 1 { "s" } else { "" },
+                    kernel.name(),
+                    names[0]
                 );
             }
         }
     }
     let defaults = KernelParams::default();
+    let fmm_only = kernel == Some(KernelKind::Fmm);
+    let octree_only = kernel.is_some() && !fmm_only;
     Ok(KernelParams {
         theta: args.theta.unwrap_or(defaults.theta),
-        leaf_size: args.leaf_size.unwrap_or(defaults.leaf_size),
+        leaf_size: args
+            .leaf_size
+            .filter(|_| !fmm_only)
+            .unwrap_or(defaults.leaf_size),
         skin: args.skin.unwrap_or(defaults.skin),
         multipole: args.multipole.unwrap_or(defaults.multipole),
+        order: args.order.unwrap_or(defaults.order),
+        fmm_leaf_size: args
+            .leaf_size
+            .filter(|_| !octree_only)
+            .unwrap_or(defaults.fmm_leaf_size),
     })
 }
 

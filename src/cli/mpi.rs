@@ -130,7 +130,9 @@ mod with_mpi {
         if let Err(e) = setup.validate() {
             return Err(MpiError::Usage(e.to_string()));
         }
-        nbody_bench::run::check_memory(setup, kernel, kernel_args.threads, copies)
+        let params =
+            kernel_params(kernel_args, Some(kernel)).map_err(|e| MpiError::Usage(e.to_string()))?;
+        nbody_bench::run::check_memory(setup, kernel, &params, kernel_args.threads, copies)
             .map_err(|e| MpiError::Usage(e.to_string()))
     }
 

@@ -21,13 +21,14 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     }
     let setup = setup(args.scenario, &args.system);
     setup.validate()?;
-    nbody_bench::run::check_memory(&setup, args.kernel, args.kernel_args.threads, 1)?;
+    let params = kernel_params(&args.kernel_args, Some(args.kernel))?;
+    nbody_bench::run::check_memory(&setup, args.kernel, &params, args.kernel_args.threads, 1)?;
     if !args.yes {
         refuse_long_run(&setup, args.kernel, &args.kernel_args, args.steps as u64)?;
     }
     let spec = RunSpec {
         kernel: args.kernel,
-        params: kernel_params(&args.kernel_args, Some(args.kernel))?,
+        params,
         steps: args.steps as u64,
         threads: args.kernel_args.threads,
         trajectory: args.trajectory.map(|path| TrajectorySpec {

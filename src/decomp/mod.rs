@@ -69,6 +69,12 @@ pub enum DecompError {
         decomp: &'static str,
         kernel: &'static str,
     },
+    #[error(
+        "--decomp {0} distributes the octree's Barnes-Hut tree; the fmm kernel has no distributed \
+         walk (its cell pairs would cross ranks both ways): run it with --decomp allgather, where \
+         each rank computes the whole step, or use --kernel octree"
+    )]
+    FmmTree(&'static str),
 }
 
 impl Decomposition {
@@ -109,6 +115,8 @@ impl Decomposition {
             Ok(())
         } else if self == Decomposition::Domain {
             Err(DecompError::DomainKernel(kernel.name()))
+        } else if kernel == KernelKind::Fmm {
+            Err(DecompError::FmmTree(self.name()))
         } else {
             Err(DecompError::TreeKernel {
                 decomp: self.name(),
@@ -197,6 +205,8 @@ mod tests {
             let msg = decomp.check(KernelKind::Naive).unwrap_err().to_string();
             assert!(msg.contains("--kernel octree"), "{msg}");
             assert!(msg.contains(decomp.name()), "{msg}");
+            let msg = decomp.check(KernelKind::Fmm).unwrap_err().to_string();
+            assert!(msg.contains("fmm") && msg.contains("allgather"), "{msg}");
         }
     }
 }

@@ -167,12 +167,15 @@ pub struct SweepConfig {
     pub threads: Vec<usize>,
     #[serde(default = "one_seed")]
     pub seeds: Vec<u64>,
-    /// Barnes-Hut opening angles (octree cases only).
+    /// Opening angles (octree and fmm cases only; the fmm's cases take those below 1).
     #[serde(default = "default_theta")]
     pub theta: Vec<f64>,
     /// Expansion orders of the octree's nodes (octree cases only).
     #[serde(default = "default_multipole")]
     pub multipole: Vec<crate::kernels::Multipole>,
+    /// Expansion orders p of the fmm's cells (fmm cases only).
+    #[serde(default = "default_order")]
+    pub order: Vec<usize>,
     #[serde(default)]
     pub precision: Option<Precision>,
     /// Output directory [default: results].
@@ -245,6 +248,9 @@ fn default_theta() -> Vec<f64> {
 }
 fn default_multipole() -> Vec<crate::kernels::Multipole> {
     vec![crate::kernels::KernelParams::default().multipole]
+}
+fn default_order() -> Vec<usize> {
+    vec![crate::kernels::KernelParams::default().order]
 }
 fn default_out() -> PathBuf {
     PathBuf::from("results")
@@ -381,6 +387,21 @@ impl SweepConfig {
                 "must list at least one of \"monopole\", \"quadrupole\"".into(),
             ));
         }
+        if self.kernels.contains(&KernelKind::Fmm) && !self.theta.iter().any(|&t| t < 1.0) {
+            return Err(bad(
+                "theta",
+                "has no value below 1, and the fmm kernel runs only there (its expansions \
+                 converge for theta < 1); add one, such as 0.5"
+                    .into(),
+            ));
+        }
+        let max_order = crate::kernels::MAX_FMM_ORDER;
+        if self.order.is_empty() || self.order.iter().any(|p| !(1..=max_order).contains(p)) {
+            return Err(bad(
+                "order",
+                format!("must be a non-empty list of expansion orders from 1 to {max_order}"),
+            ));
+        }
         match (&self.study, &self.weak) {
             (Study::Weak, None) => {
                 return Err(bad(
@@ -492,6 +513,7 @@ impl SweepConfig {
             ("seeds", twice(&self.seeds)),
             ("theta", twice(&self.theta)),
             ("multipole", twice(&self.multipole)),
+            ("order", twice(&self.order)),
             ("mpi.ranks", twice(&ranks)),
             ("mpi.decomp", decomp),
             ("external.name", twice(&names)),

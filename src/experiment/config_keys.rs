@@ -76,6 +76,7 @@ pub fn allowed(key: &str) -> Option<&'static str> {
         "multipole" => {
             "a list of expansion orders, such as multipole = [\"monopole\", \"quadrupole\"]"
         }
+        "order" => "a list of fmm expansion orders from 1 to 8, such as order = [3, 4, 6]",
         "precision" => "\"f32\" or \"f64\"",
         "out" => "a directory, as a string, such as out = \"results\"",
         "measure" => {

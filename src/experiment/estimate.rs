@@ -313,6 +313,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         Option<Precision>,
         Option<u64>,
         Multipole,
+        Option<usize>,
     );
     // External programs are not probed (`None`).
     let key = |c: &Case| {
@@ -322,6 +323,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
             c.precision,
             c.theta.map(f64::to_bits),
             c.multipole,
+            c.order,
         ))
     };
     let started = Instant::now();
@@ -346,8 +348,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         setup.precision = case.precision;
         let job = ProbeJob {
             kernel: this.1,
-            theta: case.theta,
-            multipole: case.multipole,
+            params: case.kernel_params(),
             error_sample,
             started: Instant::now(),
         };
@@ -379,8 +380,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
 /// Measures one set-up on the system it is given (built after `started`).
 struct ProbeJob {
     kernel: KernelKind,
-    theta: Option<f64>,
-    multipole: Multipole,
+    params: KernelParams,
     error_sample: usize,
     started: Instant,
 }
@@ -389,13 +389,8 @@ impl SystemJob for ProbeJob {
     type Output = Result<Probe, RunError>;
 
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
-        let params = KernelParams {
-            theta: self.theta.unwrap_or(KernelParams::default().theta),
-            multipole: self.multipole,
-            ..KernelParams::default()
-        };
         let law = system.law;
-        let kernel = self.kernel.build::<T, L, D>(law, &params)?;
+        let kernel = self.kernel.build::<T, L, D>(law, &self.params)?;
         let mut sim = Simulation::new(system, kernel);
         let built_s = self.started.elapsed().as_secs_f64();
         let t = Instant::now();

@@ -9,7 +9,7 @@ use super::plan::Case;
 use crate::clock::{WallClock, clock_cost};
 use crate::decomp::stats::MpiReport;
 use crate::engine::PhaseTimes;
-use crate::kernels::WorkCounters;
+use crate::kernels::{KernelKind, WorkCounters};
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -98,10 +98,12 @@ pub fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> 
     if let Some(theta) = case.theta {
         a.extend(["--theta".to_string(), theta.to_string()]);
     }
-    // Whenever there is a θ (an octree case): the binary's default order is not the one of
-    // every case.
-    if case.theta.is_some() {
+    // The binary's default orders are not the ones of every case.
+    if case.kernel.kernel() == Some(KernelKind::Octree) {
         a.extend(["--multipole".to_string(), case.multipole.name().to_string()]);
+    }
+    if let Some(p) = case.order {
+        a.extend(["--order".to_string(), p.to_string()]);
     }
     if let Some(p) = case.precision {
         a.extend(["--precision".to_string(), p.name().to_string()]);

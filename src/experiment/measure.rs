@@ -6,7 +6,7 @@ use super::reference::time_reference;
 use super::slowdown::TestSlowdown;
 use crate::clock::{Clock, clock_cost};
 use crate::engine::{PhaseTimes, Simulation};
-use crate::kernels::{KernelParams, WorkCounters};
+use crate::kernels::WorkCounters;
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::run::RunError;
@@ -85,11 +85,7 @@ impl<C: Clock> SystemJob for MeasureJob<'_, C> {
     type Output = Result<RoundOutcome, RunError>;
 
     fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
-        let params = KernelParams {
-            theta: self.case.theta.unwrap_or(KernelParams::default().theta),
-            multipole: self.case.multipole,
-            ..KernelParams::default()
-        };
+        let params = self.case.kernel_params();
         let law = system.law;
         let kernel = TestSlowdown::apply(
             self.spec.slowdown,

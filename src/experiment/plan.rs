@@ -3,7 +3,7 @@
 use super::code::Code;
 use super::config::{Study, SweepConfig, WeakRule};
 use crate::decomp::Decomposition;
-use crate::kernels::{KernelKind, Multipole};
+use crate::kernels::{KernelKind, KernelParams, Multipole};
 use crate::scenario::{Precision, ScenarioKind};
 use serde::{Deserialize, Serialize};
 
@@ -17,11 +17,14 @@ pub struct Case {
     pub threads: usize,
     /// MPI ranks (1 without MPI).
     pub ranks: usize,
-    /// Opening angle, for the octree only.
+    /// Opening angle, for the octree and the fmm only.
     pub theta: Option<f64>,
     /// Expansion order of the octree's nodes; absent (monopole) in files written before it.
     #[serde(default, skip_serializing_if = "is_monopole")]
     pub multipole: Multipole,
+    /// Expansion order p of the fmm's cells, for the fmm only.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub order: Option<usize>,
     pub seed: u64,
     pub precision: Option<Precision>,
     /// Simulated-time factor of a weak-by-time study (the run stands for this many times the
@@ -51,6 +54,9 @@ impl Case {
         if self.multipole != Multipole::Monopole {
             k.push_str(&format!("/{}", self.multipole.name()));
         }
+        if let Some(p) = self.order {
+            k.push_str(&format!("/order={p}"));
+        }
         if let Some(p) = self.precision {
             k.push_str(&format!("/{}", p.name()));
         }
@@ -62,6 +68,18 @@ impl Case {
         }
         k
     }
+
+    /// The kernel parameters the case runs with: its θ and expansion order, the defaults
+    /// for the rest.
+    pub fn kernel_params(&self) -> KernelParams {
+        let defaults = KernelParams::default();
+        KernelParams {
+            theta: self.theta.unwrap_or(defaults.theta),
+            multipole: self.multipole,
+            order: self.order.unwrap_or(defaults.order),
+            ..defaults
+        }
+    }
 }
 
 /// Whether `m` is the default order (left out of case files and keys).
@@ -70,7 +88,7 @@ pub fn is_monopole(m: &Multipole) -> bool {
 }
 
 /// The cases of a config, in a fixed order: the externals' first, then per scenario, kernel,
-/// n, threads, seed, θ, multipole.
+/// n, threads, seed, θ, multipole or fmm order.
 /// The cases of `config`, refused when two share a key (an `[[external]]` named like a
 /// built-in kernel, say): one would be measured and reported for both.
 pub fn unique_cases(config: &SweepConfig) -> Result<Vec<Case>, String> {
@@ -92,15 +110,27 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
     external_cases(config, &mut out);
     for &scenario in &config.scenarios {
         for &kernel in config.kernels.iter().filter(|k| k.supports(scenario.law())) {
-            let (thetas, orders): (Vec<Option<f64>>, Vec<Multipole>) =
-                if kernel == KernelKind::Octree {
-                    (
-                        config.theta.iter().map(|&t| Some(t)).collect(),
-                        config.multipole.clone(),
-                    )
-                } else {
-                    (vec![None], vec![Multipole::Monopole])
-                };
+            let thetas: Vec<Option<f64>> = match kernel {
+                KernelKind::Octree => config.theta.iter().map(|&t| Some(t)).collect(),
+                // The fmm's expansions converge for θ below 1 only (validation keeps one).
+                KernelKind::Fmm => config
+                    .theta
+                    .iter()
+                    .filter(|&&t| t < 1.0)
+                    .map(|&t| Some(t))
+                    .collect(),
+                _ => vec![None],
+            };
+            // The expansion orders: the octree's multipoles, the fmm's p.
+            let orders: Vec<(Multipole, Option<usize>)> = match kernel {
+                KernelKind::Octree => config.multipole.iter().map(|&m| (m, None)).collect(),
+                KernelKind::Fmm => config
+                    .order
+                    .iter()
+                    .map(|&p| (Multipole::Monopole, Some(p)))
+                    .collect(),
+                _ => vec![(Multipole::Monopole, None)],
+            };
             // Without MPI one launch of one rank; under a launcher, every rank count with
             // every decomposition that runs this kernel.
             let launches: Vec<(usize, Option<Decomposition>)> = match &config.mpi {
@@ -131,7 +161,7 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                 for (n, time_factor) in sizes {
                     for &seed in &config.seeds {
                         for &theta in &thetas {
-                            for &multipole in &orders {
+                            for &(multipole, order) in &orders {
                                 out.push(Case {
                                     scenario,
                                     kernel: Code::Kernel(kernel),
@@ -140,6 +170,7 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                                     ranks,
                                     theta,
                                     multipole,
+                                    order,
                                     seed,
                                     precision: config.precision,
                                     time_factor,
@@ -212,6 +243,7 @@ fn external_cases(config: &SweepConfig, out: &mut Vec<Case>) {
                                     ranks: r,
                                     theta,
                                     multipole: Multipole::Monopole,
+                                    order: None,
                                     seed,
                                     precision: config.precision,
                                     time_factor,
@@ -242,9 +274,13 @@ pub fn weak_size(
         WeakRule::Linear => b * pf,
         WeakRule::Sqrt => b * pf.sqrt(),
         WeakRule::CostModel => match kernel {
-            None | Some(KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair) => {
-                b * pf
-            }
+            None
+            | Some(
+                KernelKind::CellList
+                | KernelKind::Verlet
+                | KernelKind::ClusterPair
+                | KernelKind::Fmm,
+            ) => b * pf,
             Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread) => {
                 b * pf.sqrt()
             }

@@ -163,8 +163,11 @@ pub fn run_sweep<C: Clock>(
             .validate()
             .map_err(|e| Box::new(e) as Box<dyn std::error::Error + Send + Sync>)
             .and_then(|()| match case.kernel.kernel() {
-                Some(kernel) => crate::run::check_memory(&setup, kernel, case.threads, copies)
-                    .map_err(|e| Box::new(e) as _),
+                Some(kernel) => {
+                    let params = case.kernel_params();
+                    crate::run::check_memory(&setup, kernel, &params, case.threads, copies)
+                }
+                .map_err(|e| Box::new(e) as _),
                 None => Ok(()),
             });
         checked.map_err(|source| SweepError::Case {

@@ -393,6 +393,10 @@ fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<S
         None => t.remove("theta"),
     };
     t.insert("multipole".into(), list(case.multipole.name().into()));
+    match case.order {
+        Some(p) => t.insert("order".into(), list((p as i64).into())),
+        None => t.remove("order"),
+    };
     if let Some(p) = case.precision {
         t.insert("precision".into(), p.name().into());
     }

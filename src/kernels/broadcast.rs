@@ -45,6 +45,9 @@ pub fn tile_forces<T: Real, L: PairLaw<T>, const D: usize>(
     own: usize,
 ) -> [[T; LANES]; D] {
     let n = src.len();
+    // Any `own` at or past the run means no lane's slot is in it; clamped, `j − own` wraps to
+    // far past the lanes for every j (unclamped, `usize::MAX` would wrap to j + 1).
+    let own = own.min(n);
     let pos: [&[T]; D] = std::array::from_fn(|d| &src.pos[d][..n]);
     let s = &src.s[..n];
     let mut force = [[T::zero(); LANES]; D];
@@ -77,7 +80,8 @@ mod tests {
     use crate::physics::{Coulomb, Gravity, pair_force};
 
     /// Every lane's force equals the sum over its sources but its own slot, for partial tiles
-    /// and tiles overlapping the sources' start and end, in both laws.
+    /// and tiles overlapping the sources' start and end, in both laws; and the sum over every
+    /// source when the targets are not among them (`own` = `usize::MAX`).
     #[test]
     fn tile_matches_the_pair_sum() {
         let n = 2 * LANES + 5;
@@ -114,6 +118,22 @@ mod tests {
             check(&|dx, a, b| pair_force(&gravity, dx, a, b), g, lo, hi - lo);
             let c = tile_forces(&coulomb, &tile, &src, lo);
             check(&|dx, a, b| pair_force(&coulomb, dx, a, b), c, lo, hi - lo);
+        }
+        // Targets that are not sources: every source acts on every lane.
+        let far: [Vec<f64>; 3] = std::array::from_fn(|d| pos[d].iter().map(|x| x + 7.0).collect());
+        let tile = Tile::load(&far, &s, 0, LANES);
+        let got = tile_forces(&gravity, &tile, &src, usize::MAX);
+        for l in 0..LANES {
+            let mut want = [0.0; 3];
+            for j in 0..n {
+                let dx: [f64; 3] = std::array::from_fn(|d| pos[d][j] - far[d][l]);
+                let f = pair_force(&gravity, dx, s[l], s[j]);
+                (0..3).for_each(|d| want[d] += f[d]);
+            }
+            let scale = want.iter().map(|w| w.abs()).sum::<f64>();
+            for d in 0..3 {
+                assert!((got[d][l] - want[d]).abs() <= 1e-13 * scale, "lane {l}");
+            }
         }
     }
 }

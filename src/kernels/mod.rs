@@ -10,6 +10,7 @@ mod broadcast;
 mod cell_list;
 mod cluster_pair;
 mod counting_sort;
+mod fmm;
 pub mod footprint;
 mod naive;
 mod octree;
@@ -21,6 +22,7 @@ pub mod verlet;
 
 pub use cell_list::CellList;
 pub use cluster_pair::ClusterPair;
+pub use fmm::{Fmm, MAX_ORDER as MAX_FMM_ORDER};
 pub use naive::Naive;
 pub(crate) use octree::interleave;
 pub use octree::{Multipole, Octree, TreeView, far_from_box};
@@ -36,7 +38,7 @@ use serde::Serialize;
 use std::ops::Range;
 use thiserror::Error;
 
-/// The seven kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
+/// The eight kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
 #[derive(
     Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
 )]
@@ -58,10 +60,13 @@ pub enum KernelKind {
     /// Verlet list of 4-particle clusters (GROMACS nbnxm style), each against runs of 16
     /// particles in one SIMD block, for dense systems (O(n)).
     ClusterPair,
+    /// Fast multipole method (falcON style): mutual cell–cell interactions of Cartesian
+    /// order p between cells that pass the opening test with θ, near leaves directly (O(n)).
+    Fmm,
 }
 
 impl KernelKind {
-    pub const ALL: [KernelKind; 7] = [
+    pub const ALL: [KernelKind; 8] = [
         KernelKind::Naive,
         KernelKind::Symmetric,
         KernelKind::PerThread,
@@ -69,6 +74,7 @@ impl KernelKind {
         KernelKind::Octree,
         KernelKind::Verlet,
         KernelKind::ClusterPair,
+        KernelKind::Fmm,
     ];
 
     pub fn name(self) -> &'static str {
@@ -80,12 +86,13 @@ impl KernelKind {
             KernelKind::Octree => "octree",
             KernelKind::Verlet => "verlet",
             KernelKind::ClusterPair => "cluster-pair",
+            KernelKind::Fmm => "fmm",
         }
     }
 
     /// Whether the kernel computes the exact pair sum (to rounding) rather than an approximation.
     pub fn is_exact(self) -> bool {
-        !matches!(self, KernelKind::Octree)
+        !matches!(self, KernelKind::Octree | KernelKind::Fmm)
     }
 
     /// Whether the kernel can compute forces for a law of this family.
@@ -93,7 +100,7 @@ impl KernelKind {
         match self {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => true,
             KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair => law.has_cutoff(),
-            KernelKind::Octree => law.is_inverse_square(),
+            KernelKind::Octree | KernelKind::Fmm => law.is_inverse_square(),
         }
     }
 
@@ -104,9 +111,10 @@ impl KernelKind {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => {
                 Complexity::Quadratic
             }
-            KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair => {
-                Complexity::Linear
-            }
+            KernelKind::CellList
+            | KernelKind::Verlet
+            | KernelKind::ClusterPair
+            | KernelKind::Fmm => Complexity::Linear,
             KernelKind::Octree => Complexity::NLogN,
         }
     }
@@ -153,6 +161,15 @@ impl KernelKind {
             )),
             KernelKind::Verlet => Box::new(Verlet::new(law, params.skin)?),
             KernelKind::ClusterPair => Box::new(ClusterPair::new(law, params.skin)?),
+            KernelKind::Fmm => {
+                params.validate_fmm::<D>()?;
+                Box::new(Fmm::new(
+                    law,
+                    params.theta,
+                    params.order,
+                    params.fmm_leaf_size,
+                ))
+            }
         })
     }
 }
@@ -205,6 +222,20 @@ pub struct KernelParams {
     /// Barnes-Hut expansion order of accepted nodes.
     #[serde(default)]
     pub multipole: Multipole,
+    /// Expansion order p of the fast multipole kernel (1 to `fmm::MAX_ORDER`).
+    #[serde(default = "default_order")]
+    pub order: usize,
+    /// Most particles in a leaf of the fast multipole kernel's tree.
+    #[serde(default = "default_fmm_leaf_size")]
+    pub fmm_leaf_size: usize,
+}
+
+fn default_order() -> usize {
+    fmm::DEFAULT_ORDER
+}
+
+fn default_fmm_leaf_size() -> usize {
+    fmm::DEFAULT_LEAF_SIZE
 }
 
 /// The Verlet skin by default: 0.3σ of the LJ scenarios.
@@ -220,6 +251,8 @@ impl Default for KernelParams {
             skin: default_skin(),
             // Cheaper than monopoles at equal error (REPORT.md, accuracy section).
             multipole: Multipole::Quadrupole,
+            order: default_order(),
+            fmm_leaf_size: default_fmm_leaf_size(),
         }
     }
 }
@@ -234,8 +267,26 @@ impl KernelParams {
         }
         if self.leaf_size == 0 || self.leaf_size > 4096 {
             return Err(KernelError::BadParam(format!(
-                "leaf size must be between 1 and 4096 (got {})",
-                self.leaf_size
+                "--leaf-size must be between 1 and 4096 for the octree kernel (got {}); {} is \
+                 its default",
+                self.leaf_size,
+                KernelParams::default().leaf_size
+            )));
+        }
+        if !(1..=fmm::MAX_ORDER).contains(&self.order) {
+            return Err(KernelError::BadParam(format!(
+                "order must be between 1 and {} (got {}); {} is the default",
+                fmm::MAX_ORDER,
+                self.order,
+                default_order()
+            )));
+        }
+        if self.fmm_leaf_size == 0 || self.fmm_leaf_size > 4096 {
+            return Err(KernelError::BadParam(format!(
+                "--leaf-size must be between 1 and 4096 for the fmm kernel (got {}); {} is its \
+                 default",
+                self.fmm_leaf_size,
+                default_fmm_leaf_size()
             )));
         }
         if !(self.skin.is_finite() && self.skin > 0.0) {
@@ -244,6 +295,34 @@ impl KernelParams {
                 self.skin,
                 default_skin()
             )));
+        }
+        Ok(())
+    }
+}
+
+impl KernelParams {
+    /// Whether θ is below 1, where the fmm's expansions converge (the fmm refuses the rest).
+    pub fn fmm_converges(&self) -> bool {
+        self.theta < 1.0
+    }
+
+    /// What the fast multipole kernel needs beyond [`KernelParams::validate`]: θ below 1 (the
+    /// expansions converge only there) and three dimensions (its expansions are 3-D).
+    fn validate_fmm<const D: usize>(&self) -> Result<(), KernelError> {
+        if !self.fmm_converges() {
+            return Err(KernelError::BadParam(format!(
+                "theta must be below 1 for the fmm kernel (got {}): two cells interact through \
+                 their expansions when their radii add up to less than theta times their \
+                 distance, and the expansions converge only where that sum is below the \
+                 distance; 0.5 is the usual choice",
+                self.theta
+            )));
+        }
+        if D != 3 {
+            return Err(KernelError::Dimension {
+                kernel: KernelKind::Fmm.name(),
+                dim: D,
+            });
         }
         Ok(())
     }
@@ -259,6 +338,11 @@ pub enum KernelError {
     },
     #[error("{0}")]
     BadParam(String),
+    #[error(
+        "kernel `{kernel}` runs in three dimensions only and this system has {dim}; the long-range \
+         scenarios (coulomb, galaxy) are 3-D, and the octree handles 2-D systems"
+    )]
+    Dimension { kernel: &'static str, dim: usize },
 }
 
 /// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order), unless

@@ -121,7 +121,10 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     fn energy(&self, r2: T, si: T, sj: T) -> T;
 
     /// Whether the pair at squared distance `r2` interacts at all (inside the cutoff, outside
-    /// the quench radius). Used only to count work.
+    /// the quench radius). The kernels count work with it, and the fmm accepts a pair of cells
+    /// only where it holds at the least distance their particles can have: so for a law
+    /// without cutoff it must hold at every distance beyond one where it holds (the force
+    /// there is the smooth field the expansions stand for).
     fn interacts(&self, r2: T) -> bool;
 
     /// The cutoff radius, for short-ranged laws.

@@ -319,6 +319,9 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 if t.series.multipole != Multipole::Monopole {
                     name.push_str(&format!(" {}", t.series.multipole.name()));
                 }
+                if let Some(p) = t.series.order {
+                    name.push_str(&format!(" order {p}"));
+                }
                 name
             },
             points: t
@@ -366,6 +369,7 @@ fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
                 && o.ranks == c.ranks
                 && o.theta == c.theta
                 && o.case.multipole == c.case.multipole
+                && o.case.order == c.case.order
                 && o.decomp == c.decomp
         };
         match out.iter().position(same) {

@@ -189,12 +189,14 @@ pub fn weak(a: &Analysis) -> String {
     md
 }
 
-/// θ of an octree case, with the expansion order when it is not the default monopole.
+/// θ of an octree or fmm case, with the expansion order when it is not the octree's
+/// default monopole (the fmm's order always).
 fn theta_cell(p: &crate::analysis::groups::Point) -> String {
     let theta = p.theta.map_or(NONE.to_string(), |t| t.to_string());
-    match p.case.multipole {
-        crate::kernels::Multipole::Monopole => theta,
-        m => format!("{theta} ({})", m.name()),
+    match (p.case.multipole, p.case.order) {
+        (_, Some(order)) => format!("{theta} (order {order})"),
+        (crate::kernels::Multipole::Monopole, None) => theta,
+        (m, None) => format!("{theta} ({})", m.name()),
     }
 }
 

@@ -7,7 +7,7 @@
 //! only criterion's loops.
 
 use crate::engine::Simulation;
-use crate::kernels::{CellList, ForceKernel, KernelKind, KernelParams, Octree, Verlet};
+use crate::kernels::{CellList, Fmm, ForceKernel, KernelKind, KernelParams, Octree, Verlet};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::scenario::{Setup, System, SystemJob};
@@ -101,6 +101,16 @@ impl SystemJob for Prepare {
                     KernelKind::Verlet => Box::new(
                         Verlet::new(system.law, params.skin).map_err(|e| kernel_error(&e))?,
                     ),
+                    KernelKind::Fmm => {
+                        // Checks θ, the order and the dimension as a run would.
+                        build()?;
+                        Box::new(Fmm::new(
+                            system.law,
+                            params.theta,
+                            params.order,
+                            params.fmm_leaf_size,
+                        ))
+                    }
                     other => {
                         return Err(BenchCaseError::Kernel(format!(
                             "{} has no build phase",
@@ -151,6 +161,12 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Builder<T, D> for CellList<L, T, D>
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> Builder<T, D> for Octree<L, T, D> {
+    fn build_phase(&mut self, state: &State<T, D>) {
+        self.build(state);
+    }
+}
+
+impl<T: Real, L: PairLaw<T>, const D: usize> Builder<T, D> for Fmm<L, T, D> {
     fn build_phase(&mut self, state: &State<T, D>) {
         self.build(state);
     }
@@ -219,7 +235,10 @@ mod tests {
                 step.run();
                 let build = bench_case(&setup(scenario, 300), kernel, Work::Build);
                 match kernel {
-                    KernelKind::CellList | KernelKind::Octree | KernelKind::Verlet => {
+                    KernelKind::CellList
+                    | KernelKind::Octree
+                    | KernelKind::Verlet
+                    | KernelKind::Fmm => {
                         build.unwrap().run();
                     }
                     _ => assert!(build.is_err(), "{kernel:?} has no build phase"),

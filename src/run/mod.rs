@@ -170,11 +170,13 @@ pub const MAX_THREADS: usize = 1024;
 pub fn check_memory(
     setup: &Setup,
     kernel: KernelKind,
+    params: &KernelParams,
     threads: usize,
     processes: usize,
 ) -> Result<(), footprint::TooLarge> {
     footprint::check(
         kernel,
+        params,
         setup.n(),
         setup.scenario.dim(),
         setup.precision().bytes(),

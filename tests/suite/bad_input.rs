@@ -237,10 +237,13 @@ fn configs_name_the_key_and_the_allowed_forms() {
 
 #[test]
 fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
-    for flag in [
-        ["--theta", "0.7"],
-        ["--leaf-size", "4"],
-        ["--multipole", "quadrupole"],
+    for (kernel, flag, users) in [
+        ("naive", ["--theta", "0.7"], "octree and fmm kernels"),
+        ("naive", ["--leaf-size", "4"], "octree and fmm kernels"),
+        ("naive", ["--multipole", "quadrupole"], "octree kernel"),
+        ("fmm", ["--multipole", "quadrupole"], "octree kernel"),
+        ("naive", ["--order", "3"], "fmm kernel"),
+        ("octree", ["--order", "3"], "fmm kernel"),
     ] {
         let o = bin()
             .args([
@@ -248,17 +251,14 @@ fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
                 "--scenario",
                 "galaxy",
                 "--kernel",
-                "naive",
+                kernel,
                 "-n",
                 "20",
             ])
             .args(flag)
             .output()
             .unwrap();
-        refused(
-            &o,
-            &format!("{} applies to the octree kernel only", flag[0]),
-        );
+        refused(&o, &format!("{} applies to the {users} only", flag[0]));
     }
     let o = bin()
         .args([

@@ -1,5 +1,5 @@
 //! Energy conservation of velocity Verlet over a few hundred steps for every scenario, and a
-//! two-body circular orbit that stays circular.
+//! two-body circular orbit that stays circular (the fmm's through its expansions).
 
 use nbody_bench::boundary::Boundary;
 use nbody_bench::engine::Simulation;
@@ -81,6 +81,7 @@ fn energy_drift_is_bounded_for_every_scenario() {
             None,
             1e-3,
         ),
+        (ScenarioKind::Galaxy, KernelKind::Fmm, 1000, 300, None, 1e-3),
         // At the source's dt = 1e-5 the closest opposite charges collapse within ~100 steps and
         // cross the quench radius, where the zeroed force does not conserve energy; a smaller
         // step keeps the check about the integrator.
@@ -124,7 +125,12 @@ fn two_body_circular_orbit_stays_circular() {
         density: None,
         box_side: None,
     };
-    for kernel in [KernelKind::Naive, KernelKind::Symmetric, KernelKind::Octree] {
+    for kernel in [
+        KernelKind::Naive,
+        KernelKind::Symmetric,
+        KernelKind::Octree,
+        KernelKind::Fmm,
+    ] {
         let system = System {
             state: state.clone(),
             law: Gravity::<f64>::new(1.0, 0.0),
@@ -133,9 +139,15 @@ fn two_body_circular_orbit_stays_circular() {
             dt: period / steps as f64,
             info: info.clone(),
         };
-        let k = kernel
-            .build::<f64, _, 3>(system.law, &KernelParams::default())
-            .unwrap();
+        // Leaves of one particle for the fmm: at its default leaf size both bodies share a
+        // leaf and it is the direct sum; so each body has a cell of its own, whose radius is
+        // zero, the two cells interact through their expansions (M2L, L2P) at any θ > 0.
+        let params = KernelParams {
+            fmm_leaf_size: 1,
+            ..KernelParams::default()
+        };
+        assert!(params.theta > 0.0);
+        let k = kernel.build::<f64, _, 3>(system.law, &params).unwrap();
         let mut sim = Simulation::new(system, k);
         let e0 = sim.probe().total();
         for _ in 0..steps {
@@ -152,6 +164,14 @@ fn two_body_circular_orbit_stays_circular() {
             (sim.state.pos[0][slot[0]] - r).abs() < 1e-4 && sim.state.pos[1][slot[0]].abs() < 1e-3
         );
         assert!(((sim.probe().total() - e0) / e0).abs() < 1e-8);
+        if kernel == KernelKind::Fmm {
+            // Every step through the expansions, none through the particle pair.
+            assert_eq!(
+                sim.work.pair_checks, 0,
+                "fmm: the bodies met in the near field"
+            );
+            assert!(sim.work.nodes_accepted >= steps, "{:?}", sim.work);
+        }
     }
 }
 

@@ -1,7 +1,8 @@
 //! Every kernel against the naive sum in f64, on every law it supports, for several n
 //! (tiny and odd included), thread counts (2 and 3 oversubscribe a 2-CPU machine) and both
 //! precisions; the octree's error shrinks with θ and is exact at θ = 0, at both expansion
-//! orders, the quadrupole's below the monopole's.
+//! orders, the quadrupole's below the monopole's; the fmm is exact at θ = 0 and within its
+//! tolerance on the scenarios, and `validate` skips it, visibly, at θ ≥ 1.
 
 use nbody_bench::kernels::{KernelKind, KernelParams, Multipole};
 use nbody_bench::physics::PairLaw;
@@ -17,6 +18,8 @@ struct Compare {
     threads: usize,
     theta: f64,
     multipole: Multipole,
+    /// The fmm's expansion order (None: the default).
+    order: Option<usize>,
     /// Computes with the probe (energy, interacting pairs) on both sides: the path of the first
     /// kick and of every energy check.
     probe: bool,
@@ -44,6 +47,7 @@ impl SystemJob for Compare {
         let params = KernelParams {
             theta: self.theta,
             multipole: self.multipole,
+            order: self.order.unwrap_or(KernelParams::default().order),
             ..KernelParams::default()
         };
         // Exact kernels are compared with naive in their own precision (identical pair
@@ -139,6 +143,7 @@ fn exact_kernels_agree_with_the_reference() {
                         threads,
                         theta: 0.5,
                         multipole: Multipole::Monopole,
+                        order: None,
                         probe: false,
                     };
                     let (eps, errs) = setup(scenario, n, precision, 7).dispatch(job).unwrap();
@@ -177,6 +182,7 @@ fn probe_paths_agree_with_naive() {
                         threads,
                         theta: 0.5,
                         multipole: Multipole::Monopole,
+                        order: None,
                         probe: true,
                     };
                     let (eps, errs) = setup(scenario, n, precision, 11).dispatch(job).unwrap();
@@ -214,6 +220,7 @@ fn octree_is_exact_at_theta_zero() {
                         threads,
                         theta: 0.0,
                         multipole,
+                        order: None,
                         probe: false,
                     };
                     let (eps, errs) = setup(scenario, n, Precision::F64, 3).dispatch(job).unwrap();
@@ -235,6 +242,7 @@ fn octree_error(scenario: ScenarioKind, theta: f64, multipole: Multipole, thread
         threads,
         theta,
         multipole,
+        order: None,
         probe: false,
     };
     setup(scenario, 3000, Precision::F64, 5)
@@ -278,4 +286,89 @@ fn quadrupole_octree_error_is_below_the_monopoles() {
             last = quad;
         }
     }
+}
+
+/// The fmm on the long-range scenarios: the direct sum at θ = 0 (every pair in the near
+/// field), and within its tolerance at θ = 0.5 for several orders, on any thread count.
+#[test]
+fn fmm_is_exact_at_theta_zero_and_within_its_tolerance() {
+    for scenario in [ScenarioKind::Galaxy, ScenarioKind::Coulomb] {
+        for n in [1, 3, 17, 600] {
+            for threads in [1, 2] {
+                let job = Compare {
+                    kinds: vec![KernelKind::Fmm],
+                    threads,
+                    theta: 0.0,
+                    multipole: Multipole::Monopole,
+                    order: None,
+                    probe: false,
+                };
+                let (eps, errs) = setup(scenario, n, Precision::F64, 3).dispatch(job).unwrap();
+                assert!(
+                    errs[0].rounding_ratio <= EXACT_ULPS * eps,
+                    "{scenario:?} n={n}: {:e}",
+                    errs[0].rounding_ratio
+                );
+            }
+        }
+        for order in [2, 4, 6] {
+            let job = Compare {
+                kinds: vec![KernelKind::Fmm],
+                threads: 2,
+                theta: 0.5,
+                multipole: Multipole::Monopole,
+                order: Some(order),
+                probe: true,
+            };
+            let errs = setup(scenario, 3000, Precision::F64, 5)
+                .dispatch(job)
+                .unwrap()
+                .1;
+            let bound = nbody_bench::validate::fmm_tolerance(0.5, order);
+            assert!(
+                errs[0].median_rel <= bound,
+                "{scenario:?} p={order}: median error {:e} > {bound:e}",
+                errs[0].median_rel
+            );
+            // The probe's energy: within the force error's order of magnitude.
+            assert!(
+                errs[0].energy_rel <= bound,
+                "{scenario:?} p={order}: energy"
+            );
+        }
+    }
+}
+
+/// At θ = 1 the fmm refuses to run (its expansions diverge there) but the octree does not:
+/// `validate` checks the other kernels, shows the fmm as skipped on each long-range scenario,
+/// and passes.
+#[test]
+fn validate_at_theta_one_skips_the_fmm_and_passes() {
+    let o = crate::bin()
+        .args(["validate", "-n", "300", "--theta", "1"])
+        .output()
+        .unwrap();
+    let out = crate::text(&o.stdout);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{out}\n{}",
+        crate::text(&o.stderr)
+    );
+    let skips: Vec<&str> = out.lines().filter(|l| l.contains("skip")).collect();
+    // One row per long-range scenario, and the closing line.
+    assert_eq!(skips.len(), 3, "{out}");
+    for row in &skips[..2] {
+        assert!(row.trim_start().starts_with("fmm"), "{row}");
+        assert!(row.contains("skipped (fmm needs theta below 1)"), "{row}");
+    }
+    assert!(
+        out.contains("skipped: coulomb/fmm, galaxy/fmm") && !out.contains("FAIL"),
+        "{out}"
+    );
+    // The octree still ran at θ = 1.
+    assert!(
+        out.lines().any(|l| l.trim_start().starts_with("octree")),
+        "{out}"
+    );
 }

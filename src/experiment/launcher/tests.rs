@@ -25,6 +25,7 @@ fn case() -> Case {
         ranks: 4,
         theta: None,
         multipole: Default::default(),
+        order: None,
         seed: 3,
         precision: Some(Precision::F64),
         time_factor: 1,

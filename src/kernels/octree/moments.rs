@@ -59,7 +59,7 @@ const EMPTY: Sums = Sums {
 };
 
 /// Reused buffers of the pass.
-pub(super) struct Quadrupoles<T> {
+pub(in crate::kernels) struct Quadrupoles<T> {
     /// `stride(D)` values per node, in arena order.
     pub values: Vec<T>,
     sums: Vec<Sums>,

@@ -6,7 +6,7 @@ use crate::real::Real;
 
 /// One tree node: a Morton cell and the particles `start..end` (sorted order) inside it.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Node<T, const D: usize> {
+pub(in crate::kernels) struct Node<T, const D: usize> {
     /// Centre of strength (mass-weighted centre); the mean position if the strength is zero.
     pub com: [T; D],
     /// Total source strength.

@@ -6,58 +6,15 @@ use super::*;
 use crate::kernels::Naive;
 use crate::physics::{Coulomb, Gravity};
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, plummer_state as plummer, random_state};
+use crate::testing::{
+    SEED_1, SEED_2, forces_of, max_rel_diff, median_rel_err, plummer_state as plummer, random_state,
+};
 
 fn pool(p: usize) -> rayon::ThreadPool {
     rayon::ThreadPoolBuilder::new()
         .num_threads(p)
         .build()
         .expect("thread pool")
-}
-
-/// Forces (and the probe energy) of a kernel on a state.
-fn forces_of<T: Real, const D: usize>(
-    k: &mut dyn ForceKernel<T, D>,
-    s: &State<T, D>,
-    probe: bool,
-) -> (Field<T, D>, ForceReport) {
-    let mut f = zero_field(s.len());
-    let r = k.compute(s, &mut f, probe);
-    (f, r)
-}
-
-fn norm<T: Real, const D: usize>(f: &Field<T, D>, i: usize) -> f64 {
-    (0..D).map(|d| f[d][i].as_f64().powi(2)).sum::<f64>().sqrt()
-}
-
-/// max_i |a_i − b_i| / max_i |b_i|.
-fn max_rel_diff<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
-    let n = a[0].len();
-    let scale = (0..n).map(|i| norm(b, i)).fold(0.0, f64::max).max(1e-300);
-    let diff = (0..n)
-        .map(|i| {
-            let e: f64 = (0..D)
-                .map(|d| (a[d][i].as_f64() - b[d][i].as_f64()).powi(2))
-                .sum();
-            e.sqrt()
-        })
-        .fold(0.0, f64::max);
-    diff / scale
-}
-
-/// Median over particles of |a_i − b_i| / |b_i|.
-fn median_rel_err<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
-    let n = a[0].len();
-    let mut errs: Vec<f64> = (0..n)
-        .map(|i| {
-            let e: f64 = (0..D)
-                .map(|d| (a[d][i].as_f64() - b[d][i].as_f64()).powi(2))
-                .sum();
-            e.sqrt() / norm(b, i).max(1e-300)
-        })
-        .collect();
-    errs.sort_by(f64::total_cmp);
-    errs[n / 2]
 }
 
 fn gravity<T: Real>() -> Gravity<T> {

@@ -10,9 +10,11 @@
 //!
 //! Sources of both signs (Coulomb) get separate trees: a monopole of mixed-sign charges has no
 //! meaningful centre. The sign is the key's top bit, so the one sort also separates the trees.
+//! The fast multipole kernel (`kernels::fmm`) builds the same tree over all its sources in one
+//! class ([`Tree::one_class`]): its expansions carry charges of both signs.
 
 use super::moments::Quadrupoles;
-pub(super) use super::node::Node;
+pub(in crate::kernels) use super::node::Node;
 use crate::real::Real;
 use crate::state::State;
 
@@ -31,7 +33,7 @@ pub(super) const fn max_depth(d: usize) -> u32 {
 
 /// A target group: a run of sibling subtrees whose particles share one interaction list.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Group {
+pub(in crate::kernels) struct Group {
     pub start: u32,
     pub end: u32,
 }
@@ -55,7 +57,7 @@ impl<const D: usize> Moments<D> {
 }
 
 /// The tree and the particles in tree (sorted) order. Every buffer is reused across steps.
-pub(super) struct Tree<T, const D: usize> {
+pub(in crate::kernels) struct Tree<T, const D: usize> {
     /// (key, original index) pairs, sorted by key; the index breaks ties deterministically.
     keys: Vec<(u64, u32)>,
     /// `order[sorted slot] = original index`.
@@ -73,6 +75,8 @@ pub(super) struct Tree<T, const D: usize> {
     /// Second moments of every node, computed only for the quadrupole order (else empty).
     pub quad: Quadrupoles<T>,
     quadrupole: bool,
+    /// Whether negative sources get a tree of their own (see the module docs).
+    split_signs: bool,
     theta: f64,
     leaf_size: usize,
     group_size: usize,
@@ -95,11 +99,22 @@ impl<T: Real, const D: usize> Tree<T, D> {
             dummy: [T::zero(); D],
             quad: Quadrupoles::new(),
             quadrupole,
+            split_signs: true,
             theta,
             leaf_size: leaf_size.max(1),
             group_size: group_size.max(1),
             lo: [0.0; D],
             side: 1.0,
+        }
+    }
+
+    /// A tree of one class whatever the signs of the sources, for the fast multipole kernel:
+    /// leaves of at most `leaf_size` particles, no θ (the kernel tests its own criterion), no
+    /// second moments.
+    pub fn one_class(leaf_size: usize) -> Self {
+        Tree {
+            split_signs: false,
+            ..Tree::new(0.0, leaf_size, leaf_size, false)
         }
     }
 
@@ -137,7 +152,7 @@ impl<T: Real, const D: usize> Tree<T, D> {
                 // `as` saturates (NaN → 0); the clamp keeps the particle on the upper faces.
                 (((state.pos[d][i].as_f64() - lo[d]) * scale) as u64).min(top)
             });
-            let sign = if state.source[i] < T::zero() {
+            let sign = if self.split_signs && state.source[i] < T::zero() {
                 NEGATIVE
             } else {
                 0
