@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 source scripts/lib/sweep.sh
 
 CONFIGS=(complexity complexity-large strong weak weak-time octree-accuracy
-    vs-lammps vs-lammps-liquid vs-pytreegrav)
+    vs-lammps vs-lammps-liquid vs-pytreegrav vs-fmm3d)
 mode="${1:-}"
 cargo build --release --quiet
 bin=target/release/nbody-bench

@@ -15,7 +15,7 @@ use std::path::PathBuf;
     about = "Characterize the performance of particle (N-body) simulation codes",
     long_about = "Characterize the performance of particle (N-body) simulation codes.\n\n\
         An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, \
-        octree, verlet) over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, \
+        octree, verlet, cluster-pair, fmm) over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, \
         work counters and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
     after_help = "Examples:\n  nbody-bench list\n  nbody-bench sweep --config configs/quick.toml\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
 )]

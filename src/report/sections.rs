@@ -231,7 +231,7 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
 }
 
 fn octree(md: &mut String, sweeps: &[Sweep]) {
-    md.push_str("\n## Octree accuracy vs cost over θ\n\n");
+    md.push_str("\n## Long-range accuracy vs cost over θ: octree and fmm\n\n");
     // A sweep against another tree code is shown in its own section.
     let with: Vec<&Sweep> = sweeps
         .iter()
@@ -262,7 +262,7 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
     if with.is_empty() {
         md.push_str(
             "No sweep ran an external program next to our kernels (configs/vs-lammps.toml, \
-             configs/vs-pytreegrav.toml, after scripts/install-peers.sh).\n\n",
+             configs/vs-pytreegrav.toml, configs/vs-fmm3d.toml, after scripts/install-peers.sh).\n\n",
         );
     } else {
         md.push_str(

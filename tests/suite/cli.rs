@@ -44,6 +44,16 @@ fn help_and_list() {
         assert!(out.contains(word), "list lacks {word}");
     }
     assert!(out.contains("galaxy     (gravity): naive, symmetric, per-thread, octree"));
+    // The top-level help's summary names every kernel the binary has.
+    let help = String::from_utf8_lossy(&bin(&["--help"]).stdout).into_owned();
+    let summary = help.split("Exit codes").next().unwrap_or_default();
+    for kind in nbody_bench::kernels::KernelKind::ALL {
+        assert!(
+            summary.contains(kind.name()),
+            "--help's summary lacks the {} kernel",
+            kind.name()
+        );
+    }
 }
 
 #[test]
