@@ -53,19 +53,16 @@ use std::time::Instant;
 use tree::Cells;
 use walk::Walk;
 
-/// The expansion order by default. Measured on a 2-vCPU Intel Xeon at 2.8 GHz (single runs,
-/// one thread, µs per particle-step at n = 1e5, median force errors at n = 2e4): at a median
-/// error near 1e-3, p = 4 was the cheapest order on `galaxy` (θ 0.8: 1.0e-3 at 2.7 µs; p 5
-/// at θ 0.9: 9.0e-4 at 3.3 µs; p 3 at θ 0.5: 9.8e-4 at 7.6 µs) and within the runs' noise
-/// of p 5 and 6 on `coulomb` (θ 0.5: 6.8e-4 at 5.1 µs; p 6 at θ 0.7: 9.0e-4 at 4.1 µs; p 3
-/// at θ 0.4: 7.6e-4 at 7.9 µs). Towards 1e-4 the higher orders at larger θ win (galaxy
-/// p 5 at θ 0.7: 2.2e-4 at 4.8 µs against p 4 at θ 0.6: 3.3e-4 at 5.7 µs).
+/// The expansion order by default: at a median force error near 1e-3, the usual accuracy of
+/// these studies, order 4 was the cheapest on `galaxy` and level with orders 5 and 6 on
+/// `coulomb`; towards 1e-4 the higher orders at a larger θ cost less (REPORT.md's long-range
+/// accuracy section, `configs/octree-accuracy.toml`, has the sweep).
 pub const DEFAULT_ORDER: usize = 4;
 
-/// Most particles in a leaf by default: on `galaxy` (θ 0.7, p 5, n = 1e5) 4.1 µs per
-/// particle-step against 5.4 at 32 and 5.5 at 128; on `coulomb` (uniform charges, whose
-/// octree cells jump in population by 8 per level) 64 and 128 build the same tree there, and
-/// 32 tripled the error (2.0e-3 against 6.8e-4 at θ 0.5, p 4) for no gain.
+/// Most particles in a leaf by default: on `galaxy` 32 and 128 were about 1.3 times slower
+/// per particle-step than 64 at equal θ and order; on `coulomb` (uniform charges, whose octree
+/// cells grow by 8 per level) 64 and 128 build the same tree, and 32 tripled the error for no
+/// gain.
 pub const DEFAULT_LEAF_SIZE: usize = 64;
 
 /// Cells (M2L) or leaves (near field, L2P) per parallel task.
