@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-# The coulomb scenario's quench (src/scenario/mod.rs, COULOMB_QUENCH): pairs closer than this
+# The coulomb scenario's quench (crates/engine/src/scenario/mod.rs, COULOMB_QUENCH): pairs closer than this
 # exert no force.
 QUENCH = 1e-3
 USAGE = "usage: fmm3d-driver.py STATE.npy EPS STEPS [SAMPLE] [--forces OUT.npy]"

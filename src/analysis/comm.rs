@@ -3,9 +3,9 @@
 //! beyond the machine, for a weak-scaling series of the 2-D LJ gas (n = n₀·p).
 
 use super::Fitted;
-use crate::decomp::bench_file::MpiBenchFile;
 use crate::decomp::model;
 use crate::fit::{self, AlphaBetaFit, Samples};
+use crate::ranks::bench_file::MpiBenchFile;
 use serde::Serialize;
 
 /// One predicted point: communication seconds per step with the 95% band of the fit.

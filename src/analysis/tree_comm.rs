@@ -14,13 +14,13 @@
 use super::Fitted;
 use super::comm::{PREDICTED_RANKS, fit_ping_pong, predict};
 use super::groups::Point;
-use crate::decomp::bench_file::MpiBenchFile;
 use crate::decomp::octants::{Octants, root_cube};
 use crate::decomp::orb::Orb;
 use crate::decomp::{Decomposition, Domains, model};
 use crate::fit::AlphaBetaFit;
 use crate::kernels::Multipole;
 use crate::physics::PairLaw;
+use crate::ranks::bench_file::MpiBenchFile;
 use crate::real::Real;
 use crate::scenario::{ScenarioKind, Setup, System, SystemJob};
 use rayon::prelude::*;

@@ -7,7 +7,7 @@
 
 use crate::cli::args::{MpiBenchArgs, MpiCheckArgs, RunArgs};
 use nbody_bench::decomp::Decomposition;
-use nbody_bench::decomp::job::Job;
+use nbody_bench::ranks::job::Job;
 
 /// The job the ranks compare when MPI starts (`Mpi::init`): the subcommand `name` and its
 /// parsed arguments (so `--steps=3` and `--steps 3` agree, and defaults count), and the
@@ -435,7 +435,7 @@ mod tests {
     use super::job;
     use crate::cli::args::{Cli, Command};
     use clap::Parser;
-    use nbody_bench::decomp::job::{Difference, JobDigest};
+    use nbody_bench::ranks::job::{Difference, JobDigest};
 
     /// The digest of the MPI job of a command line, as `Mpi::init` computes it.
     fn digest(line: &str) -> JobDigest {

@@ -391,9 +391,7 @@ impl Metadata {
             tool_version: env!("CARGO_PKG_VERSION").to_string(),
             git_commit,
             git_dirty,
-            rustc_version: option_env!("NBODY_BENCH_RUSTC")
-                .unwrap_or("unknown")
-                .to_string(),
+            rustc_version: nbody_engine::RUSTC_VERSION.to_string(),
             simd: crate::simd::level().name().to_string(),
             target_features: compiled_features(),
             cargo_features: [("mpi", cfg!(feature = "mpi"))]

@@ -4,10 +4,10 @@
 
 use super::comm::Comm;
 use super::error::MpiError;
-use crate::decomp::bench_file::{
+use crate::experiment::results::{git_state, utc_now};
+use crate::ranks::bench_file::{
     MPI_BENCH_SCHEMA, MpiBenchFile, Series, SizeTimings, reps_at, sizes,
 };
-use crate::experiment::results::{git_state, utc_now};
 use std::time::Instant;
 
 /// Message sizes and repetitions.
@@ -70,7 +70,7 @@ pub fn run(comm: &mut Comm, o: &BenchOptions) -> Result<Option<MpiBenchFile>, Mp
         mpi_standard: format!("{major}.{minor}"),
         logical_cpus: logical,
         oversubscribed: here > logical,
-        transport: crate::decomp::bench_file::transport_from_env(),
+        transport: crate::ranks::bench_file::transport_from_env(),
         ping_pong: Series {
             definition: "one-way seconds: half the round trip of a message of `bytes` from rank 0 \
                          to rank 1 and back"

@@ -50,7 +50,7 @@ pub enum MpiError {
     #[error("{0}")]
     Usage(String),
     #[error("{0}")]
-    JobMismatch(crate::decomp::job::Mismatch),
+    JobMismatch(crate::ranks::job::Mismatch),
 }
 
 impl MpiError {

@@ -22,8 +22,8 @@ pub use domain::DomainOptions;
 pub use error::MpiError;
 pub use job::{MpiSpec, RootResult};
 
-use crate::decomp::bench_file::MpiBenchFile;
-use crate::decomp::job::Job;
+use crate::ranks::bench_file::MpiBenchFile;
+use crate::ranks::job::Job;
 use crate::scenario::Setup;
 use ::mpi::Threading;
 use ::mpi::environment::Universe;

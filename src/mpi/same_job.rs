@@ -7,7 +7,7 @@
 use super::comm::Comm;
 use super::comm::CommCounters;
 use super::error::MpiError;
-use crate::decomp::job::{Job, JobDigest, Mismatch, build_identity};
+use crate::ranks::job::{Job, JobDigest, Mismatch, build_identity};
 
 pub fn check(comm: &mut Comm, job: &Job) -> Result<(), MpiError> {
     if comm.size() == 1 {

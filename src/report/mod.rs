@@ -214,8 +214,8 @@ fn in_sweep_dir(path: &Path, names: &[&str]) -> bool {
 /// Every `mpi-bench*.json` file one level under the results directory, sorted by path.
 fn bench_files(
     results_dir: &Path,
-) -> Result<Vec<(PathBuf, crate::decomp::bench_file::MpiBenchFile)>, ReportError> {
-    use crate::decomp::bench_file::MpiBenchFile;
+) -> Result<Vec<(PathBuf, crate::ranks::bench_file::MpiBenchFile)>, ReportError> {
+    use crate::ranks::bench_file::MpiBenchFile;
     let mut benches: Vec<(PathBuf, MpiBenchFile)> = Vec::new();
     for dir in std::fs::read_dir(results_dir)
         .map_err(|source| ReportError::Dir {
@@ -274,7 +274,7 @@ fn tree_comm(
     // A sweep's α-β comes from the mpi-bench files in its own directory (the same machine).
     let names: Vec<&str> = galaxy.iter().map(|s| s.analysis.name.as_str()).collect();
     let files = bench_files(results_dir)?;
-    let benches: Vec<(String, &crate::decomp::bench_file::MpiBenchFile)> = files
+    let benches: Vec<(String, &crate::ranks::bench_file::MpiBenchFile)> = files
         .iter()
         .filter(|(p, _)| in_sweep_dir(p, &names))
         .map(|(p, b)| (relative_source(p).to_string_lossy().into_owned(), b))

@@ -1,8 +1,13 @@
-//! No import cycles between the files of `src/`: each file's `crate::` and `super::` paths are
-//! resolved to the file of the module they name, and the graph of those edges must have no
-//! cycle. A file using its own ancestors' items (`super::Thing` in a submodule) is how Rust
-//! modules work and is not counted; the other direction is. The binary crate (`src/main.rs`,
-//! `src/cli/`) is checked on its own; the library cannot import it at all.
+//! The layering of the two crates. The engine (`crates/engine`) cannot use the harness at all:
+//! Cargo forbids the dependency, and its manifest is checked here to stay free of the
+//! harness's stacks (plotting, TOML, JSON records, the command line but for the optional clap
+//! derives). Within each crate, the top-level modules form layers: a module names only
+//! modules of lower layers, and no files import each other in a cycle. Each file's `crate::`
+//! and `super::` paths are resolved to the file of the module they name; a file using its own
+//! ancestors' items (`super::Thing` in a submodule) is how Rust modules work and is not
+//! counted, the other direction is. Test modules import what they test and are left out. The
+//! binary crate (`src/main.rs`, `src/cli/`) is checked on its own; the library cannot import
+//! it at all.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
@@ -256,6 +261,41 @@ fn cycles(edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<Vec<Strin
     t.out
 }
 
+/// The engine's top-level modules, bottom up: a module may use modules of lower layers only.
+/// `testing` (fixtures for tests) stands above them all and is left out of the check.
+const ENGINE_LAYERS: &[&[&str]] = &[
+    &["real", "simd", "clock", "input", "stats"],
+    &["par", "physics"],
+    &["state"],
+    &["kernels", "boundary", "integrator"],
+    &["scenario", "decomp"],
+    &["engine", "output", "export"],
+    &["run"],
+    &["validate"],
+];
+
+/// The harness's own top-level modules, bottom up (the engine's modules, re-exported at its
+/// root, are below them all).
+const HARNESS_LAYERS: &[&[&str]] = &[
+    &["console", "children", "fit", "calibrate", "ranks", "plot"],
+    &["units"],
+    &["experiment"],
+    &["analysis", "gate"],
+    &["render"],
+    &["report"],
+    &["mpi"],
+];
+
+/// Modules of a crate's test support, outside the layers.
+const TEST_SUPPORT: &[&str] = &["testing"];
+
+fn engine_files() -> (PathBuf, Vec<PathBuf>) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/engine/src");
+    let mut all = Vec::new();
+    rust_files(&root, &mut all);
+    (root, all)
+}
+
 fn crate_files() -> (PathBuf, Vec<PathBuf>, Vec<PathBuf>) {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut all = Vec::new();
@@ -266,8 +306,43 @@ fn crate_files() -> (PathBuf, Vec<PathBuf>, Vec<PathBuf>) {
     (root, lib, bin)
 }
 
+/// The edges of `edges` that go up or across `layers` (as "from -> to" lines), and the
+/// top-level modules no layer names.
+fn against_layers(
+    edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>,
+    layers: &[&[&str]],
+) -> (Vec<String>, BTreeSet<String>) {
+    let layer_of = |m: &str| layers.iter().position(|l| l.contains(&m));
+    let mut wrong = Vec::new();
+    let mut unplaced = BTreeSet::new();
+    for (from, tos) in edges {
+        let Some(a) = from.first() else { continue };
+        if TEST_SUPPORT.contains(&a.as_str()) {
+            continue;
+        }
+        let Some(la) = layer_of(a) else {
+            unplaced.insert(a.clone());
+            continue;
+        };
+        for to in tos {
+            let b = &to[0];
+            if b == a || TEST_SUPPORT.contains(&b.as_str()) {
+                continue;
+            }
+            match layer_of(b) {
+                Some(lb) if lb < la => {}
+                Some(_) => wrong.push(format!("{} -> {}", from.join("::"), to.join("::"))),
+                None => {
+                    unplaced.insert(b.clone());
+                }
+            }
+        }
+    }
+    (wrong, unplaced)
+}
+
 #[test]
-fn no_import_cycles_between_files_of_src() {
+fn no_import_cycles_between_files() {
     let (root, lib, bin) = crate_files();
     let lib_cycles = cycles(&graph(&root, &lib));
     assert!(
@@ -279,6 +354,75 @@ fn no_import_cycles_between_files_of_src() {
         bin_cycles.is_empty(),
         "binary import cycles: {bin_cycles:#?}"
     );
+    let (root, engine) = engine_files();
+    let engine_cycles = cycles(&graph(&root, &engine));
+    assert!(
+        engine_cycles.is_empty(),
+        "engine import cycles: {engine_cycles:#?}"
+    );
+}
+
+#[test]
+fn modules_use_only_lower_layers() {
+    let (root, engine) = engine_files();
+    let (wrong, unplaced) = against_layers(&graph(&root, &engine), ENGINE_LAYERS);
+    assert!(
+        wrong.is_empty(),
+        "engine imports against its layers: {wrong:#?}"
+    );
+    assert!(
+        unplaced.is_empty(),
+        "engine modules in no layer of ENGINE_LAYERS: {unplaced:?}"
+    );
+    let (root, lib, _) = crate_files();
+    let (wrong, unplaced) = against_layers(&graph(&root, &lib), HARNESS_LAYERS);
+    assert!(
+        wrong.is_empty(),
+        "harness imports against its layers: {wrong:#?}"
+    );
+    assert!(
+        unplaced.is_empty(),
+        "harness modules in no layer of HARNESS_LAYERS: {unplaced:?}"
+    );
+}
+
+#[test]
+fn the_engine_depends_on_no_harness_stack() {
+    let manifest = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/engine/Cargo.toml"),
+    )
+    .unwrap();
+    let manifest: toml::Table = toml::from_str(&manifest).unwrap();
+    let deps = manifest["dependencies"].as_table().unwrap();
+    for name in [
+        "nbody-bench",
+        "plotters",
+        "plotters-backend",
+        "resvg",
+        "toml",
+        "serde_json",
+        "regex",
+        "indicatif",
+        "anyhow",
+        "mpi",
+    ] {
+        assert!(!deps.contains_key(name), "the engine depends on {name}");
+    }
+    // clap only for the derives a command line may ask for, off by default.
+    let clap = deps.get("clap").and_then(|c| c.as_table());
+    assert!(
+        clap.is_none_or(|c| c.get("optional").and_then(|o| o.as_bool()) == Some(true)),
+        "clap must stay optional in the engine"
+    );
+    let (_, engine) = engine_files();
+    for file in engine {
+        let code = code_of(&std::fs::read_to_string(&file).unwrap());
+        assert!(
+            !code.contains("nbody_bench"),
+            "{} names the harness crate",
+            file.display()
+        );
+    }
 }
 
 #[test]
@@ -313,9 +457,17 @@ fn the_check_finds_a_cycle_and_expands_use_trees() {
     std::fs::write(src.join("b.rs"), "fn f() { crate::a::g(); }\n").unwrap();
     let mut files = Vec::new();
     rust_files(src, &mut files);
-    let found = cycles(&graph(src, &files));
-    assert_eq!(found, vec![vec!["a".to_string(), "b".to_string()]]);
+    let edges = graph(src, &files);
+    assert_eq!(cycles(&edges), vec![vec!["a".to_string(), "b".to_string()]]);
+    // With a below b, a's import is against the layers; b's is not.
+    let (wrong, unplaced) = against_layers(&edges, &[&["a"], &["b"]]);
+    assert_eq!(wrong, vec!["a -> b".to_string()]);
+    assert!(unplaced.is_empty());
+    let (_, unplaced) = against_layers(&edges, &[&["a"]]);
+    assert_eq!(unplaced, BTreeSet::from(["b".to_string()]));
     // Without b's inline path there is no cycle.
     std::fs::write(src.join("b.rs"), "// crate::a::g() in a comment\n").unwrap();
-    assert!(cycles(&graph(src, &files)).is_empty());
+    let edges = graph(src, &files);
+    assert!(cycles(&edges).is_empty());
+    assert!(against_layers(&edges, &[&["b"], &["a"]]).0.is_empty());
 }

@@ -11,7 +11,8 @@
 
 use std::io::{self, Read, Write};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum NbviewFormat {
     /// `NBView00`: text.
     NbviewText,

@@ -128,7 +128,7 @@ pub fn build_identity() -> String {
     format!(
         "nbody-bench {} ({}; {}-{}; features [{}]; executable {executable})",
         env!("CARGO_PKG_VERSION"),
-        env!("NBODY_BENCH_RUSTC"),
+        nbody_engine::RUSTC_VERSION,
         std::env::consts::ARCH,
         std::env::consts::OS,
         features.join(", "),

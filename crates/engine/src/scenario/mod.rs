@@ -21,9 +21,8 @@ use thiserror::Error;
 pub use placement::PlacementError;
 
 /// The scenarios a user can pick.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum ScenarioKind {
     /// 2-D Lennard-Jones gas in a box with reflecting walls and downward gravity (the LJ-box assignment).
@@ -118,9 +117,10 @@ impl ScenarioKind {
 /// and 2^29 particles already need tens of GB.
 pub const MAX_PARTICLES: usize = 1 << 29;
 
-/// Lennard-Jones parameters shared by the LJ scenarios (the LJ-box assignment's units).
+/// Lennard-Jones parameters shared by the LJ scenarios (the LJ-box assignment's units); σ is
+/// the physics layer's, where the kernels' defaults also read it.
 pub const LJ_EPSILON: f64 = 1.0;
-pub const LJ_SIGMA: f64 = 0.01;
+pub use crate::physics::LJ_SIGMA;
 pub const LJ_CUTOFF: f64 = 2.5 * LJ_SIGMA;
 /// The source's 500 particles in the unit square (≈1 neighbour inside rc: a dilute gas).
 pub const LJ_GAS_DENSITY: f64 = 500.0;
@@ -143,7 +143,8 @@ pub struct Defaults {
     pub density: Option<f64>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Precision {
     F32,

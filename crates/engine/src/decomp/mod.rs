@@ -1,11 +1,9 @@
 //! Decompositions of a simulation over processes, without MPI itself: the spatial regions of
 //! the domain decomposition and their rebalancing ([`regions`]), the per-rank statistics and
-//! their reduction ([`stats`]), the bytes each decomposition moves ([`model`]), the
-//! `mpi-bench` results file ([`bench_file`]), particles as message bytes ([`wire`]), the
-//! comparison of a distributed run with a serial one ([`check`]) and the digest of the job the
-//! ranks compare before their first collective ([`job`]). The drivers that use them with MPI
-//! are in `crate::mpi` (feature `mpi`); everything here builds and is tested without an MPI
-//! library.
+//! their reduction ([`stats`]), the bytes each decomposition moves ([`model`]), particles as
+//! message bytes ([`wire`]) and the comparison of a distributed run with a serial one
+//! ([`check`]). The drivers that use them with MPI are the harness's (`nbody_bench::mpi`,
+//! feature `mpi`); everything here builds and is tested without an MPI library.
 //!
 //! The geometry of a distributed Barnes-Hut, also MPI-free: the domains of the ranks, either
 //! the octants of the root cube in Morton order ([`octants`], the gravity source's scheme) or a
@@ -14,10 +12,8 @@
 //! rank's octree that another rank's domain needs, selected with the octree's own opening test;
 //! and the top nodes a rank shares in the source's scheme ([`top_nodes`]).
 
-pub mod bench_file;
 pub mod check;
 pub mod essential;
-pub mod job;
 pub mod model;
 pub mod octants;
 pub mod orb;
@@ -35,7 +31,8 @@ use thiserror::Error;
 pub const WITHOUT_MPI: &str = "built without the `mpi` feature; rebuild with `--features mpi`";
 
 /// How a run is split over MPI ranks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Decomposition {
     /// Replicated data (the LJ-box assignment, the Coulomb MPI tutorial): each rank owns a block of particles, computes

@@ -12,7 +12,7 @@ mod lj;
 
 pub use coulomb::Coulomb;
 pub use gravity::Gravity;
-pub use lj::LennardJones;
+pub use lj::{LJ_SIGMA, LennardJones};
 
 use crate::real::Real;
 use serde::Serialize;

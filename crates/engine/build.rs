@@ -1,4 +1,5 @@
-//! Records the compiler version for the results metadata.
+//! Records the compiler version (`nbody_engine::RUSTC_VERSION`) for the results metadata and
+//! the digest MPI ranks compare.
 use std::process::Command;
 
 fn main() {

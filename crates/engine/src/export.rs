@@ -16,7 +16,8 @@ use crate::scenario::{System, SystemJob};
 use std::fmt::Write as _;
 use thiserror::Error;
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ExportFormat {
     LammpsData,
     Npy,

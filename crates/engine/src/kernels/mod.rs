@@ -39,9 +39,8 @@ use std::ops::Range;
 use thiserror::Error;
 
 /// The eight kernels. `ALL` drives `list`, `validate`, the tests and the sweeps.
-#[derive(
-    Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize, clap::ValueEnum,
-)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, serde::Deserialize)]
+#[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum KernelKind {
     /// Every particle against every other (n(n−1) pair evaluations).
@@ -240,7 +239,7 @@ fn default_fmm_leaf_size() -> usize {
 
 /// The Verlet skin by default: 0.3σ of the LJ scenarios.
 fn default_skin() -> f64 {
-    0.3 * crate::scenario::LJ_SIGMA
+    0.3 * crate::physics::LJ_SIGMA
 }
 
 impl Default for KernelParams {
