@@ -4,10 +4,11 @@
 # Works on a fresh machine with a Rust toolchain (Open MPI and libclang are installed with apt
 # when missing and this runs as root).
 #
-# Compile time is most of the run, so the crate is built once, with the `mpi` feature: tests,
-# benches and binary together. That binary runs validate and the performance gate, the tests
-# that start it, and the MPI drivers under mpirun (every MPI-free part of the drivers lives in
-# `crate::decomp` and is unit-tested like the rest). The one test of a build without the
+# Compile time is most of the run, so the workspace (the engine crate, crates/engine, and the
+# harness with the binary) is built once, with the `mpi` feature: tests, benches and binary
+# together. That binary runs validate and the performance gate, the tests that start it, and
+# the MPI drivers under mpirun (every MPI-free part of the drivers lives in `decomp` and
+# `ranks` and is unit-tested like the rest). The one test of a build without the
 # feature (the MPI entry points refusing with the rebuild hint, tests/suite/mpi_cli.rs) runs in
 # a plain `cargo test`. The binary reaches the simulation through the library's non-generic
 # entry points, so the system types are compiled in the library, not again in the binary.
@@ -32,8 +33,8 @@ scripts/install-mpi.sh
 cargo fmt --all -- --check
 
 step "the build, linted: tests, benches and binary, with the mpi feature"
-# One build of every test target (unit tests, the integration suite, the benches in test
-# mode, the examples, the binary). The binary it makes is the one judged below: a `cargo build`
+# One build of every test target of both crates (the engine's and the harness's unit tests, the
+# integration suite, the benches in test mode, the examples, the binary). The binary it makes is the one judged below: a `cargo build`
 # would compile the crate again (the tests' dev-dependencies change the features of shared
 # dependencies).
 #
@@ -51,7 +52,7 @@ if [[ -z "$clippy_driver" ]]; then
 fi
 export RUSTC_WORKSPACE_WRAPPER="$clippy_driver" RUSTFLAGS="-D warnings"
 features=(--features mpi)
-cargo test --release --all-targets "${features[@]}" --no-run
+cargo test --release --workspace --all-targets "${features[@]}" --no-run
 bin=target/release/nbody-bench
 
 step "validation and the performance gate"
@@ -72,9 +73,9 @@ step "every test"
 # The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
 # without `lmp`: install it when missing (as root, with apt; scripts/install-lammps.sh).
 scripts/install-lammps.sh
-# The unit tests; the suite but its timing tests; those alone on one test thread
+# The unit tests of both crates; the suite but its timing tests; those alone on one test thread
 # (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
-cargo test --release "${features[@]}" --lib --bins
+cargo test --release --workspace "${features[@]}" --lib --bins
 cargo test --release "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
 cargo test --release "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
 cargo test --release "${features[@]}" --benches

@@ -19,10 +19,8 @@ use crate::decomp::orb::Orb;
 use crate::decomp::{Decomposition, Domains, model};
 use crate::fit::AlphaBetaFit;
 use crate::kernels::Multipole;
-use crate::physics::PairLaw;
 use crate::ranks::bench_file::MpiBenchFile;
-use crate::real::Real;
-use crate::scenario::{ScenarioKind, Setup, System, SystemJob};
+use crate::scenario::galaxy::galaxy;
 use rayon::prelude::*;
 use serde::Serialize;
 
@@ -124,65 +122,42 @@ pub fn count(
 ) -> Vec<Counted> {
     ranks
         .par_iter()
-        .flat_map_iter(|&p| {
-            let mut setup = Setup::new(ScenarioKind::Galaxy);
-            setup.n = Some(n_per_rank * p);
-            setup.seed = seed;
-            setup
-                .dispatch(CountJob {
-                    ranks: p,
-                    theta,
-                    leaf,
-                })
-                .unwrap_or_default()
-        })
+        .flat_map_iter(|&p| count_one(p, n_per_rank * p, seed, theta, leaf))
         .collect()
 }
 
-struct CountJob {
-    ranks: usize,
-    theta: f64,
-    leaf: usize,
-}
-
-impl SystemJob for CountJob {
-    type Output = Vec<Counted>;
-
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Vec<Counted> {
-        let CountJob {
-            ranks: p,
-            theta,
-            leaf,
-        } = self;
-        let s = &system.state;
-        let n = s.len();
-        let w = std::mem::size_of::<T>();
-        let summary = |decomp, bytes: Vec<f64>, counts: Vec<usize>| Counted {
-            ranks: p,
-            n,
-            decomp,
-            bytes_mean: bytes.iter().sum::<f64>() / bytes.len().max(1) as f64,
-            bytes_max: bytes.iter().copied().fold(0.0, f64::max),
-            messages: messages(decomp, p),
-            bodies_imbalance: crate::decomp::stats::MinMeanMax::of(
-                counts.iter().map(|&c| c as f64),
-            )
-            .imbalance(),
-        };
-        let mut out = Vec::new();
-        let all = model::allgather_bytes_per_rank(n, p, D, w);
-        out.push(summary(Decomposition::Allgather, vec![all], vec![n / p; p]));
-        let (lo, side) = root_cube(&s.pos);
-        if let Ok(oct) = Octants::new(lo, side, p, &s.pos) {
-            let bytes = model::octants_bytes_of_cloud(s, &oct, theta, leaf, TOP_LEVELS);
-            out.push(summary(Decomposition::Octants, bytes, oct.counts(&s.pos)));
-        }
-        if let Ok(orb) = Orb::over(p, &s.pos, &vec![1.0; n]) {
-            let bytes = model::tree_bytes_of_cloud(s, &orb, theta, leaf, Multipole::Monopole);
-            out.push(summary(Decomposition::Tree, bytes, orb.counts(&s.pos)));
-        }
-        out
+/// The three decompositions counted on the galaxy of `n` bodies (in the scenario's f64) over
+/// `p` ranks.
+fn count_one(p: usize, n: usize, seed: u64, theta: f64, leaf: usize) -> Vec<Counted> {
+    if n == 0 {
+        return Vec::new();
     }
+    let state = galaxy::<f64>(n, seed);
+    let s = &state;
+    let w = std::mem::size_of::<f64>();
+    let summary = |decomp, bytes: Vec<f64>, counts: Vec<usize>| Counted {
+        ranks: p,
+        n,
+        decomp,
+        bytes_mean: bytes.iter().sum::<f64>() / bytes.len().max(1) as f64,
+        bytes_max: bytes.iter().copied().fold(0.0, f64::max),
+        messages: messages(decomp, p),
+        bodies_imbalance: crate::decomp::stats::MinMeanMax::of(counts.iter().map(|&c| c as f64))
+            .imbalance(),
+    };
+    let mut out = Vec::new();
+    let all = model::allgather_bytes_per_rank(n, p, 3, w);
+    out.push(summary(Decomposition::Allgather, vec![all], vec![n / p; p]));
+    let (lo, side) = root_cube(&s.pos);
+    if let Ok(oct) = Octants::new(lo, side, p, &s.pos) {
+        let bytes = model::octants_bytes_of_cloud(s, &oct, theta, leaf, TOP_LEVELS);
+        out.push(summary(Decomposition::Octants, bytes, oct.counts(&s.pos)));
+    }
+    if let Ok(orb) = Orb::over(p, &s.pos, &vec![1.0; n]) {
+        let bytes = model::tree_bytes_of_cloud(s, &orb, theta, leaf, Multipole::Monopole);
+        out.push(summary(Decomposition::Tree, bytes, orb.counts(&s.pos)));
+    }
+    out
 }
 
 /// The model and the measured side by side: `benches` are (path, file) of `mpi-bench` runs,

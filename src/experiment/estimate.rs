@@ -16,12 +16,10 @@
 use super::config::{MpiLaunch, SweepConfig};
 use super::plan::Case;
 use super::runner::samples_in_round;
-use crate::engine::Simulation;
-use crate::kernels::{Complexity, KernelKind, KernelParams, MIN_PARALLEL_PAIRS, Multipole};
-use crate::physics::PairLaw;
-use crate::real::Real;
+use crate::kernels::{Complexity, KernelKind, MIN_PARALLEL_PAIRS, Multipole};
 use crate::run::RunError;
-use crate::scenario::{Precision, ScenarioKind, Setup, SetupError, System, SystemJob};
+use crate::scenario::{Precision, ScenarioKind, Setup, SetupError};
+use crate::stepper::{Stepper, stepper};
 use std::collections::HashMap;
 use std::time::Instant;
 use thiserror::Error;
@@ -346,14 +344,13 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         setup.n = Some(n);
         setup.seed = case.seed;
         setup.precision = case.precision;
-        let job = ProbeJob {
-            kernel: this.1,
-            params: case.kernel_params(),
-            error_sample,
-            started: Instant::now(),
-        };
+        let params = case.kernel_params();
         let probe = pool
-            .install(|| setup.dispatch(job))
+            .install(|| {
+                let started = Instant::now();
+                let sim = stepper(&setup, this.1, &params, 1.0)?;
+                Ok::<_, SetupError>(sim.and_then(|sim| probe_one(sim, started, error_sample)))
+            })
             .map_err(|source| ProbeError::Setup {
                 what: what.clone(),
                 n,
@@ -377,66 +374,56 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
     })
 }
 
-/// Measures one set-up on the system it is given (built after `started`).
-struct ProbeJob {
-    kernel: KernelKind,
-    params: KernelParams,
-    error_sample: usize,
+/// Measures one set-up on its simulation (built after `started`).
+fn probe_one(
+    mut sim: Box<dyn Stepper>,
     started: Instant,
-}
-
-impl SystemJob for ProbeJob {
-    type Output = Result<Probe, RunError>;
-
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
-        let law = system.law;
-        let kernel = self.kernel.build::<T, L, D>(law, &self.params)?;
-        let mut sim = Simulation::new(system, kernel);
-        let built_s = self.started.elapsed().as_secs_f64();
+    error_sample: usize,
+) -> Result<Probe, RunError> {
+    let built_s = started.elapsed().as_secs_f64();
+    let t = Instant::now();
+    sim.probe();
+    let energy_s = t.elapsed().as_secs_f64();
+    // The first step allocates the kernel's scratch memory; later ones reuse it.
+    sim.step()?;
+    // (step, its force phase, its pair checks), each step timed alone: the median step
+    // does not count a scheduler slice that another process took during one of them.
+    let mut steps: Vec<(f64, f64, u64)> = Vec::new();
+    let started = Instant::now();
+    while steps.len() < PROBE_STEPS
+        && (steps.is_empty() || started.elapsed().as_secs_f64() < PROBE_STEP_BUDGET_S)
+    {
+        let force0 = sim.phases().force_build + sim.phases().force_interact;
+        let pairs0 = sim.work().pair_checks;
         let t = Instant::now();
-        sim.probe();
-        let energy_s = t.elapsed().as_secs_f64();
-        // The first step allocates the kernel's scratch memory; later ones reuse it.
         sim.step()?;
-        // (step, its force phase, its pair checks), each step timed alone: the median step
-        // does not count a scheduler slice that another process took during one of them.
-        let mut steps: Vec<(f64, f64, u64)> = Vec::new();
-        let started = Instant::now();
-        while steps.len() < PROBE_STEPS
-            && (steps.is_empty() || started.elapsed().as_secs_f64() < PROBE_STEP_BUDGET_S)
-        {
-            let force0 = sim.phases.force_build + sim.phases.force_interact;
-            let pairs0 = sim.work.pair_checks;
-            let t = Instant::now();
-            sim.step()?;
-            steps.push((
-                t.elapsed().as_secs_f64(),
-                sim.phases.force_build + sim.phases.force_interact - force0,
-                sim.work.pair_checks - pairs0,
-            ));
-        }
-        steps.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let (per_step, force_s, pair_checks) = steps
-            .get(steps.len().saturating_sub(1) / 2)
-            .copied()
-            .unwrap_or_default();
-        let n = sim.state.len();
-        let error_pair_s = (self.error_sample > 0).then(|| {
-            let m = self.error_sample.min(n).min(PROBE_ERROR_SAMPLE);
-            let t = Instant::now();
-            crate::validate::sampled_force_error(&law, &sim.state, &sim.forces, m, 0x5eed);
-            t.elapsed().as_secs_f64() / (m * n).max(1) as f64
-        });
-        Ok(Probe {
-            n,
-            build_s: (built_s - energy_s).max(0.0),
-            energy_s,
-            force_s,
-            other_s: (per_step - force_s).max(0.0),
-            pair_checks: pair_checks as f64,
-            error_pair_s,
-        })
+        steps.push((
+            t.elapsed().as_secs_f64(),
+            sim.phases().force_build + sim.phases().force_interact - force0,
+            sim.work().pair_checks - pairs0,
+        ));
     }
+    steps.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let (per_step, force_s, pair_checks) = steps
+        .get(steps.len().saturating_sub(1) / 2)
+        .copied()
+        .unwrap_or_default();
+    let n = sim.len();
+    let error_pair_s = (error_sample > 0).then(|| {
+        let m = error_sample.min(n).min(PROBE_ERROR_SAMPLE);
+        let t = Instant::now();
+        sim.sampled_force_error(m, 0x5eed);
+        t.elapsed().as_secs_f64() / (m * n).max(1) as f64
+    });
+    Ok(Probe {
+        n,
+        build_s: (built_s - energy_s).max(0.0),
+        energy_s,
+        force_s,
+        other_s: (per_step - force_s).max(0.0),
+        pair_checks: pair_checks as f64,
+        error_pair_s,
+    })
 }
 
 #[cfg(test)]

@@ -5,12 +5,11 @@ use super::plan::Case;
 use super::reference::time_reference;
 use super::slowdown::TestSlowdown;
 use crate::clock::{Clock, clock_cost};
-use crate::engine::{PhaseTimes, Simulation};
+use crate::engine::PhaseTimes;
 use crate::kernels::WorkCounters;
-use crate::physics::PairLaw;
-use crate::real::Real;
 use crate::run::RunError;
-use crate::scenario::{System, SystemJob};
+use crate::scenario::{Setup, SetupError};
+use crate::stepper::{Stepper, stepper};
 use serde::{Deserialize, Serialize};
 
 /// How one round of a case is measured.
@@ -71,44 +70,37 @@ pub struct RoundOutcome {
     pub external: Option<super::external::ExternalRound>,
 }
 
-/// Measures a round of `case` on the system it is given.
-pub struct MeasureJob<'a, C: Clock> {
-    pub case: &'a Case,
-    /// The case's kernel (a built-in one: external programs are measured by
-    /// `experiment::external`).
-    pub kernel: crate::kernels::KernelKind,
-    pub spec: &'a RoundSpec,
-    pub clock: &'a C,
-}
-
-impl<C: Clock> SystemJob for MeasureJob<'_, C> {
-    type Output = Result<RoundOutcome, RunError>;
-
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
-        let params = self.case.kernel_params();
-        let law = system.law;
-        let kernel = TestSlowdown::apply(
-            self.spec.slowdown,
-            self.kernel.build::<T, L, D>(law, &params)?,
-        );
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(self.case.threads)
-            .build()
-            .map_err(|source| RunError::Pool {
-                threads: self.case.threads,
-                source,
-            })?;
-        pool.install(|| measure(self.spec, self.clock, &law, Simulation::new(system, kernel)))
-    }
-}
-
-fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
+/// Measures one round of `case` (a built-in kernel's: external programs are measured by
+/// `experiment::external`) on the system of `setup`.
+pub fn measure_round<C: Clock>(
+    setup: &Setup,
+    case: &Case,
+    kernel: crate::kernels::KernelKind,
     spec: &RoundSpec,
     clock: &C,
-    law: &L,
-    mut sim: Simulation<T, D>,
+) -> Result<Result<RoundOutcome, RunError>, SetupError> {
+    let slowdown = spec.slowdown.map_or(1.0, |s| s.factor_for(kernel));
+    let params = case.kernel_params();
+    Ok(
+        stepper(setup, kernel, &params, slowdown)?.and_then(|mut sim| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(case.threads)
+                .build()
+                .map_err(|source| RunError::Pool {
+                    threads: case.threads,
+                    source,
+                })?;
+            pool.install(|| measure(spec, clock, sim.as_mut()))
+        }),
+    )
+}
+
+fn measure<C: Clock>(
+    spec: &RoundSpec,
+    clock: &C,
+    sim: &mut dyn Stepper,
 ) -> Result<RoundOutcome, RunError> {
-    let n = sim.state.len();
+    let n = sim.len();
     let e0 = sim.probe().total();
     let initial_work = sim.probe_work();
     // Warm-up: untimed for the results, but its step times choose the sample length.
@@ -126,7 +118,7 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
     let k = spec
         .steps_per_sample
         .unwrap_or_else(|| ((spec.min_sample_s / typical).ceil() as u64).clamp(1, 1_000_000));
-    let (phases0, work0, steps0) = (sim.phases, sim.work, sim.step);
+    let (phases0, work0, steps0) = (sim.phases(), sim.work(), sim.steps());
     let mut samples = Vec::with_capacity(spec.samples);
     let mut reference = Vec::new();
     let mut step_ns = Vec::with_capacity(spec.samples * k as usize);
@@ -144,19 +136,13 @@ fn measure<T: Real, L: PairLaw<T>, const D: usize, C: Clock>(
         }
         samples.push(sum as f64 * 1e-9 / k as f64);
     }
-    let steps = sim.step - steps0;
-    let e1 = sim.probe().finite_after(sim.step)?.total();
+    let steps = sim.steps() - steps0;
+    let e1 = sim.probe().finite_after(sim.steps())?.total();
     // No trajectory is written while measuring: the output phase stays zero.
-    let phases = (sim.phases - phases0).per_step(steps);
-    let work = sim.work - work0;
+    let phases = (sim.phases() - phases0).per_step(steps);
+    let work = sim.work() - work0;
     let force_error = (spec.force_error_sample > 0).then(|| {
-        let (median, max) = crate::validate::sampled_force_error(
-            law,
-            &sim.state,
-            &sim.forces,
-            spec.force_error_sample,
-            0x5eed,
-        );
+        let (median, max) = sim.sampled_force_error(spec.force_error_sample, 0x5eed);
         [median, max]
     });
     let clock_cost = clock_cost(clock);

@@ -4,7 +4,7 @@
 use super::code::Code;
 use super::config::SweepConfig;
 use super::lock::WriterLock;
-use super::measure::{MeasureJob, RoundSpec};
+use super::measure::{RoundSpec, measure_round};
 use super::plan::{Case, cases};
 use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
@@ -345,12 +345,13 @@ fn measure_case<C: Clock>(
     if let Some(launch) = &config.mpi {
         return Ok(super::launcher::measure_round(launch, case, spec)?);
     }
-    Ok(case_setup(case).dispatch(MeasureJob {
+    Ok(measure_round(
+        &case_setup(case),
         case,
         kernel,
         spec,
         clock,
-    })??)
+    )??)
 }
 
 /// Where external programs find the sweep; their work directories go next to the results.

@@ -272,6 +272,7 @@ const ENGINE_LAYERS: &[&[&str]] = &[
     &["engine", "output", "export"],
     &["run"],
     &["validate"],
+    &["stepper"],
 ];
 
 /// The harness's own top-level modules, bottom up (the engine's modules, re-exported at its

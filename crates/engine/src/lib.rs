@@ -3,7 +3,8 @@
 //! Layers, bottom up: [`real`], [`simd`] and [`par`] (precision, instruction set, threads),
 //! [`state`] and [`physics`] (particles and pair laws), [`kernels`] (ways of visiting the
 //! pairs), [`scenario`], [`integrator`], [`boundary`] and [`engine`] (a running simulation),
-//! [`run`] and [`validate`] (measured runs and force checks), [`decomp`] (domain
+//! [`run`] and [`validate`] (measured runs and force checks), [`stepper`] (a simulation of any
+//! type behind one interface, for measurements that are not generic), [`decomp`] (domain
 //! decompositions and what ranks exchange, without MPI), [`output`] and [`export`] (files), with
 //! [`stats`], [`clock`] and [`input`] beside them. Nothing here plots, reads TOML, fits models or
 //! parses a command line: that is the harness's (the `nbody-bench` crate), which depends on this
@@ -26,6 +27,7 @@ pub mod scenario;
 pub mod simd;
 pub mod state;
 pub mod stats;
+pub mod stepper;
 #[doc(hidden)]
 pub mod testing;
 pub mod validate;

@@ -15,6 +15,7 @@ pub mod footprint;
 mod naive;
 mod octree;
 mod per_thread;
+pub mod repeated;
 pub mod rows;
 mod share;
 mod symmetric;

@@ -5,7 +5,7 @@
 //! where runtime choices become compile-time types is [`Setup::dispatch`]: every command hands
 //! it a [`SystemJob`] and receives the job's result.
 
-mod galaxy;
+pub mod galaxy;
 mod placement;
 
 use crate::boundary::Boundary;
