@@ -4,9 +4,9 @@
 # Works on a fresh machine with a Rust toolchain (Open MPI and libclang are installed with apt
 # when missing and this runs as root).
 #
-# Compile time is most of the run, so the workspace (the engine crate, crates/engine, and the
-# harness with the binary) is built once, with the `mpi` feature: tests, benches and binary
-# together. That binary runs validate and the performance gate, the tests that start it, and
+# Compile time is most of the run, so the workspace (the engine, crates/engine; the MPI
+# drivers, crates/mpi; the harness with the binary) is built once, with the `mpi` feature:
+# tests, benches and binary together. That binary runs validate and the performance gate, the tests that start it, and
 # the MPI drivers under mpirun (every MPI-free part of the drivers lives in `decomp` and
 # `ranks` and is unit-tested like the rest). The one test of a build without the
 # feature (the MPI entry points refusing with the rebuild hint, tests/suite/mpi_cli.rs) runs in

@@ -25,9 +25,9 @@ pub mod experiment;
 pub mod fit;
 pub mod gate;
 #[cfg(feature = "mpi")]
-pub mod mpi;
+pub use nbody_mpi::mpi;
+pub use nbody_mpi::ranks;
 pub mod plot;
-pub mod ranks;
 pub mod render;
 pub mod report;
 pub mod units;

@@ -1,7 +1,7 @@
-//! The layering of the two crates. The engine (`crates/engine`) cannot use the harness at all:
+//! The layering of the crates. The engine (`crates/engine`) cannot use the harness at all:
 //! Cargo forbids the dependency, and its manifest is checked here to stay free of the
 //! harness's stacks (plotting, TOML, JSON records, the command line but for the optional clap
-//! derives). Within each crate, the top-level modules form layers: a module names only
+//! derives). The MPI crate (`crates/mpi`) depends on the engine alone; the harness on both. Within each crate, the top-level modules form layers: a module names only
 //! modules of lower layers, and no files import each other in a cycle. Each file's `crate::`
 //! and `super::` paths are resolved to the file of the module they name; a file using its own
 //! ancestors' items (`super::Thing` in a submodule) is how Rust modules work and is not
@@ -275,26 +275,36 @@ const ENGINE_LAYERS: &[&[&str]] = &[
     &["stepper"],
 ];
 
-/// The harness's own top-level modules, bottom up (the engine's modules, re-exported at its
-/// root, are below them all).
+/// The harness's own top-level modules, bottom up (the engine's and the MPI crate's modules,
+/// re-exported at its root, are below them all).
 const HARNESS_LAYERS: &[&[&str]] = &[
-    &["console", "children", "fit", "calibrate", "ranks", "plot"],
+    &["console", "children", "fit", "calibrate", "plot"],
     &["units"],
     &["experiment"],
     &["analysis", "gate"],
     &["render"],
     &["report"],
-    &["mpi"],
 ];
+
+/// The MPI crate's modules (`crates/mpi`), bottom up, over the engine's.
+const MPI_LAYERS: &[&[&str]] = &[&["ranks"], &["mpi"]];
 
 /// Modules of a crate's test support, outside the layers.
 const TEST_SUPPORT: &[&str] = &["testing"];
 
-fn engine_files() -> (PathBuf, Vec<PathBuf>) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/engine/src");
+/// The source folder of a workspace crate (`crates/NAME/src`) and its files.
+fn member_files(name: &str) -> (PathBuf, Vec<PathBuf>) {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("crates")
+        .join(name)
+        .join("src");
     let mut all = Vec::new();
     rust_files(&root, &mut all);
     (root, all)
+}
+
+fn engine_files() -> (PathBuf, Vec<PathBuf>) {
+    member_files("engine")
 }
 
 fn crate_files() -> (PathBuf, Vec<PathBuf>, Vec<PathBuf>) {
@@ -355,12 +365,11 @@ fn no_import_cycles_between_files() {
         bin_cycles.is_empty(),
         "binary import cycles: {bin_cycles:#?}"
     );
-    let (root, engine) = engine_files();
-    let engine_cycles = cycles(&graph(&root, &engine));
-    assert!(
-        engine_cycles.is_empty(),
-        "engine import cycles: {engine_cycles:#?}"
-    );
+    for member in ["engine", "mpi"] {
+        let (root, files) = member_files(member);
+        let found = cycles(&graph(&root, &files));
+        assert!(found.is_empty(), "{member} import cycles: {found:#?}");
+    }
 }
 
 #[test]
@@ -375,6 +384,16 @@ fn modules_use_only_lower_layers() {
         unplaced.is_empty(),
         "engine modules in no layer of ENGINE_LAYERS: {unplaced:?}"
     );
+    let (root, files) = member_files("mpi");
+    let (wrong, unplaced) = against_layers(&graph(&root, &files), MPI_LAYERS);
+    assert!(
+        wrong.is_empty(),
+        "MPI crate imports against its layers: {wrong:#?}"
+    );
+    assert!(
+        unplaced.is_empty(),
+        "MPI crate modules in no layer of MPI_LAYERS: {unplaced:?}"
+    );
     let (root, lib, _) = crate_files();
     let (wrong, unplaced) = against_layers(&graph(&root, &lib), HARNESS_LAYERS);
     assert!(
@@ -387,16 +406,22 @@ fn modules_use_only_lower_layers() {
     );
 }
 
+/// The `[dependencies]` table of `crates/NAME/Cargo.toml`.
+fn member_dependencies(name: &str) -> toml::Table {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("crates")
+        .join(name)
+        .join("Cargo.toml");
+    let manifest: toml::Table = toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    manifest["dependencies"].as_table().unwrap().clone()
+}
+
 #[test]
 fn the_engine_depends_on_no_harness_stack() {
-    let manifest = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/engine/Cargo.toml"),
-    )
-    .unwrap();
-    let manifest: toml::Table = toml::from_str(&manifest).unwrap();
-    let deps = manifest["dependencies"].as_table().unwrap();
+    let deps = member_dependencies("engine");
     for name in [
         "nbody-bench",
+        "nbody-mpi",
         "plotters",
         "plotters-backend",
         "resvg",
@@ -417,6 +442,24 @@ fn the_engine_depends_on_no_harness_stack() {
     );
     let (_, engine) = engine_files();
     for file in engine {
+        let code = code_of(&std::fs::read_to_string(&file).unwrap());
+        assert!(
+            !code.contains("nbody_bench"),
+            "{} names the harness crate",
+            file.display()
+        );
+    }
+}
+
+#[test]
+fn the_mpi_crate_depends_on_the_engine_only() {
+    let deps = member_dependencies("mpi");
+    assert!(deps.contains_key("nbody-engine"));
+    for name in ["nbody-bench", "plotters", "resvg", "toml", "clap", "regex"] {
+        assert!(!deps.contains_key(name), "the MPI crate depends on {name}");
+    }
+    let (_, files) = member_files("mpi");
+    for file in files {
         let code = code_of(&std::fs::read_to_string(&file).unwrap());
         assert!(
             !code.contains("nbody_bench"),

@@ -3,6 +3,7 @@
 
 pub mod dump;
 pub mod nbview;
+pub mod provenance;
 mod temporary_dir;
 
 pub use temporary_dir::TemporaryDir;

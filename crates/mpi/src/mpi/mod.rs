@@ -60,7 +60,9 @@ impl Mpi {
             if let MpiError::JobMismatch(m) = &err
                 && m.printed()
             {
-                crate::console::print_error(m);
+                // As the harness's `console::print_error`: a failed write to stderr is ignored.
+                let line = format!("error: {m}\n");
+                let _ = std::io::Write::write_all(&mut std::io::stderr().lock(), line.as_bytes());
             }
             // Dropping `mpi` finalizes MPI, on every rank together.
             return Err(err);

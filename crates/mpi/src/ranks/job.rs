@@ -108,9 +108,6 @@ pub fn build_identity() -> String {
     if cfg!(feature = "mpi") {
         features.push("mpi");
     }
-    if cfg!(feature = "plot") {
-        features.push("plot");
-    }
     let executable = std::env::current_exe()
         .and_then(|path| {
             let mut file = std::fs::File::open(path)?;

@@ -4,7 +4,7 @@
 
 use super::comm::Comm;
 use super::error::MpiError;
-use crate::experiment::results::{git_state, utc_now};
+use crate::output::provenance::{git_state, utc_now};
 use crate::ranks::bench_file::{
     MPI_BENCH_SCHEMA, MpiBenchFile, Series, SizeTimings, reps_at, sizes,
 };
