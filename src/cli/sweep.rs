@@ -51,7 +51,6 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         out: args.out.clone(),
         run_dir,
         calibrate: !args.no_calibration,
-        stop_after: None,
         config_dir: config_path
             .parent()
             .filter(|p| !p.as_os_str().is_empty() && !from_pipe)

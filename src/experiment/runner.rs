@@ -28,8 +28,6 @@ pub struct SweepOptions {
     pub run_dir: Option<PathBuf>,
     /// Calibrate the machine at the start and end (tests turn it off).
     pub calibrate: bool,
-    /// Stop after this many measured rounds, as if interrupted (tests).
-    pub stop_after: Option<usize>,
     /// `{config_dir}` of external commands [default: the current directory].
     pub config_dir: Option<PathBuf>,
     /// `{nbody_bench}` of external commands [default: this program].
@@ -42,6 +40,11 @@ pub trait Observer {
     fn round_done(&mut self, _record: &CaseRecord, _round: usize) {}
     fn message(&mut self, _text: &str) {}
     fn finish(&mut self) {}
+    /// Asked before each round: `false` stops the sweep there, as an interrupt would (what
+    /// was measured is saved; `--resume` continues). The tests of resuming stop this way.
+    fn keep_going(&mut self) -> bool {
+        true
+    }
 }
 
 /// Observes nothing.
@@ -270,7 +273,7 @@ pub fn run_sweep<C: Clock>(
                 stopped = true;
                 break 'rounds;
             }
-            if options.stop_after.is_some_and(|k| measured >= k) {
+            if !observer.keep_going() {
                 stopped = true;
                 break 'rounds;
             }

@@ -376,11 +376,9 @@ env = {{ OMP_NUM_THREADS = "{{threads}}" }}
     let config = SweepConfig::parse(&text, Path::new("ext.toml")).unwrap();
     let clock = MockClock::new(Duration::from_millis(1));
     let mut opts = options(dir.path());
-    opts.stop_after = Some(3);
-    let first = run_sweep(&config, &text, &opts, &clock, &mut Silent).unwrap();
+    let first = run_sweep(&config, &text, &opts, &clock, &mut crate::StopAfter(3)).unwrap();
     assert_eq!((first.rounds_measured, first.incomplete), (3, 4));
     let partial = ResultsFile::load(&first.path).unwrap();
-    opts.stop_after = None;
     opts.resume = true;
     let second = run_sweep(&config, &text, &opts, &clock, &mut Silent).unwrap();
     assert_eq!((second.rounds_measured, second.incomplete), (8 - 3, 0));

@@ -36,6 +36,20 @@ mod whole_step;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
 
+/// A sweep observer that stops the sweep after this many measured rounds, as an interrupt
+/// would.
+pub struct StopAfter(pub usize);
+
+impl nbody_bench::experiment::runner::Observer for StopAfter {
+    fn round_done(&mut self, _: &nbody_bench::experiment::results::CaseRecord, _: usize) {
+        self.0 = self.0.saturating_sub(1);
+    }
+
+    fn keep_going(&mut self) -> bool {
+        self.0 > 0
+    }
+}
+
 /// This build's binary, without the test-only slowdown and with no standard input.
 pub fn bin() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_nbody-bench"));

@@ -72,9 +72,8 @@ fn resume_after_interruption_repeats_nothing_and_loses_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let config = SweepConfig::parse(TINY, Path::new("mock.toml")).unwrap();
     let clock = MockClock::new(Duration::from_millis(1));
-    let mut opts = options(dir.path());
-    opts.stop_after = Some(11);
-    let first = run_sweep(&config, TINY, &opts, &clock, &mut Silent).unwrap();
+    let opts = options(dir.path());
+    let first = run_sweep(&config, TINY, &opts, &clock, &mut crate::StopAfter(11)).unwrap();
     assert_eq!((first.rounds_measured, first.incomplete), (11, 16));
     let partial = ResultsFile::load(&first.path).unwrap();
     // Without --resume the existing file is refused, not overwritten.
