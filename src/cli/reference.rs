@@ -136,13 +136,13 @@ fn meaning(key: &str) -> Option<&'static str> {
         "study" => "how the sweep is read: threads at fixed n (strong), work per thread held (weak), kernels over n (complexity), every combination (cartesian)",
         "scenarios" => "the scenarios measured",
         "kernels" => "the built-in kernels measured (may be empty when `[[external]]` lists programs)",
-        "n" => "particle counts (weak studies use `weak.base_n` instead)",
+        "n" => "particle counts; required except in weak studies, which use `weak.base_n` instead",
         "threads" => "thread counts; a strong study must include 1",
         "seeds" => "seeds of the initial state; each is a case of its own",
         "theta" => "opening angles, octree and fmm cases only (the fmm takes those below 1)",
         "multipole" => "expansion orders of the octree's nodes, octree cases only",
         "order" => "expansion orders of the fmm's cells, fmm cases only",
-        "precision" => "overrides each scenario's precision",
+        "precision" => "overrides each scenario's precision (when left out: each scenario's own)",
         "out" => "the results directory",
         "measure" => "how each case is measured",
         "weak" => "weak studies only: how n grows with the workers",
@@ -174,12 +174,12 @@ fn meaning(key: &str) -> Option<&'static str> {
         "external.force_error" => "a regular expression whose groups are the median (and largest) force error the program reports",
         "external.env" => "environment variables set for the program (values with placeholders)",
         "external.version" => "a command whose first line of output names the program's version (results metadata)",
-        "external.empty" => "the empty run whose wall time is the launch overhead of wall timing",
+        "external.empty" => "the empty run whose wall time is the launch overhead of wall timing (when left out: `true` under the same launcher)",
         "external.timeout_s" => "a run taking longer is stopped (SIGTERM, then SIGKILL) and is an error",
         "external.warmup_runs" => "untimed runs before each round's samples",
-        "external.scenarios" => "the scenarios its cases stand for",
-        "external.threads" => "thread counts, instead of the config's",
-        "external.ranks" => "rank counts, instead of the `[mpi]` table's",
+        "external.scenarios" => "the scenarios its cases stand for (when left out: the config's)",
+        "external.threads" => "thread counts (when left out: the config's)",
+        "external.ranks" => "rank counts (when left out: the `[mpi]` table's, else 1)",
         _ => return None,
     })
 }
@@ -257,8 +257,8 @@ pub fn config_page() -> anyhow::Result<String> {
          looked up in `configs/`). Unknown keys, wrong types, empty lists, zero threads and \
          kernels that apply to none of the scenarios are refused before anything runs, with the \
          file, the key and the forms below. A default of *required* means the config (or the \
-         table, when it is given) must set the key; *none* means that leaving it out turns the \
-         feature off. How to write an `[[external]]` entry: \
+         table, when it is given) must set the key; *none* means the key has no value of its own \
+         when left out: the feature is off, or what the description names applies. How to write an `[[external]]` entry: \
          [measure your own program](../howto/measure-your-own-program.md); the `[mpi]` table: \
          [run MPI studies](../howto/run-mpi-studies.md).\n",
     );
