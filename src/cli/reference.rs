@@ -132,10 +132,16 @@ ranks = [1]
 /// What a key means (the forms it accepts come from `config_keys::allowed`).
 fn meaning(key: &str) -> Option<&'static str> {
     Some(match key {
-        "name" => "names the results: `<out>/runs/<name>/<UTC time>/`, or `DIR/<name>/` with `--out DIR`",
-        "study" => "how the sweep is read: threads at fixed n (strong), work per thread held (weak), kernels over n (complexity), every combination (cartesian)",
+        "name" => {
+            "names the results: `<out>/runs/<name>/<UTC time>/`, or `DIR/<name>/` with `--out DIR`"
+        }
+        "study" => {
+            "how the sweep is read: threads at fixed n (strong), work per thread held (weak), kernels over n (complexity), every combination (cartesian)"
+        }
         "scenarios" => "the scenarios measured",
-        "kernels" => "the built-in kernels measured (may be empty when `[[external]]` lists programs)",
+        "kernels" => {
+            "the built-in kernels measured (may be empty when `[[external]]` lists programs)"
+        }
         "n" => "particle counts; required except in weak studies, which use `weak.base_n` instead",
         "threads" => "thread counts; a strong study must include 1",
         "seeds" => "seeds of the initial state; each is a case of its own",
@@ -146,17 +152,27 @@ fn meaning(key: &str) -> Option<&'static str> {
         "out" => "the results directory",
         "measure" => "how each case is measured",
         "weak" => "weak studies only: how n grows with the workers",
-        "mpi" => "run every case under an MPI launcher (`mpirun -n R nbody-bench run --decomp ...`)",
+        "mpi" => {
+            "run every case under an MPI launcher (`mpirun -n R nbody-bench run --decomp ...`)"
+        }
         "external" => "other programs measured as cases of the sweep",
         "measure.warmup_s" => "untimed stepping before the samples",
         "measure.samples" => "samples per case, shared between the rounds",
         "measure.min_sample_s" => "a sample lasts at least this long (its step count adapts)",
         "measure.rounds" => "interleaved rounds over all cases",
-        "measure.budget_s" => "stop starting cases after this many seconds (0 = no limit); the rest is left for `--resume`",
+        "measure.budget_s" => {
+            "stop starting cases after this many seconds (0 = no limit); the rest is left for `--resume`"
+        }
         "measure.max_energy_drift" => "flag a case whose relative energy drift exceeds this",
-        "measure.force_error_sample" => "also measure the force error against an f64 direct sum on this many particles",
-        "measure.reference_s" => "seconds of the reference workload before each sample, for `gate` (0 = off)",
-        "weak.rule" => "cost-model: n grows by each kernel's cost model; linear: n0·p; sqrt: n0·√p; time: n fixed, steps × p",
+        "measure.force_error_sample" => {
+            "also measure the force error against an f64 direct sum on this many particles"
+        }
+        "measure.reference_s" => {
+            "seconds of the reference workload before each sample, for `gate` (0 = off)"
+        }
+        "weak.rule" => {
+            "cost-model: n grows by each kernel's cost model; linear: n0·p; sqrt: n0·√p; time: n fixed, steps × p"
+        }
         "weak.base_n" => "n at one worker",
         "mpi.launcher" => "the launcher program",
         "mpi.ranks" => "rank counts; each case runs at every one",
@@ -166,16 +182,34 @@ fn meaning(key: &str) -> Option<&'static str> {
         "mpi.steps" => "timed steps per launch, split into the round's samples",
         "mpi.warmup_steps" => "untimed steps before them",
         "external.name" => "the kernel name of its cases (keys, tables, figures)",
-        "external.command" => "the program and its arguments, each token with placeholders; never a shell string",
-        "external.setup" => "run once per round before the samples, untimed and without the launcher",
-        "external.steps" => "time steps of one run: a sample's time per step is its time divided by this",
-        "external.time" => "how a run is timed: the whole process, or the first group of the last match in its output",
-        "external.check" => "a regular expression the output must match, else the sample is an error",
-        "external.force_error" => "a regular expression whose groups are the median (and largest) force error the program reports",
+        "external.command" => {
+            "the program and its arguments, each token with placeholders; never a shell string"
+        }
+        "external.setup" => {
+            "run once per round before the samples, untimed and without the launcher"
+        }
+        "external.steps" => {
+            "time steps of one run: a sample's time per step is its time divided by this"
+        }
+        "external.time" => {
+            "how a run is timed: the whole process, or the first group of the last match in its output"
+        }
+        "external.check" => {
+            "a regular expression the output must match, else the sample is an error"
+        }
+        "external.force_error" => {
+            "a regular expression whose groups are the median (and largest) force error the program reports"
+        }
         "external.env" => "environment variables set for the program (values with placeholders)",
-        "external.version" => "a command whose first line of output names the program's version (results metadata)",
-        "external.empty" => "the empty run whose wall time is the launch overhead of wall timing (when left out: `true` under the same launcher)",
-        "external.timeout_s" => "a run taking longer is stopped (SIGTERM, then SIGKILL) and is an error",
+        "external.version" => {
+            "a command whose first line of output names the program's version (results metadata)"
+        }
+        "external.empty" => {
+            "the empty run whose wall time is the launch overhead of wall timing (when left out: `true` under the same launcher)"
+        }
+        "external.timeout_s" => {
+            "a run taking longer is stopped (SIGTERM, then SIGKILL) and is an error"
+        }
         "external.warmup_runs" => "untimed runs before each round's samples",
         "external.scenarios" => "the scenarios its cases stand for (when left out: the config's)",
         "external.threads" => "thread counts (when left out: the config's)",

@@ -6,8 +6,8 @@
 //! `NBODY_BENCH_UPDATE_DOCS=1 cargo test --test suite docs` rewrites the generated pages.
 
 use crate::{bin, text};
-use nbody_bench::experiment::results::ResultsFile;
 use nbody_bench::experiment::external::SampleError;
+use nbody_bench::experiment::results::ResultsFile;
 use nbody_bench::experiment::vet::Rejected;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -76,7 +76,12 @@ fn the_cli_reference_is_the_commands_help() {
 #[test]
 fn the_config_reference_has_every_key() {
     let page = reference("config");
-    for key in ["`measure.samples`", "`weak.rule`", "`mpi.ranks`", "`external.time`"] {
+    for key in [
+        "`measure.samples`",
+        "`weak.rule`",
+        "`mpi.ranks`",
+        "`external.time`",
+    ] {
         assert!(page.contains(key), "{key} missing");
     }
     check_generated("config.md", &page);
