@@ -11,7 +11,8 @@ use super::groups::{Point, workers_suffix};
 use crate::stats::{BOOTSTRAP_RESAMPLES, bootstrap_ratio_ci};
 use serde::Serialize;
 
-/// The median relative force error at which tree codes are compared (SPEC §6).
+/// The median relative force error at which tree codes are compared: the octree's target
+/// at θ = 0.5.
 pub const EQUAL_ERROR: f64 = 1e-3;
 
 /// The seed of the ratio bootstraps: the same results give the same intervals.

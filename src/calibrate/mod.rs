@@ -1,5 +1,5 @@
 //! Machine calibration for a sweep: what this machine can do at best, measured the same way
-//! every time, so that kernel timings can be read against it (SPEC §3).
+//! every time, so that kernel timings can be read against it.
 //!
 //! Four measurements, each bounded by a time budget:
 //! - **FMA throughput** of one thread: many independent multiply-add chains in the

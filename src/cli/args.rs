@@ -56,6 +56,26 @@ pub enum Command {
     /// Write a scenario's initial state for another code: a LAMMPS data file (reduced units),
     /// or a text / .npy table of positions, velocities, masses and strengths.
     Export(ExportArgs),
+    /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
+    /// every key of a sweep config.
+    #[command(hide = true)]
+    Reference(ReferenceArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct ReferenceArgs {
+    /// The page to print.
+    #[arg(value_enum)]
+    pub page: ReferencePage,
+}
+
+/// A generated reference page.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ReferencePage {
+    /// docs/reference/cli.md: every subcommand's help.
+    Cli,
+    /// docs/reference/config.md: every key of a sweep config.
+    Config,
 }
 
 #[derive(Debug, Args)]
@@ -529,7 +549,7 @@ pub struct GateArgs {
     /// Relative slowdown a case must exceed, with its whole 95% CI, to count as a regression
     /// (0.10 = 10%); the same margin below 1 counts as an improvement [default: 0.10 for two
     /// files and for A/B runs, 0.25 when the gate sweeps and compares with a baseline file
-    /// measured at another time: the margins the noise studies in the README found safe];
+    /// measured at another time: the margins the gate's noise studies found safe];
     /// at most 1 (a doubling).
     #[arg(long, value_parser = parse_threshold, allow_hyphen_values = true)]
     pub threshold: Option<f64>,

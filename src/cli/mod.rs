@@ -12,6 +12,7 @@ mod fit_tables;
 mod gate;
 mod list;
 mod mpi;
+mod reference;
 mod report;
 mod run;
 mod summary;
@@ -36,6 +37,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::MpiBench(args) => mpi::bench(args),
         Command::MpiCheck(args) => mpi::check(args),
         Command::Export(args) => export::export(args),
+        Command::Reference(args) => reference::reference(args),
     }
 }
 

@@ -96,7 +96,7 @@ impl Counts {
     }
 }
 
-/// How each case is measured (SPEC §3).
+/// How each case is measured (docs/explanation/statistics.md).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Measure {

@@ -7,7 +7,7 @@ use crate::kernels::{KernelKind, KernelParams, Multipole};
 use crate::scenario::{Precision, ScenarioKind};
 use serde::{Deserialize, Serialize};
 
-/// One measured configuration (SPEC §3): everything that changes the work or the machine use.
+/// One measured configuration: everything that changes the work or the machine use.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Case {
     pub scenario: ScenarioKind,

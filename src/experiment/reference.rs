@@ -15,7 +15,7 @@
 //! slower and hide itself. Under load it still slows down a little more than the kernels (about
 //! 3.4x against 2.9x with two busy loops beside it; a peak-rate FMA loop, tried first, did the
 //! same), so a run under more load than its baseline reads slightly faster, and a baseline
-//! should be measured on a quiet machine (README, CI section). Every thread of the case's pool
+//! should be measured on a quiet machine (docs/explanation/gate.md). Every thread of the case's pool
 //! runs it (a 2-thread case waits for its slowest thread at every step; so does the
 //! broadcast); a 1-thread pool runs it on the calling thread.
 

@@ -54,7 +54,8 @@ impl Calibrations {
     }
 }
 
-/// Where and how the results were produced (SPEC §3).
+/// Where and how the results were produced, so that a result can be reproduced and compared
+/// only with results of the same machine and build.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metadata {
     pub tool_version: String,

@@ -21,7 +21,7 @@ use std::time::Duration;
 use thiserror::Error;
 
 /// Most rounds of every case per build: 4 are the default and were enough for the error rates
-/// in the README; 100 rounds of `configs/ci.toml` already take about half an hour.
+/// of docs/explanation/gate.md; 100 rounds of `configs/ci.toml` already take about half an hour.
 pub const MAX_ROUNDS: usize = 100;
 
 /// Whether `rounds` rounds per build can be measured: an even number from 2 to

@@ -16,7 +16,7 @@ use thiserror::Error;
 /// Longest a git command may take (a worktree of a large checkout takes seconds).
 const GIT_LIMIT: Duration = Duration::from_secs(300);
 /// Longest the base revision's release build may take: a fresh build takes 1-10 minutes on
-/// the 2-vCPU CI machines (README, CI section), so a build past an hour is stuck.
+/// the 2-vCPU CI machines, so a build past an hour is stuck.
 pub const BUILD_LIMIT: Duration = Duration::from_secs(3600);
 /// Longest `rustc -vV` may take.
 const RUSTC_LIMIT: Duration = Duration::from_secs(60);

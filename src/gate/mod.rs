@@ -35,8 +35,8 @@ use crate::experiment::results::ResultsFile;
 use serde::Serialize;
 use thiserror::Error;
 
-/// Default threshold of an A/B run (both builds interleaved in one run): see the README's CI
-/// section for the A/A runs it was chosen from.
+/// Default threshold of an A/B run (both builds interleaved in one run): see
+/// docs/explanation/gate.md for the A/A runs it was chosen from.
 pub const AB_THRESHOLD: f64 = 0.10;
 /// Default threshold against a baseline file measured at another time.
 pub const FILE_THRESHOLD: f64 = 0.25;

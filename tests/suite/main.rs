@@ -12,6 +12,7 @@ mod bad_sizes;
 mod cli;
 mod config_corpus;
 mod conservation;
+mod docs;
 mod dry_run;
 mod export;
 mod external;

@@ -16,7 +16,7 @@ pub const EXACT_ULPS: f64 = 1000.0;
 /// Largest median relative error the octree may have at opening angle θ, for a law.
 ///
 /// Monopole Barnes-Hut error grows roughly as θ²; the bound is 4e-3·θ² for gravity
-/// (1e-3 at θ = 0.5, the SPEC target) and ten times that for mixed-sign charges, whose net
+/// (1e-3 at θ = 0.5, the octree's accuracy target) and ten times that for mixed-sign charges, whose net
 /// forces are small differences of large opposing sums. At θ = 0 the octree is exact and
 /// is held to the exact-kernel bound instead.
 pub fn octree_tolerance(law: crate::physics::LawKind, theta: f64) -> f64 {

@@ -1,5 +1,5 @@
 //! Per-rank statistics of a distributed run, their reduction over ranks, and the `mpi` block
-//! of the `run --json` result (documented in `docs/mpi.md`).
+//! of the `run --json` result (documented in `docs/howto/run-mpi-studies.md`).
 //!
 //! Time is split three ways on every rank: *compute* (everything outside MPI calls: forces,
 //! integration, walls, packing), *communication* (time inside MPI calls, the Coulomb MPI tutorial's
@@ -29,7 +29,7 @@ pub struct RankStats {
     pub wait_s: f64,
     /// `comm_s − wait_s`, at least 0: moving data and MPI overhead.
     pub transfer_s: f64,
-    /// Payload bytes and messages this rank sent (collectives: see `docs/mpi.md`).
+    /// Payload bytes and messages this rank sent (collectives: see `docs/howto/run-mpi-studies.md`).
     pub bytes_sent: u64,
     pub messages_sent: u64,
     /// Collective calls made.

@@ -1,7 +1,7 @@
 //! The results file of `nbody-bench mpi-bench`: raw timings of point-to-point messages and of
 //! Allgatherv over message sizes, from which the analysis fits the α-β model
 //! (`t = α + β · bytes`) and predicts communication at rank counts beyond the machine.
-//! Layout in `docs/mpi.md`.
+//! Layout in `docs/howto/run-mpi-studies.md`.
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
