@@ -281,9 +281,10 @@ const HARNESS_LAYERS: &[&[&str]] = &[
     &["console", "children", "fit", "calibrate", "plot"],
     &["units"],
     &["experiment"],
-    &["analysis", "gate"],
+    &["analysis"],
     &["render"],
-    &["report"],
+    // The gate writes its Markdown through render's table builder.
+    &["gate", "report"],
 ];
 
 /// The MPI crate's modules (`crates/mpi`), bottom up, over the engine's.
