@@ -14,23 +14,26 @@ impl Duration {
     pub fn from_ns(ns: f64) -> Self {
         Duration(ns * 1e-9)
     }
+
+    /// The unit a span of `seconds` is written in, and its length in seconds: `(1e-3, "ms")`.
+    /// The figures' axes take it too, so a plot and a table name a time alike.
+    pub fn unit_for(seconds: f64) -> (f64, &'static str) {
+        const UNITS: [(f64, &str); 4] = [(1.0, "s"), (1e-3, "ms"), (1e-6, "µs"), (1e-9, "ns")];
+        let s = seconds.abs();
+        *UNITS.iter().find(|(len, _)| s >= *len).unwrap_or(&UNITS[3])
+    }
 }
 
 impl fmt::Display for Duration {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        let s = self.0;
-        let (value, unit, default) = if s.abs() >= 1.0 {
-            (s, "s", 3)
-        } else if s.abs() >= 1e-3 {
-            (s * 1e3, "ms", 3)
-        } else if s.abs() >= 1e-6 {
-            (s * 1e6, "µs", 3)
-        } else {
-            (s * 1e9, "ns", 2)
-        };
+        let (len, unit) = Self::unit_for(self.0);
+        // Nanoseconds are the timer's grain: a third decimal there would be noise.
+        let default = if unit == "ns" { 2 } else { 3 };
+        // 1 / len is exactly 1e3, 1e6 or 1e9: the product rounds as `s * 1e3` always has.
         write!(
             f,
-            "{value:.d$} {unit}",
+            "{:.d$} {unit}",
+            self.0 * (1.0 / len),
             d = f.precision().unwrap_or(default)
         )
     }
@@ -66,21 +69,32 @@ impl fmt::Display for WallTime {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bytes(pub f64);
 
-impl fmt::Display for Bytes {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        const UNITS: [&str; 4] = ["KiB", "MiB", "GiB", "TiB"];
-        let b = self.0;
-        if b.abs() < 1024.0 {
-            return write!(f, "{b:.0} B");
-        }
-        let mut value = b / 1024.0;
+impl Bytes {
+    /// The unit a count of `bytes` is written in, and its size in bytes: `(1024.0, "KiB")`.
+    /// The figures' axes take it too, so a plot and a table name a size alike.
+    pub fn unit_for(bytes: f64) -> (f64, &'static str) {
+        const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
+        let b = bytes.abs();
+        let mut size = 1.0;
         let mut unit = 0;
-        while value.abs() >= 1024.0 && unit + 1 < UNITS.len() {
-            value /= 1024.0;
+        while b >= 1024.0 * size && unit + 1 < UNITS.len() {
+            size *= 1024.0;
             unit += 1;
         }
-        let d = f.precision().unwrap_or(1);
-        write!(f, "{value:.d$} {}", UNITS[unit])
+        (size, UNITS[unit])
+    }
+}
+
+impl fmt::Display for Bytes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let (size, unit) = Self::unit_for(self.0);
+        // Whole bytes have no decimals; the format's precision is for the larger units.
+        let d = if size == 1.0 {
+            0
+        } else {
+            f.precision().unwrap_or(1)
+        };
+        write!(f, "{:.d$} {unit}", self.0 / size)
     }
 }
 
@@ -125,10 +139,15 @@ pub struct WithCi<U> {
 impl<U> WithCi<U> {
     /// The estimate and interval of `e`, each in the unit `unit` makes of it.
     pub fn of(e: &crate::fit::Estimate, unit: impl Fn(f64) -> U) -> Self {
+        Self::new(e.estimate, e.ci95, unit)
+    }
+
+    /// `estimate` and its interval `ci95`, each in the unit `unit` makes of it.
+    pub fn new(estimate: f64, ci95: [f64; 2], unit: impl Fn(f64) -> U) -> Self {
         WithCi {
-            estimate: unit(e.estimate),
-            low: unit(e.ci95[0]),
-            high: unit(e.ci95[1]),
+            estimate: unit(estimate),
+            low: unit(ci95[0]),
+            high: unit(ci95[1]),
         }
     }
 }

@@ -3,6 +3,7 @@
 
 use super::checks::short;
 use super::{CaseComparison, GateReport, Normalization, Verdict};
+use crate::render::tables::{Align, Table};
 use crate::units::Duration;
 use std::fmt::Write;
 
@@ -142,28 +143,38 @@ fn markdown(report: &GateReport) -> String {
         normalizations(report),
         1.0 + report.threshold
     );
-    s += "| case | baseline | current | ratio | 95% CI | raw ratio | verdict |\n";
-    s += "|---|---:|---:|---:|---:|---:|---|\n";
+    // Numbers line up on their last digit; the case and the verdict are words.
+    let (word, number) = (Align::Default, Align::Right);
+    let mut table = Table::new([
+        "case",
+        "baseline",
+        "current",
+        "ratio",
+        "95% CI",
+        "raw ratio",
+        "verdict",
+    ])
+    .aligned([word, number, number, number, number, number, word]);
     for c in &report.cases {
         let word = verdict_word(c);
         let verdict = match c.verdict {
             Verdict::Regressed => format!("**{word}**"),
             _ => word.to_string(),
         };
-        let _ = writeln!(
-            s,
-            "| `{}` | {} | {} | {:.3} | {:.3} – {:.3} | {:.3} | {}{} |",
-            c.key,
-            Duration(c.baseline_median_s),
-            Duration(c.current_median_s),
-            c.ratio,
-            c.ci95[0],
-            c.ci95[1],
-            c.raw_ratio,
-            verdict,
-            notes(c).map(|n| format!(" ({n})")).unwrap_or_default()
-        );
+        table.row([
+            format!("`{}`", c.key),
+            Duration(c.baseline_median_s).to_string(),
+            Duration(c.current_median_s).to_string(),
+            format!("{:.3}", c.ratio),
+            format!("{:.3} – {:.3}", c.ci95[0], c.ci95[1]),
+            format!("{:.3}", c.raw_ratio),
+            format!(
+                "{verdict}{}",
+                notes(c).map(|n| format!(" ({n})")).unwrap_or_default()
+            ),
+        ]);
     }
+    s += &table.markdown();
     let lines = findings(report);
     if !lines.is_empty() {
         s += "\n";

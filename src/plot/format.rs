@@ -1,32 +1,33 @@
-//! Tick labels that read like a person wrote them: `10 µs`, `1.5 ms`, `10k`, `64 kB`, `1e-4`.
+//! Tick labels that read like a person wrote them: `10 µs`, `1.5 ms`, `10k`, `64 KiB`, `1e-4`.
 //!
 //! Linear axes share one prefix and one number of decimals across all ticks (so `0.5 ms`,
 //! `1.0 ms`, `1.5 ms` line up); logarithmic axes pick the prefix per tick (`100 µs`, `1 ms`).
+//! Times and byte counts take their unit from `crate::units`, as the tables do.
 
 use super::spec::Unit;
+use crate::units::{Bytes, Duration};
 
-/// Multipliers and their suffixes, smallest first. The first entry also covers smaller values.
-fn prefixes(unit: Unit) -> &'static [(f64, &'static str)] {
+/// Multipliers of counts and their suffixes, smallest first. The first entry also covers
+/// smaller values.
+const COUNTS: [(f64, &str); 5] = [(1.0, ""), (1e3, "k"), (1e6, "M"), (1e9, "G"), (1e12, "T")];
+
+/// The size of the unit that suits `magnitude` and its suffix: the largest unit not above
+/// `magnitude`, the smallest one for tiny magnitudes.
+fn prefix_for(unit: Unit, magnitude: f64) -> (f64, String) {
+    // A tick computed as 0.000999… s still reads 1 ms.
+    let magnitude = magnitude * (1.0 + 1e-9);
+    let spaced = |(size, name): (f64, &str)| (size, format!(" {name}"));
     match unit {
-        Unit::Plain => &[(1.0, "")],
-        Unit::Seconds => &[(1e-9, " ns"), (1e-6, " µs"), (1e-3, " ms"), (1.0, " s")],
-        Unit::Count => &[(1.0, ""), (1e3, "k"), (1e6, "M"), (1e9, "G"), (1e12, "T")],
-        Unit::Percent => &[(0.01, "%")],
-        Unit::Bytes => &[
-            (1.0, " B"),
-            (1e3, " kB"),
-            (1e6, " MB"),
-            (1e9, " GB"),
-            (1e12, " TB"),
-        ],
+        Unit::Plain => (1.0, String::new()),
+        Unit::Percent => (0.01, "%".into()),
+        Unit::Seconds => spaced(Duration::unit_for(magnitude)),
+        Unit::Bytes => spaced(Bytes::unit_for(magnitude)),
+        Unit::Count => {
+            let fits = |&&(m, _): &&(f64, &str)| magnitude >= m;
+            let (m, suffix) = *COUNTS.iter().rev().find(fits).unwrap_or(&COUNTS[0]);
+            (m, suffix.into())
+        }
     }
-}
-
-/// The largest prefix not above `magnitude` (the smallest one for tiny magnitudes).
-fn prefix_for(unit: Unit, magnitude: f64) -> (f64, &'static str) {
-    let table = prefixes(unit);
-    let fits = |&&(m, _): &&(f64, &str)| magnitude >= m * (1.0 - 1e-9);
-    *table.iter().rev().find(fits).unwrap_or(&table[0])
 }
 
 /// Plain numbers this large or this small are written in scientific notation.
@@ -146,7 +147,8 @@ mod tests {
         assert_eq!(log_label(1e4, Unit::Plain), "1e4");
         assert_eq!(log_label(1e-4, Unit::Plain), "1e-4");
         assert_eq!(log_label(0.05, Unit::Plain), "0.05");
-        assert_eq!(log_label(2e3, Unit::Bytes), "2 kB");
+        assert_eq!(log_label(2048.0, Unit::Bytes), "2 KiB");
+        assert_eq!(log_label(1.5 * 1024.0 * 1024.0, Unit::Bytes), "1.5 MiB");
         assert_eq!(log_label(0.25, Unit::Percent), "25%");
     }
 

@@ -66,12 +66,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
         );
     }
     if !a.cases.is_empty() {
-        let _ = writeln!(
-            md,
-            "## Energy checks\n\n{}{}",
-            tables::sanity_header(false),
-            tables::sanity_rows(a, None)
-        );
+        let _ = writeln!(md, "## Energy checks\n\n{}", tables::sanity([a], false));
     }
     let flagged: Vec<_> = a.cases.iter().filter(|c| !c.sanity_ok).collect();
     if !flagged.is_empty() {

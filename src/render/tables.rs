@@ -1,7 +1,8 @@
-//! The tables of an analysis, as Markdown: cost vs n, strong scaling, weak scaling, octree
-//! accuracy and the energy checks. `summary.md` and REPORT.md both print these, so a number, a
-//! marker or a word reads the same in both: an oversubscribed case is marked `*`, an unbounded
-//! speedup is `∞`, a missing value `–`.
+//! Markdown tables: the one [`Table`] builder that every table of the harness is made with
+//! (REPORT.md, `summary.md`, the gate's report), and the tables of an analysis: cost vs n,
+//! strong scaling, weak scaling, octree accuracy and the energy checks. `summary.md` and
+//! REPORT.md both print these, so a number, a marker or a word reads the same in both: an
+//! oversubscribed case is marked `*`, an unbounded speedup is `∞`, a missing value `–`.
 
 use crate::analysis::groups::Point;
 use crate::analysis::{Analysis, Fitted};
@@ -9,11 +10,95 @@ use crate::physics::LawKind;
 use crate::units::{Duration, Percent, Plain, WithCi};
 use std::fmt::Write;
 
+/// How the cells of a column sit, as the delimiter row says it.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Align {
+    /// `---`: the renderer's default, left in every one we know.
+    #[default]
+    Default,
+    /// `---:`: for numbers that should line up on their last digit.
+    Right,
+}
+
+/// A Markdown table: a header, an alignment per column, rows of cells already formatted
+/// (through `crate::units`). Cells are written as they are: `|` in a cell is the caller's
+/// to escape.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Table {
+    header: Vec<String>,
+    align: Vec<Align>,
+    rows: Vec<Vec<String>>,
+}
+
+impl Table {
+    /// A table with these column headers, every column default-aligned, and no rows.
+    pub fn new<S: Into<String>>(header: impl IntoIterator<Item = S>) -> Self {
+        let header: Vec<String> = header.into_iter().map(Into::into).collect();
+        let align = vec![Align::Default; header.len()];
+        Table {
+            header,
+            align,
+            rows: Vec::new(),
+        }
+    }
+
+    /// The same table with one alignment per column, in order.
+    pub fn aligned(mut self, align: impl IntoIterator<Item = Align>) -> Self {
+        self.align = align.into_iter().collect();
+        assert_eq!(
+            self.align.len(),
+            self.header.len(),
+            "one alignment per column"
+        );
+        self
+    }
+
+    /// Adds a row; it has one cell per column.
+    pub fn row<S: Into<String>>(&mut self, cells: impl IntoIterator<Item = S>) -> &mut Self {
+        let cells: Vec<String> = cells.into_iter().map(Into::into).collect();
+        // A short or long row silently shifts every cell after it into the wrong column.
+        debug_assert_eq!(cells.len(), self.header.len(), "one cell per column");
+        self.rows.push(cells);
+        self
+    }
+
+    /// The header, the delimiter row and the rows, each line ending in a newline.
+    pub fn markdown(&self) -> String {
+        let mut md = line(&self.header);
+        md.push('|');
+        for a in &self.align {
+            md.push_str(match a {
+                Align::Default => "---|",
+                Align::Right => "---:|",
+            });
+        }
+        md.push('\n');
+        for r in &self.rows {
+            md.push_str(&line(r));
+        }
+        md
+    }
+}
+
+/// One line of cells: `| a | b |`, an empty cell as `| |`.
+fn line(cells: &[String]) -> String {
+    let mut md = String::new();
+    for c in cells {
+        md.push_str("| ");
+        if !c.is_empty() {
+            md.push_str(c);
+            md.push(' ');
+        }
+    }
+    md.push_str("|\n");
+    md
+}
+
 /// What a cell shows when there is no value.
 const NONE: &str = "–";
 
-/// The marker of a case that ran more workers than logical CPUs.
-fn over(oversubscribed: bool) -> &'static str {
+/// The marker of a case that ran more workers (threads or ranks) than logical CPUs.
+pub fn over(oversubscribed: bool) -> &'static str {
     if oversubscribed { "*" } else { "" }
 }
 
@@ -35,10 +120,17 @@ pub fn peak_note() -> String {
 /// Cost vs n: per series, the n range, the time at the largest n, the rates, the fitted
 /// exponent and the class chosen by cross-validation.
 pub fn complexity(a: &Analysis) -> String {
-    let mut md = String::from(
-        "| scenario | kernel | n | time/step | ns/particle-step | pair-evals/s | peak | k [95% CI] | class (LOO SMAPE) |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
-    );
+    let mut table = Table::new([
+        "scenario",
+        "kernel",
+        "n",
+        "time/step",
+        "ns/particle-step",
+        "pair-evals/s",
+        "peak",
+        "k [95% CI]",
+        "class (LOO SMAPE)",
+    ]);
     for c in &a.complexity {
         let (Some(first), Some(last)) = (c.points.first(), c.points.last()) else {
             continue;
@@ -53,19 +145,19 @@ pub fn complexity(a: &Analysis) -> String {
         let peak = a
             .peak_share(last, c.series.scenario.law(), c.series.precision)
             .map_or(NONE.to_string(), |s| format!("{:.0}", Percent(s)));
-        let _ = writeln!(
-            md,
-            "| {} | {} | {}–{} | {} | {:.1} | {:.2e} | {peak} | {k} | {class} |",
-            c.series.scenario.name(),
-            c.label,
-            first.n,
-            last.n,
-            Duration(last.median_s),
-            last.ns_per_particle_step,
-            last.pair_evals_per_s,
-        );
+        table.row([
+            c.series.scenario.name().to_string(),
+            c.label.clone(),
+            format!("{}–{}", first.n, last.n),
+            Duration(last.median_s).to_string(),
+            format!("{:.1}", last.ns_per_particle_step),
+            format!("{:.2e}", last.pair_evals_per_s),
+            peak,
+            k,
+            class,
+        ]);
     }
-    md
+    table.markdown()
 }
 
 /// The crossovers of the fitted cost curves, one line each.
@@ -84,19 +176,25 @@ fn oversubscribed_at(points: &[Point], p: f64) -> bool {
 /// Strong scaling: the speedup at each p (and over the calibrated ceiling), the Amdahl fit, its
 /// bound, the Karp-Flatt trend and the serial fraction the phase timers measured.
 pub fn strong(a: &Analysis) -> String {
-    let mut md = String::from(
-        "| scenario | kernel | n | speedup by p (÷ ceiling) | Amdahl f [95% CI] | 1/f | Karp-Flatt | f from phase timers |\n\
-         |---|---|---|---|---|---|---|---|\n",
-    );
+    let mut table = Table::new([
+        "scenario",
+        "kernel",
+        "n",
+        "speedup by p (÷ ceiling)",
+        "Amdahl f [95% CI]",
+        "1/f",
+        "Karp-Flatt",
+        "f from phase timers",
+    ]);
     for st in &a.strong {
-        let head = format!(
-            "| {} | {} | {} |",
-            st.series.scenario.name(),
-            st.label,
-            st.series.n.unwrap_or(0)
-        );
+        let head = [
+            st.series.scenario.name().to_string(),
+            st.label.clone(),
+            st.series.n.unwrap_or(0).to_string(),
+        ];
         let Some(f) = &st.fit.fit else {
-            let _ = writeln!(md, "{head} {} | | | | |", not_fitted(&st.fit));
+            let blank = std::iter::repeat_n(String::new(), 4);
+            table.row(head.into_iter().chain([not_fitted(&st.fit)]).chain(blank));
             continue;
         };
         let cells: Vec<String> = st
@@ -126,15 +224,15 @@ pub fn strong(a: &Analysis) -> String {
             .timed_serial
             .as_ref()
             .map_or(NONE.to_string(), |t| format!("{:.2}", Percent(t.fraction)));
-        let _ = writeln!(
-            md,
-            "{head} {} | {} | {bound} | {} | {timed} |",
+        table.row(head.into_iter().chain([
             cells.join("<br>"),
-            WithCi::of(&f.serial_fraction, Percent),
-            f.karp_flatt_trend.verdict.name(),
-        );
+            WithCi::of(&f.serial_fraction, Percent).to_string(),
+            bound,
+            f.karp_flatt_trend.verdict.name().to_string(),
+            timed,
+        ]));
     }
-    md
+    table.markdown()
 }
 
 /// Each strong series' timed serial fraction next to the fitted one, one line each.
@@ -157,12 +255,11 @@ pub fn serial_comparisons(a: &Analysis) -> String {
 
 /// Weak scaling: n and the efficiency at each p, and Gustafson's serial fraction.
 pub fn weak(a: &Analysis) -> String {
-    let mut md =
-        String::from("| scenario | kernel | p: n, efficiency | Gustafson α |\n|---|---|---|---|\n");
+    let mut table = Table::new(["scenario", "kernel", "p: n, efficiency", "Gustafson α"]);
     for w in &a.weak {
-        let head = format!("| {} | {} |", w.series.scenario.name(), w.label);
+        let head = [w.series.scenario.name().to_string(), w.label.clone()];
         let Some(f) = &w.fit.fit else {
-            let _ = writeln!(md, "{head} {} | |", not_fitted(&w.fit));
+            table.row(head.into_iter().chain([not_fitted(&w.fit), String::new()]));
             continue;
         };
         let cells: Vec<String> = w
@@ -179,14 +276,12 @@ pub fn weak(a: &Analysis) -> String {
                 )
             })
             .collect();
-        let _ = writeln!(
-            md,
-            "{head} {} | {} |",
+        table.row(head.into_iter().chain([
             cells.join("<br>"),
-            WithCi::of(&f.serial_fraction, Percent)
-        );
+            WithCi::of(&f.serial_fraction, Percent).to_string(),
+        ]));
     }
-    md
+    table.markdown()
 }
 
 /// θ of an octree or fmm case, with the expansion order when it is not the octree's
@@ -203,33 +298,48 @@ fn theta_cell(p: &crate::analysis::groups::Point) -> String {
 /// The octree over θ (one series per expansion order): time and the force error against an
 /// f64 direct sum.
 pub fn theta(a: &Analysis) -> String {
-    let mut md = String::from(
-        "| scenario | code | n | θ | time/step | µs/particle-step | median / max relative force error |\n\
-         |---|---|---|---|---|---|---|\n",
-    );
+    let mut table = Table::new([
+        "scenario",
+        "code",
+        "n",
+        "θ",
+        "time/step",
+        "µs/particle-step",
+        "median / max relative force error",
+    ]);
     for t in &a.theta {
         for p in &t.points {
             let error = p.force_error.map_or("not measured".to_string(), |[m, x]| {
                 format!("{m:.2e} / {x:.2e}")
             });
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {:.2} | {error} |",
-                t.series.scenario.name(),
-                t.series.kernel.name(),
-                p.n,
+            table.row([
+                t.series.scenario.name().to_string(),
+                t.series.kernel.name().to_string(),
+                p.n.to_string(),
                 theta_cell(p),
-                Duration(p.median_s),
-                p.ns_per_particle_step * 1e-3,
-            );
+                Duration(p.median_s).to_string(),
+                format!("{:.2}", p.ns_per_particle_step * 1e-3),
+                error,
+            ]);
         }
     }
-    md
+    table.markdown()
 }
 
-/// The energy check per scenario and kernel: cases, the largest drift, the cases flagged.
-/// Rows only; `sweep` names the sweep in the first column when given.
-pub fn sanity_rows(a: &Analysis, sweep: Option<&str>) -> String {
+/// The energy check per scenario and kernel of each analysis: cases, the largest drift, the
+/// cases flagged. With `by_sweep`, a first column names each analysis's sweep (REPORT.md
+/// gathers every sweep into one table).
+pub fn sanity<'a>(analyses: impl IntoIterator<Item = &'a Analysis>, by_sweep: bool) -> String {
+    let columns = ["scenario", "kernel", "cases", "largest drift", "flagged"];
+    let mut table = Table::new(by_sweep.then_some("sweep").into_iter().chain(columns));
+    for a in analyses {
+        sanity_rows(&mut table, a, by_sweep.then_some(a.name.as_str()));
+    }
+    table.markdown()
+}
+
+/// The rows of `a` in the energy-check table, led by `sweep` when given.
+fn sanity_rows(table: &mut Table, a: &Analysis, sweep: Option<&str>) {
     let mut rows: Vec<(&Point, usize, f64, usize)> = Vec::new();
     for c in &a.cases {
         let same = |r: &&mut (&Point, usize, f64, usize)| {
@@ -244,33 +354,14 @@ pub fn sanity_rows(a: &Analysis, sweep: Option<&str>) -> String {
             None => rows.push((c, 1, c.max_energy_drift, usize::from(!c.sanity_ok))),
         }
     }
-    let mut md = String::new();
     for (c, cases, drift, flagged) in rows {
-        let lead = sweep.map(|s| format!("| {s} ")).unwrap_or_default();
-        let _ = writeln!(
-            md,
-            "{lead}| {} | {} | {cases} | {drift:.1e} | {flagged} |",
-            c.case.scenario.name(),
-            c.case.kernel.name()
-        );
-    }
-    md
-}
-
-/// The header of the energy-check table, with or without the sweep column.
-pub fn sanity_header(with_sweep: bool) -> &'static str {
-    if with_sweep {
-        "| sweep | scenario | kernel | cases | largest drift | flagged |\n|---|---|---|---|---|---|\n"
-    } else {
-        "| scenario | kernel | cases | largest drift | flagged |\n|---|---|---|---|---|\n"
-    }
-}
-
-fn with_ci(estimate: f64, ci: [f64; 2]) -> WithCi<Plain> {
-    WithCi {
-        estimate: Plain(estimate),
-        low: Plain(ci[0]),
-        high: Plain(ci[1]),
+        table.row(sweep.map(str::to_string).into_iter().chain([
+            c.case.scenario.name().to_string(),
+            c.case.kernel.name().to_string(),
+            cases.to_string(),
+            format!("{drift:.1e}"),
+            flagged.to_string(),
+        ]));
     }
 }
 
@@ -292,50 +383,48 @@ pub fn peers(a: &Analysis) -> String {
         .iter()
         .any(|r| r.ours_error.is_some() || r.theirs_error.is_some());
     let others = a.peers.iter().any(|r| !r.others.is_empty());
-    let mut md = format!(
-        "| scenario | n | workers | ours | ns/particle-step [95% CI] | {} | ns/particle-step [95% CI] | theirs ÷ ours [95% CI] |",
+    let mut header = vec![
+        "scenario",
+        "n",
+        "workers",
+        "ours",
+        "ns/particle-step [95% CI]",
         if others {
             "theirs (the fastest run)"
         } else {
             "theirs"
-        }
-    );
-    let mut columns = 8;
+        },
+        "ns/particle-step [95% CI]",
+        "theirs ÷ ours [95% CI]",
+    ];
     if errors {
-        md.push_str(" median force error (ours / theirs) |");
-        columns += 1;
+        header.push("median force error (ours / theirs)");
     }
     if others {
-        md.push_str(" their other runs: ns/particle-step (theirs ÷ ours) |");
-        columns += 1;
+        header.push("their other runs: ns/particle-step (theirs ÷ ours)");
     }
-    md.push_str("\n|");
-    md.push_str(&"---|".repeat(columns));
-    md.push('\n');
+    let mut table = Table::new(header);
     for r in &a.peers {
         let ratio = match r.speedup_ci {
-            Some(ci) => format!("{:.2}", with_ci(r.speedup, ci)),
+            Some(ci) => format!("{:.2}", WithCi::new(r.speedup, ci, Plain)),
             None => format!("{:.2}", r.speedup),
         };
-        let _ = write!(
-            md,
-            "| {} | {} | {}{} | {} | {:.1} | {} | {:.1} | {ratio} |",
-            r.scenario,
-            r.n,
-            r.workers,
-            over(r.oversubscribed),
-            r.ours,
-            with_ci(r.ours_ns, r.ours_ci_ns),
-            r.theirs,
-            with_ci(r.theirs_ns, r.theirs_ci_ns),
-        );
+        let mut row = vec![
+            r.scenario.to_string(),
+            r.n.to_string(),
+            format!("{}{}", r.workers, over(r.oversubscribed)),
+            r.ours.to_string(),
+            format!("{:.1}", WithCi::new(r.ours_ns, r.ours_ci_ns, Plain)),
+            r.theirs.to_string(),
+            format!("{:.1}", WithCi::new(r.theirs_ns, r.theirs_ci_ns, Plain)),
+            ratio,
+        ];
         if errors {
-            let _ = write!(
-                md,
-                " {} / {} |",
+            row.push(format!(
+                "{} / {}",
                 error_cell(r.ours_error),
                 error_cell(r.theirs_error)
-            );
+            ));
         }
         if others {
             let cell: Vec<String> = r
@@ -356,11 +445,11 @@ pub fn peers(a: &Analysis) -> String {
             } else {
                 cell.join("; ")
             };
-            let _ = write!(md, " {cell} |");
+            row.push(cell);
         }
-        md.push('\n');
+        table.row(row);
     }
-    md
+    table.markdown()
 }
 
 /// Tree codes at equal median force error: each code's time per step interpolated to it on
@@ -369,28 +458,57 @@ pub fn peers_equal_error(a: &Analysis) -> String {
     if a.peers_equal_error.is_empty() {
         return String::new();
     }
-    let mut md = String::from(
-        "| scenario | n | workers | median error | ours | time/step | theirs | time/step | theirs ÷ ours |\n\
-         |---|---|---|---|---|---|---|---|---|\n",
-    );
+    let mut table = Table::new([
+        "scenario",
+        "n",
+        "workers",
+        "median error",
+        "ours",
+        "time/step",
+        "theirs",
+        "time/step",
+        "theirs ÷ ours",
+    ]);
     let cost = |s: Option<f64>, range: [f64; 2]| match s {
         Some(s) => Duration(s).to_string(),
         None => format!("outside the measured {:.1e}–{:.1e}", range[0], range[1]),
     };
     for r in &a.peers_equal_error {
-        let _ = writeln!(
-            md,
-            "| {} | {} | {} | {:.0e} | {} | {} | {} | {} | {} |",
-            r.scenario,
-            r.n,
-            r.workers,
-            r.error,
-            r.ours,
+        table.row([
+            r.scenario.to_string(),
+            r.n.to_string(),
+            r.workers.to_string(),
+            format!("{:.0e}", r.error),
+            r.ours.to_string(),
             cost(r.ours_s, r.ours_errors),
-            r.theirs,
+            r.theirs.to_string(),
             cost(r.theirs_s, r.theirs_errors),
             r.speedup.map_or(NONE.to_string(), |s| format!("{s:.2}")),
+        ]);
+    }
+    table.markdown()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_table_is_its_header_a_delimiter_row_and_its_rows() {
+        let mut t = Table::new(["case", "time"]).aligned([Align::Default, Align::Right]);
+        t.row(["`a`", "1.000 ms"])
+            .row(["`b`".to_string(), "–".to_string()]);
+        assert_eq!(
+            t.markdown(),
+            "| case | time |\n|---|---:|\n| `a` | 1.000 ms |\n| `b` | – |\n"
         );
     }
-    md
+
+    #[test]
+    fn empty_cells_are_one_space_wide() {
+        let mut t = Table::new(["", ""]);
+        t.row(["CPU", ""]);
+        assert_eq!(t.markdown(), "| | |\n|---|---|\n| CPU | |\n");
+        assert_eq!(Table::new(["n"]).markdown(), "| n |\n|---|\n");
+    }
 }

@@ -8,6 +8,7 @@ use crate::decomp::Decomposition;
 use crate::plot::figures::{self as fig, CommTimes, Curve, Measured};
 use crate::plot::{Axis, Unit};
 use crate::render::figures::Figure;
+use crate::render::tables::{self, Table};
 use crate::units::{Duration, Plain, WithCi};
 use std::fmt::Write;
 use std::path::Path;
@@ -101,22 +102,28 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
              time) and of the bytes sent, next to the step time. * = oversubscribed (more ranks than logical CPUs).\n",
             s.analysis.source
         );
-        md.push_str("| decomposition | ranks | n | time/step | communication/step | share | bytes sent/step/rank |\n|---|---|---|---|---|---|---|\n");
+        let mut table = Table::new([
+            "decomposition",
+            "ranks",
+            "n",
+            "time/step",
+            "communication/step",
+            "share",
+            "bytes sent/step/rank",
+        ]);
         for c in s.analysis.cases.iter().filter(|c| c.decomp.is_some()) {
             let comm_s = c.comm_s_per_step.unwrap_or(0.0);
-            let _ = writeln!(
-                md,
-                "| {} | {}{} | {} | {} | {} | {:.1}% | {:.0} |",
-                c.decomp.map_or("", |d| d.name()),
-                c.ranks,
-                if c.oversubscribed { "*" } else { "" },
-                c.n,
-                Duration(c.median_s),
-                Duration(comm_s),
-                100.0 * comm_s / c.median_s.max(f64::MIN_POSITIVE),
-                c.bytes_per_step.unwrap_or(0.0)
-            );
+            table.row([
+                c.decomp.map_or("", |d| d.name()).to_string(),
+                format!("{}{}", c.ranks, tables::over(c.oversubscribed)),
+                c.n.to_string(),
+                Duration(c.median_s).to_string(),
+                Duration(comm_s).to_string(),
+                format!("{:.1}%", 100.0 * comm_s / c.median_s.max(f64::MIN_POSITIVE)),
+                format!("{:.0}", c.bytes_per_step.unwrap_or(0.0)),
+            ]);
         }
+        md.push_str(&table.markdown());
         md.push('\n');
     }
     if let Some(c) = comm {
@@ -140,23 +147,25 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
                     WithCi::of(&f.beta.map(|b| b * 1e9), Plain),
                     m.n_per_rank
                 );
-                md.push_str("| ranks | n | allgather bytes/rank | allgather predicted | domain bytes/rank | domain predicted |\n|---|---|---|---|---|---|\n");
+                let mut table = Table::new([
+                    "ranks",
+                    "n",
+                    "allgather bytes/rank",
+                    "allgather predicted",
+                    "domain bytes/rank",
+                    "domain predicted",
+                ]);
                 for (a, d) in m.allgather.iter().zip(&m.domain) {
-                    let _ = writeln!(
-                        md,
-                        "| {} | {} | {:.0} | {} [{}, {}] | {:.0} | {} [{}, {}] |",
-                        a.ranks,
-                        a.n,
-                        a.bytes_per_rank,
-                        Duration(a.seconds),
-                        Duration(a.ci95[0]),
-                        Duration(a.ci95[1]),
-                        d.bytes_per_rank,
-                        Duration(d.seconds),
-                        Duration(d.ci95[0]),
-                        Duration(d.ci95[1])
-                    );
+                    table.row([
+                        a.ranks.to_string(),
+                        a.n.to_string(),
+                        format!("{:.0}", a.bytes_per_rank),
+                        WithCi::new(a.seconds, a.ci95, Duration).to_string(),
+                        format!("{:.0}", d.bytes_per_rank),
+                        WithCi::new(d.seconds, d.ci95, Duration).to_string(),
+                    ]);
                 }
+                md.push_str(&table.markdown());
                 md.push('\n');
             }
             None => {

@@ -4,7 +4,7 @@ use super::Sweep;
 use super::keep::region;
 use crate::calibrate::Calibration;
 use crate::experiment::config::Study;
-use crate::render::tables;
+use crate::render::tables::{self, Table};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -59,29 +59,46 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         .filter_map(|s| Some((s.analysis.calibration.as_ref()?, &s.analysis.metadata)))
         .max_by_key(|(c, _)| c.parallel_ceiling.len());
     if let Some((c, m)) = calibrated {
-        let _ = writeln!(
-            md,
-            "| | |\n|---|---|\n| CPU | {} |\n| logical CPUs | {} |\n| SIMD level of the pair loops | {} |\n\
-             | single-thread FMA throughput | {:.0} GFLOP/s (f32) |\n| hardware parallel ceiling at p = 2 | {} |\n\
-             | rayon fork/join (idle / hot workers) | {:.1} µs / {:.1} µs |\n| streaming read bandwidth, one thread | {:.1} GB/s |\n\
-             | build | {} profile, {}, target features {} |\n",
-            match &c.cpu_signature {
-                Some(sig) => format!("{} ({sig})", c.cpu_model),
-                None => c.cpu_model.clone(),
-            },
-            c.logical_cpus,
-            c.simd,
-            c.fma_gflops_1t,
-            c.ceiling(2)
-                .map(|r| format!("{r:.2}× (throughput of 2 threads over 1 on an FMA loop)"))
-                .unwrap_or_else(|| "not measured".into()),
-            c.fork_join_us,
-            c.fork_join_hot_us,
-            c.memory_bandwidth_gbs,
-            m.profile,
-            m.rustc_version,
-            m.target_features.join(" ")
-        );
+        let mut table = Table::new(["", ""]);
+        let cpu = match &c.cpu_signature {
+            Some(sig) => format!("{} ({sig})", c.cpu_model),
+            None => c.cpu_model.clone(),
+        };
+        let ceiling = c
+            .ceiling(2)
+            .map(|r| format!("{r:.2}× (throughput of 2 threads over 1 on an FMA loop)"))
+            .unwrap_or_else(|| "not measured".into());
+        for (what, value) in [
+            ("CPU", cpu),
+            ("logical CPUs", c.logical_cpus.to_string()),
+            ("SIMD level of the pair loops", c.simd.to_string()),
+            (
+                "single-thread FMA throughput",
+                format!("{:.0} GFLOP/s (f32)", c.fma_gflops_1t),
+            ),
+            ("hardware parallel ceiling at p = 2", ceiling),
+            (
+                "rayon fork/join (idle / hot workers)",
+                format!("{:.1} µs / {:.1} µs", c.fork_join_us, c.fork_join_hot_us),
+            ),
+            (
+                "streaming read bandwidth, one thread",
+                format!("{:.1} GB/s", c.memory_bandwidth_gbs),
+            ),
+            (
+                "build",
+                format!(
+                    "{} profile, {}, target features {}",
+                    m.profile,
+                    m.rustc_version,
+                    m.target_features.join(" ")
+                ),
+            ),
+        ] {
+            table.row([what.to_string(), value]);
+        }
+        md.push_str(&table.markdown());
+        md.push('\n');
     }
     let machines = machine_classes(sweeps);
     if machines.len() > 1 {
@@ -94,24 +111,34 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
             machines.join(", "),
         );
     }
-    md.push_str("| sweep | study | cases | commit | started | machine (FMA GFLOP/s per thread) | p = 2 ceiling | other load while calibrating |\n|---|---|---|---|---|---|---|---|\n");
+    let mut table = Table::new([
+        "sweep",
+        "study",
+        "cases",
+        "commit",
+        "started",
+        "machine (FMA GFLOP/s per thread)",
+        "p = 2 ceiling",
+        "other load while calibrating",
+    ]);
     for s in sweeps {
         let a = &s.analysis;
         let c = a.calibration.as_ref();
-        let _ = writeln!(
-            md,
-            "| `{}` | {:?} | {}{} | {}{} | {} | {} | {} | {} |",
-            a.source,
-            a.study,
-            a.cases.len(),
-            if a.incomplete.is_empty() {
-                String::new()
-            } else {
-                format!(" (+{} incomplete)", a.incomplete.len())
-            },
-            a.metadata.git_commit.chars().take(7).collect::<String>(),
-            if a.metadata.git_dirty { "+dirty" } else { "" },
-            a.metadata.started,
+        let incomplete = if a.incomplete.is_empty() {
+            String::new()
+        } else {
+            format!(" (+{} incomplete)", a.incomplete.len())
+        };
+        let commit: String = a.metadata.git_commit.chars().take(7).collect();
+        table.row([
+            format!("`{}`", a.source),
+            format!("{:?}", a.study),
+            format!("{}{incomplete}", a.cases.len()),
+            format!(
+                "{commit}{}",
+                if a.metadata.git_dirty { "+dirty" } else { "" }
+            ),
+            a.metadata.started.to_string(),
             c.map(|c| format!("{} ({:.0})", machine_class(c), c.fma_gflops_1t))
                 .unwrap_or_else(|| "–".into()),
             c.and_then(|c| c.ceiling(2))
@@ -120,8 +147,9 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
             c.and_then(|c| c.background_cpus)
                 .map(|b| format!("{b:.2} CPUs"))
                 .unwrap_or_else(|| "–".into()),
-        );
+        ]);
     }
+    md.push_str(&table.markdown());
     md.push('\n');
 }
 
@@ -307,10 +335,7 @@ fn sanity(md: &mut String, sweeps: &[Sweep]) {
          Largest |relative energy drift| over the measured steps of any case, per sweep, scenario and kernel; \
          a case over its sweep's limit is flagged and counted.\n\n",
     );
-    md.push_str(tables::sanity_header(true));
-    for s in sweeps {
-        md.push_str(&tables::sanity_rows(&s.analysis, Some(&s.analysis.name)));
-    }
+    md.push_str(&tables::sanity(sweeps.iter().map(|s| &s.analysis), true));
     md.push('\n');
     md.push_str(&region("sanity", NO_NOTES));
 }

@@ -5,7 +5,8 @@
 
 use super::keep::region;
 use crate::analysis::tree_comm::{TREE_DECOMPS, TreeComm};
-use crate::units::{Bytes, Duration};
+use crate::render::tables::{self, Table};
+use crate::units::{Bytes, Duration, WithCi};
 use std::fmt::Write;
 
 pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
@@ -31,7 +32,15 @@ pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
          (octants keeps the octants of the root cube, the bisection balances).\n",
         t.n_per_rank, t.theta, t.leaf_size
     );
-    md.push_str("| ranks | n | allgather bytes | octants bytes (max) | octants body imbalance | tree bytes (max) | tree ÷ allgather |\n|---|---|---|---|---|---|---|\n");
+    let mut table = Table::new([
+        "ranks",
+        "n",
+        "allgather bytes",
+        "octants bytes (max)",
+        "octants body imbalance",
+        "tree bytes (max)",
+        "tree ÷ allgather",
+    ]);
     let mut ranks: Vec<usize> = t.counted.iter().map(|c| c.ranks).collect();
     ranks.dedup();
     for p in ranks {
@@ -39,23 +48,21 @@ pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
         let [Some(a), Some(o), Some(tr)] = TREE_DECOMPS.map(get) else {
             continue;
         };
-        let _ = writeln!(
-            md,
-            "| {p} | {} | {} | {} ({}) | {:.2} | {} ({}) | {} |",
-            a.n,
-            Bytes(a.bytes_mean),
-            Bytes(o.bytes_mean),
-            Bytes(o.bytes_max),
-            o.bodies_imbalance,
-            Bytes(tr.bytes_mean),
-            Bytes(tr.bytes_max),
+        table.row([
+            p.to_string(),
+            a.n.to_string(),
+            Bytes(a.bytes_mean).to_string(),
+            format!("{} ({})", Bytes(o.bytes_mean), Bytes(o.bytes_max)),
+            format!("{:.2}", o.bodies_imbalance),
+            format!("{} ({})", Bytes(tr.bytes_mean), Bytes(tr.bytes_max)),
             if a.bytes_mean > 0.0 {
                 format!("{:.3}", tr.bytes_mean / a.bytes_mean)
             } else {
                 "–".into()
-            }
-        );
+            },
+        ]);
     }
+    md.push_str(&table.markdown());
     md.push('\n');
     for tr in &t.transports {
         let _ = write!(
@@ -92,35 +99,41 @@ pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
                 continue;
             }
         }
-        md.push_str("| decomposition | ranks | bytes counted | bytes measured | predicted transfer/step | measured in MPI/step | of it transfer | error | compute imbalance |\n|---|---|---|---|---|---|---|---|---|\n");
+        let mut table = Table::new([
+            "decomposition",
+            "ranks",
+            "bytes counted",
+            "bytes measured",
+            "predicted transfer/step",
+            "measured in MPI/step",
+            "of it transfer",
+            "error",
+            "compute imbalance",
+        ]);
         for d in TREE_DECOMPS {
             for r in tr.rows.iter().filter(|r| r.decomp == d && r.ranks > 1) {
                 let measured = r.measured_s.is_some();
                 if !measured && r.ranks > 8 && r.ranks != 128 {
                     continue;
                 }
-                let _ = writeln!(
-                    md,
-                    "| {} | {}{} | {} | {} | {} [{}, {}] | {} | {} | {} | {} |",
-                    d.name(),
-                    r.ranks,
-                    if r.oversubscribed { "*" } else { "" },
-                    Bytes(r.predicted_bytes),
+                table.row([
+                    d.name().to_string(),
+                    format!("{}{}", r.ranks, tables::over(r.oversubscribed)),
+                    Bytes(r.predicted_bytes).to_string(),
                     r.measured_bytes
                         .map_or("–".into(), |b| Bytes(b).to_string()),
-                    Duration(r.predicted_s),
-                    Duration(r.predicted_ci95[0]),
-                    Duration(r.predicted_ci95[1]),
+                    WithCi::new(r.predicted_s, r.predicted_ci95, Duration).to_string(),
                     r.measured_s.map_or("–".into(), |s| Duration(s).to_string()),
                     r.measured_transfer_s
                         .map_or("–".into(), |s| Duration(s).to_string()),
                     r.error()
                         .map_or("–".into(), |e| format!("{:+.0}%", 100.0 * e)),
                     r.compute_imbalance
-                        .map_or("–".into(), |i| format!("{i:.3}"))
-                );
+                        .map_or("–".into(), |i| format!("{i:.3}")),
+                ]);
             }
         }
+        md.push_str(&table.markdown());
         md.push('\n');
     }
     md.push_str(&region("distributed-tree", no_notes));

@@ -278,12 +278,15 @@ const ENGINE_LAYERS: &[&[&str]] = &[
 /// The harness's own top-level modules, bottom up (the engine's and the MPI crate's modules,
 /// re-exported at its root, are below them all).
 const HARNESS_LAYERS: &[&[&str]] = &[
-    &["console", "children", "fit", "calibrate", "plot"],
+    &["console", "children", "fit", "calibrate"],
     &["units"],
+    // A figure names times and sizes in the units' words.
+    &["plot"],
     &["experiment"],
-    &["analysis", "gate"],
+    &["analysis"],
     &["render"],
-    &["report"],
+    // The gate writes its Markdown through render's table builder.
+    &["gate", "report"],
 ];
 
 /// The MPI crate's modules (`crates/mpi`), bottom up, over the engine's.

@@ -2,6 +2,7 @@
 //! and error to files in the case's work directory, wall time from start to exit, and a kill
 //! of its whole process group (SIGTERM, then SIGKILL) at the timeout.
 
+use crate::units::Bytes;
 use std::path::{Path, PathBuf};
 use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
@@ -48,11 +49,11 @@ impl Finished {
         .into_iter()
         .find(|(_, o)| !o.complete())?;
         Some(format!(
-            "its {name} is {:.1} MiB, more than the {} MiB read back for the `check`, `time` and \
+            "its {name} is {:.1}, more than the {:.0} read back for the `check`, `time` and \
              `force_error` regular expressions; make it print less (e.g. a quieter log level, \
              or its log into a file of its own)",
-            o.bytes as f64 / (1u64 << 20) as f64,
-            MAX_OUTPUT_BYTES >> 20
+            Bytes(o.bytes as f64),
+            Bytes(MAX_OUTPUT_BYTES as f64)
         ))
     }
 }
