@@ -14,8 +14,8 @@
 pub mod console;
 
 pub use nbody_engine::{
-    boundary, clock, decomp, engine, export, input, integrator, kernels, output, par, physics,
-    real, run, scenario, simd, state, stats, stepper, testing, validate,
+    boundary, clock, decomp, engine, export, geometry, input, integrator, kernels, output, par,
+    physics, real, run, scenario, simd, state, stats, stepper, testing, validate,
 };
 
 pub mod analysis;

@@ -265,7 +265,7 @@ fn cycles(edges: &BTreeMap<Vec<String>, BTreeSet<Vec<String>>>) -> Vec<Vec<Strin
 /// `testing` (fixtures for tests) stands above them all and is left out of the check.
 const ENGINE_LAYERS: &[&[&str]] = &[
     &["real", "simd", "clock", "input", "stats"],
-    &["par", "physics"],
+    &["par", "physics", "geometry"],
     &["state"],
     &["kernels", "boundary", "integrator"],
     &["scenario", "decomp"],

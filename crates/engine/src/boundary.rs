@@ -1,5 +1,6 @@
 //! What happens at the edge of the simulated region.
 
+use crate::geometry::Bounds;
 use crate::par::{chunks_of, pass_chunk, worth_forking};
 use crate::real::{Real, select};
 use crate::simd;
@@ -38,11 +39,7 @@ pub enum BoundaryError {
 impl<T: Real, const D: usize> Boundary<T, D> {
     /// Applies the boundary after a drift and returns the particles' bounding box. On the
     /// pool's threads when the particles are many; the result is the same at any thread count.
-    pub fn apply(
-        &self,
-        state: &mut State<T, D>,
-        step: u64,
-    ) -> Result<([T; D], [T; D]), BoundaryError> {
+    pub fn apply(&self, state: &mut State<T, D>, step: u64) -> Result<Bounds<T, D>, BoundaryError> {
         let n = state.len();
         let c = if worth_forking(n * D) {
             pass_chunk(n)
@@ -73,7 +70,7 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                     let (lo, hi) = (lo[d], hi[d]);
                     return Err(first_offender(state, step, d, |x| !(x >= lo && x <= hi)));
                 }
-                Ok((lo, hi))
+                Ok(Bounds { lo, hi })
             }
             Boundary::Open => {
                 // No particle, nothing to check (a rank of a distributed run may own none).
@@ -89,7 +86,7 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                     )
                 };
                 let chunks = n.div_ceil(c);
-                let (lo, hi, poison) = if chunks > 1 {
+                let (Bounds { lo, hi }, poison) = if chunks > 1 {
                     (0..chunks)
                         .into_par_iter()
                         .map(part)
@@ -102,7 +99,7 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                         return Err(first_offender(state, step, d, |x| !x.is_finite()));
                     }
                 }
-                Ok((lo, hi))
+                Ok(Bounds { lo, hi })
             }
         }
     }
@@ -135,8 +132,8 @@ fn reflect<T: Real, const D: usize>(
 }
 
 /// Bounding box and a finiteness probe (`Σ x·0`: NaN when some coordinate is NaN or ±∞) of a
-/// chunk of positions; min and max skip NaN.
-type Extent<T, const D: usize> = ([T; D], [T; D], [T; D]);
+/// chunk of positions. The box skips NaN, so the probe is what catches it.
+type Extent<T, const D: usize> = (Bounds<T, D>, [T; D]);
 
 trait Join: Sized {
     fn empty() -> Self;
@@ -145,29 +142,23 @@ trait Join: Sized {
 
 impl<T: Real, const D: usize> Join for Extent<T, D> {
     fn empty() -> Self {
-        ([T::infinity(); D], [T::neg_infinity(); D], [T::zero(); D])
+        (Bounds::empty(), [T::zero(); D])
     }
 
     fn join(a: Self, b: Self) -> Self {
-        (
-            std::array::from_fn(|d| a.0[d].min(b.0[d])),
-            std::array::from_fn(|d| a.1[d].max(b.1[d])),
-            std::array::from_fn(|d| a.2[d] + b.2[d]),
-        )
+        (a.0.union(b.0), std::array::from_fn(|d| a.1[d] + b.1[d]))
     }
 }
 
 #[inline(always)]
 fn extent<T: Real, const D: usize>(pos: [&[T]; D]) -> Extent<T, D> {
-    let mut e = Extent::<T, D>::empty();
+    let mut probe = [T::zero(); D];
     for (d, x) in pos.into_iter().enumerate() {
         for &x in x {
-            e.0[d] = e.0[d].min(x);
-            e.1[d] = e.1[d].max(x);
-            e.2[d] += x * T::zero();
+            probe[d] += x * T::zero();
         }
     }
-    e
+    (Bounds::of_columns(pos), probe)
 }
 
 /// Names the first particle whose coordinate `d` fails `is_bad` (NaN is reported as non-finite).
@@ -316,7 +307,7 @@ mod tests {
     fn open_boundary_reports_bounding_box() {
         let mut s = State::<f64, 2>::new(2);
         s.pos = [vec![-3.0, 4.0], vec![1.0, -2.0]];
-        let (lo, hi) = Boundary::<f64, 2>::Open.apply(&mut s, 0).unwrap();
+        let Bounds { lo, hi } = Boundary::<f64, 2>::Open.apply(&mut s, 0).unwrap();
         assert_eq!((lo, hi), ([-3.0, -2.0], [4.0, 1.0]));
         // A rank of a distributed run may own no particle: nothing to report, no error.
         let mut none = State::<f64, 2>::new(0);

@@ -1,6 +1,7 @@
 //! The simulation loop: one kernel, one system, velocity Verlet, phase timers and counters.
 
 use crate::boundary::{Boundary, BoundaryError};
+use crate::geometry::Bounds;
 use crate::integrator::{kick, kick_drift};
 use crate::kernels::{ForceKernel, WorkCounters};
 use crate::real::Real;
@@ -109,7 +110,7 @@ pub struct Simulation<T: Real, const D: usize> {
     /// Work summed over the steps taken (probe computations excluded).
     pub work: WorkCounters,
     /// Bounding box after the last boundary phase.
-    pub bounds: ([T; D], [T; D]),
+    pub bounds: Bounds<T, D>,
     /// Energy and work of the last probe.
     last_probe: (f64, WorkCounters),
 }

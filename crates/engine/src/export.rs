@@ -10,6 +10,7 @@
 //! - `npy`: the same columns as a little-endian float64 NumPy array of shape (n, columns).
 
 use crate::boundary::Boundary;
+use crate::geometry::Bounds;
 use crate::physics::{LawParameters, PairLaw};
 use crate::real::Real;
 use crate::scenario::{System, SystemJob};
@@ -93,7 +94,7 @@ fn lammps_data<T: Real, L: PairLaw<T>, const D: usize>(
             hi.map(|x| x.as_f64() / sigma),
         ),
         Boundary::Open => {
-            let (lo, hi) = st.bounding_box();
+            let Bounds { lo, hi } = st.bounding_box();
             (
                 lo.map(|x| x.as_f64() / sigma - rc / sigma),
                 hi.map(|x| x.as_f64() / sigma + rc / sigma),

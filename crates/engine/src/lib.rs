@@ -15,6 +15,7 @@ pub mod clock;
 pub mod decomp;
 pub mod engine;
 pub mod export;
+pub mod geometry;
 pub mod input;
 pub mod integrator;
 pub mod kernels;

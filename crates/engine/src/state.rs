@@ -4,6 +4,7 @@
 //! streams and vectorize. Particles carry a stable `id`; kernels may ask the engine to reorder the
 //! arrays (cell or Morton order) for locality, and output is always written in `id` order.
 
+use crate::geometry::Bounds;
 use crate::real::Real;
 
 /// One value per particle for each of the `D` components (x, y[, z]).
@@ -118,17 +119,11 @@ impl<T: Real, const D: usize> State<T, D> {
         }
     }
 
-    /// Axis-aligned bounding box of all positions, as (min, max).
-    pub fn bounding_box(&self) -> ([T; D], [T; D]) {
-        let mut lo = [T::infinity(); D];
-        let mut hi = [T::neg_infinity(); D];
-        for d in 0..D {
-            for &x in &self.pos[d] {
-                lo[d] = lo[d].min(x);
-                hi[d] = hi[d].max(x);
-            }
-        }
-        (lo, hi)
+    /// Axis-aligned bounding box of all positions (NaN skipped, empty without particles: see
+    /// [`crate::geometry`]).
+    #[inline(always)]
+    pub fn bounding_box(&self) -> Bounds<T, D> {
+        Bounds::of_columns(self.pos.each_ref().map(Vec::as_slice))
     }
 
     /// Total kinetic energy, accumulated in f64.

@@ -7,8 +7,8 @@
 use nbody_engine::input;
 #[cfg(feature = "mpi")]
 use nbody_engine::{
-    boundary, decomp, engine, integrator, kernels, output, physics, real, run, scenario, state,
-    stats, validate,
+    boundary, decomp, engine, geometry, integrator, kernels, output, physics, real, run, scenario,
+    state, stats, validate,
 };
 
 #[cfg(feature = "mpi")]

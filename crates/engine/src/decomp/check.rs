@@ -2,6 +2,7 @@
 //! and kernel: the same particles (none lost, none duplicated) at the same positions and
 //! velocities to rounding.
 
+use crate::geometry::Bounds;
 use crate::real::Real;
 use crate::state::State;
 use serde::Serialize;
@@ -103,7 +104,7 @@ pub fn compare<T: Real, const D: usize>(
         }
     }
     let ids_complete = distributed.len() == n && seen.iter().all(|&s| s == 1);
-    let (lo, hi) = serial.bounding_box();
+    let Bounds { lo, hi } = serial.bounding_box();
     let extent = (0..D)
         .map(|d| (hi[d] - lo[d]).as_f64().abs())
         .fold(f64::MIN_POSITIVE, f64::max);

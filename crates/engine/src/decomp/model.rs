@@ -14,7 +14,8 @@
 use super::Domains;
 use super::essential::{self, body_entry_values, node_entry_values};
 use super::regions::grid_dims;
-use super::top_nodes::{self, TopNodes, TopWalk};
+use super::top_nodes::{TopNodes, TopWalk};
+use crate::geometry::Bounds;
 use crate::kernels::{Multipole, Octree};
 use crate::real::Real;
 use crate::state::State;
@@ -92,7 +93,7 @@ pub fn domain_messages_per_rank(dims: &[usize]) -> f64 {
 
 /// The octant scheme of the gravity source (`--decomp octants`) on a given cloud, counted by
 /// running its selection without MPI: every rank builds the octree of the bodies it owns under
-/// `domains`, shares its top nodes (`top_levels` levels, [`top_nodes::node_values`] values each,
+/// `domains`, shares its top nodes (`top_levels` levels, [`super::top_nodes::node_values`] values each,
 /// with every other rank), and sends each group of its bodies whose walk of another rank's top
 /// nodes must open a node to that rank (a count, then position and strength per body), which
 /// answers with D force values per body. Returns the bytes each rank sends in one step, as the
@@ -136,7 +137,7 @@ pub fn octants_bytes_of_cloud<T: Real, const D: usize>(
         }
         for group in view.groups() {
             let points: Vec<[T; D]> = group.clone().map(|k| view.position(k)).collect();
-            let (lo, hi) = top_nodes::bounding_box(&points);
+            let Bounds { lo, hi } = Bounds::of_points(points.iter().copied());
             for (r, top) in tops.iter().enumerate() {
                 if r != me && !top.is_empty() && top.walk(&lo, &hi) == TopWalk::Open {
                     let bodies = points.len() as f64;

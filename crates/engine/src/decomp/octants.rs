@@ -16,7 +16,8 @@
 //! boxes, so the two never disagree at a face.
 
 use super::{Aabb, DomainError, Domains};
-use crate::kernels::interleave;
+use crate::geometry::Bounds;
+use crate::geometry::{deinterleave, interleave};
 use crate::real::Real;
 use std::ops::Range;
 
@@ -40,19 +41,16 @@ pub struct Octants<const D: usize> {
 /// The bounding cube of the bodies as the octree computes it: the lower corner of their
 /// bounding box and its longest side (1 when the bodies coincide or there are none).
 pub fn root_cube<T: Real, const D: usize>(pos: &[Vec<T>; D]) -> ([f64; D], f64) {
-    let (lo, hi) = super::orb::bounding_box(pos);
-    let side = (0..D).map(|d| hi[d] - lo[d]).fold(0.0, f64::max);
+    let (lo, side) = Bounds::of_columns(pos.each_ref().map(Vec::as_slice))
+        .to_f64()
+        .cube();
+    // Unlike the octree, which lets a non-finite cube put every key at 0, the cells need
+    // finite faces: no bodies (an empty box), or a corner or side at infinity, give the unit
+    // cube at the origin.
     if !lo.iter().all(|x| x.is_finite()) {
         return ([0.0; D], 1.0);
     }
-    (
-        lo,
-        if side > 0.0 && side.is_finite() {
-            side
-        } else {
-            1.0
-        },
-    )
+    (lo, if side.is_finite() { side } else { 1.0 })
 }
 
 impl<const D: usize> Octants<D> {
@@ -178,13 +176,7 @@ impl<const D: usize> Octants<D> {
 
     /// The cell coordinates of a Morton index (the inverse of `interleave`).
     fn cell_of(&self, key: u64) -> [u64; D] {
-        let mut cell = [0u64; D];
-        for b in 0..self.level {
-            for (d, c) in cell.iter_mut().enumerate() {
-                *c |= ((key >> (D as u32 * b + d as u32)) & 1) << b;
-            }
-        }
-        cell
+        deinterleave::<D>(key, self.level)
     }
 }
 

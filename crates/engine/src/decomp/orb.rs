@@ -15,6 +15,7 @@
 //! every rank still gets a region, possibly empty of bodies.
 
 use super::{Aabb, DomainError, Domains};
+use crate::geometry::Bounds;
 use crate::real::Real;
 
 /// Where a cut sends each side: another cut or a rank.
@@ -41,16 +42,11 @@ pub struct Orb<const D: usize> {
     root: Child,
 }
 
-/// The bounding box of the bodies, `[0, 1]^D` when there are none.
-pub fn bounding_box<T: Real, const D: usize>(pos: &[Vec<T>; D]) -> Aabb<D> {
-    let mut lo = [f64::INFINITY; D];
-    let mut hi = [f64::NEG_INFINITY; D];
-    for d in 0..D {
-        for &x in &pos[d] {
-            lo[d] = lo[d].min(x.as_f64());
-            hi[d] = hi[d].max(x.as_f64());
-        }
-    }
+/// The box the bisection starts from: the bounding box of the bodies, or `[0, 1]^D` when they
+/// leave an axis empty (no bodies, or only NaN there) or all sit at +∞ on one, so that a rank
+/// without bodies still gets a finite region to cut.
+pub fn root_box<T: Real, const D: usize>(pos: &[Vec<T>; D]) -> Aabb<D> {
+    let Bounds { lo, hi } = Bounds::of_columns(pos.each_ref().map(Vec::as_slice)).to_f64();
     if lo.contains(&f64::INFINITY) {
         return ([0.0; D], [1.0; D]);
     }
@@ -64,7 +60,7 @@ impl<const D: usize> Orb<D> {
         pos: &[Vec<T>; D],
         weights: &[f64],
     ) -> Result<Self, DomainError> {
-        let (lo, hi) = bounding_box(pos);
+        let (lo, hi) = root_box(pos);
         Self::new(lo, hi, ranks, pos, weights)
     }
 

@@ -13,6 +13,7 @@
 //! The nodes are flattened breadth first: node k's children are the `children` entries from
 //! `first`, so a walk needs no pointers and the list travels as plain values.
 
+use crate::geometry::Bounds;
 use crate::kernels::{TreeView, far_from_box};
 use crate::physics::{PairLaw, pair_force};
 use crate::real::Real;
@@ -49,19 +50,6 @@ pub enum TopWalk {
     Accepted(Vec<u32>),
     /// A node had to be opened below the shared levels: the owner must compute the group.
     Open,
-}
-
-/// The bounding box of points.
-pub fn bounding_box<T: Real, const D: usize>(points: &[[T; D]]) -> ([T; D], [T; D]) {
-    let mut lo = [T::of(f64::INFINITY); D];
-    let mut hi = [T::of(f64::NEG_INFINITY); D];
-    for p in points {
-        for d in 0..D {
-            lo[d] = if p[d] < lo[d] { p[d] } else { lo[d] };
-            hi[d] = if p[d] > hi[d] { p[d] } else { hi[d] };
-        }
-    }
-    (lo, hi)
 }
 
 impl<T: Real, const D: usize> TopNodes<T, D> {
@@ -196,8 +184,7 @@ pub fn group_forces<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,
     group: &[([T; D], T)],
 ) -> (Vec<[T; D]>, u64) {
-    let points: Vec<[T; D]> = group.iter().map(|g| g.0).collect();
-    let (lo, hi) = bounding_box(&points);
+    let Bounds { lo, hi } = Bounds::of_points(group.iter().map(|g| g.0));
     let mut sources: Vec<([T; D], T)> = Vec::new();
     let mut stack: Vec<u32> = tree.roots().to_vec();
     while let Some(node) = stack.pop() {

@@ -57,18 +57,58 @@ pub fn pack_particle<T: Real, const D: usize>(state: &State<T, D>, i: usize, out
     out.push(state.id[i] as f64);
 }
 
+/// The id of a record written by [`pack_particle`].
+pub fn packed_id<const D: usize>(record: &[f64]) -> f64 {
+    record[2 * D + 2]
+}
+
+/// Appends the particle of a record written by [`pack_particle`] (its first
+/// `particle_values(D)` values; a record may carry more after them) to `state`.
+pub fn push_particle<T: Real, const D: usize>(record: &[f64], state: &mut State<T, D>) {
+    for d in 0..D {
+        state.pos[d].push(T::of(record[d]));
+        state.vel[d].push(T::of(record[D + d]));
+    }
+    state.mass.push(T::of(record[2 * D]));
+    state.source.push(T::of(record[2 * D + 1]));
+    state.id.push(packed_id::<D>(record) as u32);
+}
+
 /// Appends the particles packed by [`pack_particle`] to `state`.
 pub fn unpack_particles<T: Real, const D: usize>(bytes: &[u8], state: &mut State<T, D>) {
     let values: Vec<f64> = floats_of(bytes);
-    for p in values.chunks_exact(particle_values(D)) {
-        for d in 0..D {
-            state.pos[d].push(T::of(p[d]));
-            state.vel[d].push(T::of(p[D + d]));
-        }
-        state.mass.push(T::of(p[2 * D]));
-        state.source.push(T::of(p[2 * D + 1]));
-        state.id.push(p[2 * D + 2] as u32);
+    for record in values.chunks_exact(particle_values(D)) {
+        push_particle(record, state);
     }
+}
+
+/// Appends a source particle to `state`: at rest with unit mass, as the force kernels see
+/// ghosts and imported nodes (only position and source enter the forces).
+pub fn push_source<T: Real, const D: usize>(
+    state: &mut State<T, D>,
+    x: [T; D],
+    source: T,
+    id: u32,
+) {
+    for d in 0..D {
+        state.pos[d].push(x[d]);
+        state.vel[d].push(T::zero());
+    }
+    state.mass.push(T::one());
+    state.source.push(source);
+    state.id.push(id);
+}
+
+/// Appends the point sources of a message (D coordinates and the source each, in `T`) to
+/// `state` with [`push_source`] and no id (`u32::MAX`); returns how many.
+pub fn unpack_sources<T: Real, const D: usize>(bytes: &[u8], state: &mut State<T, D>) -> usize {
+    let values: Vec<T> = floats_of(bytes);
+    let records = values.chunks_exact(D + 1);
+    let count = records.len();
+    for g in records {
+        push_source(state, std::array::from_fn(|d| g[d]), g[D], u32::MAX);
+    }
+    count
 }
 
 #[cfg(test)]
@@ -100,5 +140,19 @@ mod tests {
         }
         let v = [1.5f64, -2.0];
         assert_eq!(floats_of::<f64>(bytes_of(&v)), v.to_vec());
+    }
+
+    #[test]
+    fn sources_arrive_at_rest_with_unit_mass_and_no_id() {
+        let sent = [1.0f32, 2.0, -0.5, 3.0, 4.0, 0.25];
+        let mut t = State::<f32, 2>::new(1);
+        assert_eq!(unpack_sources(bytes_of(&sent), &mut t), 2);
+        assert_eq!(t.len(), 3);
+        assert_eq!(t.position(1), [1.0, 2.0]);
+        assert_eq!(t.position(2), [3.0, 4.0]);
+        assert_eq!(t.source[1..], [-0.5, 0.25]);
+        assert_eq!(t.mass[1..], [1.0, 1.0]);
+        assert_eq!(t.vel[0][1..], [0.0, 0.0]);
+        assert_eq!(t.id[1..], [u32::MAX, u32::MAX]);
     }
 }

@@ -25,7 +25,6 @@ pub use cell_list::CellList;
 pub use cluster_pair::ClusterPair;
 pub use fmm::{Fmm, MAX_ORDER as MAX_FMM_ORDER};
 pub use naive::Naive;
-pub(crate) use octree::interleave;
 pub use octree::{Multipole, Octree, TreeView, far_from_box};
 pub use per_thread::PerThread;
 pub use share::Share;

@@ -3,6 +3,7 @@
 
 use crate::clock::Clock;
 use crate::engine::Simulation;
+use crate::geometry::Bounds;
 use crate::kernels::{KernelKind, KernelParams, footprint};
 use crate::output::nbview::{self, NbviewFormat};
 use crate::output::{AtomicFile, WriteError, dump};
@@ -208,7 +209,7 @@ impl Trajectory {
     ) -> Result<Self, WriteError> {
         let mut file = AtomicFile::create(&spec.path)?;
         // The viewer shows [0, scale]²: the box side, or the initial extent of an open system.
-        let (lo, hi) = sim.state.bounding_box();
+        let Bounds { lo, hi } = sim.state.bounding_box();
         let extent = (0..D.min(2))
             .map(|d| hi[d].as_f64().abs().max(lo[d].as_f64().abs()))
             .fold(0.0, f64::max);

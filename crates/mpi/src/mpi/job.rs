@@ -11,7 +11,7 @@ use super::tree::{EssentialTree, OctantTree};
 use crate::decomp::Decomposition;
 use crate::decomp::check::{CheckReport, TreeCheck, compare, relative_drift};
 use crate::decomp::stats::{MasterSummary, MpiReport, RankStats, attribute_waits, reduce};
-use crate::decomp::wire::{bytes_of, floats_of, particle_values};
+use crate::decomp::wire::{bytes_of, floats_of, packed_id, particle_values, push_particle};
 use crate::engine::{PhaseTimes, Simulation};
 use crate::kernels::{KernelKind, KernelParams, WorkCounters};
 use crate::output::dump;
@@ -192,19 +192,14 @@ fn gather_state<T: Real, const D: usize>(
         records.extend(floats_of::<f64>(p));
     }
     let mut rows: Vec<&[f64]> = records.chunks_exact(width).collect();
-    rows.sort_by(|a, b| a[2 * D + 2].total_cmp(&b[2 * D + 2]));
-    let n = rows.len();
-    let mut out = State::<T, D>::new(n);
-    let mut f = zero_field::<T, D>(n);
-    for (i, r) in rows.iter().enumerate() {
+    rows.sort_by(|a, b| packed_id::<D>(a).total_cmp(&packed_id::<D>(b)));
+    let mut out = State::<T, D>::new(0);
+    let mut f = zero_field::<T, D>(0);
+    for r in rows {
+        push_particle(r, &mut out);
         for d in 0..D {
-            out.pos[d][i] = T::of(r[d]);
-            out.vel[d][i] = T::of(r[D + d]);
-            f[d][i] = T::of(r[particle_values(D) + d]);
+            f[d].push(T::of(r[particle_values(D) + d]));
         }
-        out.mass[i] = T::of(r[2 * D]);
-        out.source[i] = T::of(r[2 * D + 1]);
-        out.id[i] = r[2 * D + 2] as u32;
     }
     Ok(Some((out, f)))
 }

@@ -244,7 +244,7 @@ fn entries_and_bytes_count_the_payload() {
 fn faces_on_the_root_walls_open_to_infinity_and_the_export_still_holds_beyond_them() {
     let cloud = plummer_state::<f64, 3>(3000, SEED_1);
     let orb = Orb::over(2, &cloud.pos, &vec![1.0; 3000]).expect("orb");
-    let root = crate::decomp::orb::bounding_box(&cloud.pos);
+    let root = crate::decomp::orb::root_box(&cloud.pos);
     let open = open_at_walls(&orb.boxes(1), &root);
     assert_eq!(open.len(), 1);
     let (lo, hi) = open[0];

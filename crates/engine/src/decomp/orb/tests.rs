@@ -33,7 +33,7 @@ fn check_balance<const D: usize>(s: &State<f64, D>, weights: &[f64], p: usize, w
 /// The regions lie in the root box, their volumes add up to it, and each probe point (the
 /// bodies and the regions' corners) lies in exactly the region of its owner.
 fn check_tiling<const D: usize>(orb: &Orb<D>, pos: &[Vec<f64>; D], what: &str) {
-    let (lo, hi) = bounding_box(pos);
+    let (lo, hi) = root_box(pos);
     let volume = |b: &Aabb<D>| (0..D).map(|a| b.1[a] - b.0[a]).product::<f64>();
     let sum: f64 = (0..orb.ranks()).map(|r| volume(&orb.region(r))).sum();
     let root = volume(&(lo, hi));
@@ -82,7 +82,7 @@ fn splits_balance_the_weights_on_uniform_and_concentrated_clouds() {
 fn one_rank_owns_the_root_box() {
     let s = plummer_state::<f64, 3>(500, SEED_1);
     let orb = Orb::over(1, &s.pos, &vec![1.0; 500]).expect("orb");
-    assert_eq!(orb.region(0), bounding_box(&s.pos));
+    assert_eq!(orb.region(0), root_box(&s.pos));
     assert_eq!(orb.counts(&s.pos), vec![500]);
     assert_eq!(orb.owner([1e9; 3]), 0);
 }

@@ -4,7 +4,6 @@
 //! their coordinates on the other axes. Each row carries one extra empty *phantom* bin at its end,
 //! so that "the end of bin `b`" is always `start[b + 1]`, even for the last bin of a row.
 use crate::real::Real;
-use crate::state::State;
 
 /// Relative margin of the bin side over the cutoff. The bin of a particle is computed in f64 and
 /// the pair distance in `T`; the margin keeps a pair that `T` rounding places just inside the
@@ -139,35 +138,4 @@ pub fn sentinel<T: Real, const D: usize>(lo: [T; D], hi: [T; D], rc: f64) -> Opt
     let far = T::of(l - (2.0 * (l.abs() + h.abs()) + 4.0 * rc));
     let finite = far.is_finite() && lo.iter().all(|x| x.is_finite());
     finite.then(|| std::array::from_fn(|d| if d == 0 { far } else { lo[d] }))
-}
-
-/// Lanes of the bounding-box scan (independent minima, so the loop vectorizes).
-const BOX_LANES: usize = 16;
-
-/// Bounding box of the positions, ignoring NaN. Unlike `State::bounding_box` (`f32::min`
-/// propagates the NaN rules, which keeps it scalar) this compiles to vector compares.
-#[inline(always)]
-pub fn bounding_box<T: Real, const D: usize>(state: &State<T, D>) -> ([T; D], [T; D]) {
-    let mut lo = [T::infinity(); D];
-    let mut hi = [T::neg_infinity(); D];
-    for d in 0..D {
-        let mut l = [T::infinity(); BOX_LANES];
-        let mut h = [T::neg_infinity(); BOX_LANES];
-        let chunks = state.pos[d].chunks_exact(BOX_LANES);
-        for &x in chunks.remainder() {
-            l[0] = if x < l[0] { x } else { l[0] };
-            h[0] = if x > h[0] { x } else { h[0] };
-        }
-        for c in chunks {
-            for k in 0..BOX_LANES {
-                l[k] = if c[k] < l[k] { c[k] } else { l[k] };
-                h[k] = if c[k] > h[k] { c[k] } else { h[k] };
-            }
-        }
-        for k in 0..BOX_LANES {
-            lo[d] = if l[k] < lo[d] { l[k] } else { lo[d] };
-            hi[d] = if h[k] > hi[d] { h[k] } else { hi[d] };
-        }
-    }
-    (lo, hi)
 }

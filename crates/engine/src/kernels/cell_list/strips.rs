@@ -12,7 +12,8 @@
 //! to a whole number of SIMD blocks: what it gains are columns `x+2…` of its strip (at least one
 //! bin width, so at least the cutoff, away along axis 0) or sentinels, which contribute zero.
 
-use super::grid::{Grid, bounding_box, sentinel};
+use super::grid::{Grid, sentinel};
+use crate::geometry::Bounds;
 use crate::kernels::counting_sort::{CountingSort, order_of};
 use crate::kernels::rows::LANES;
 use crate::par::{Disjoint, chunk_len, for_chunks, worth_forking};
@@ -81,9 +82,9 @@ impl<T: Real, const D: usize> Strips<T, D> {
             n <= MAX_PARTICLES,
             "the cell list handles at most {MAX_PARTICLES} particles (got {n})"
         );
-        let (lo, hi) = simd::dispatch(
+        let Bounds { lo, hi } = simd::dispatch(
             #[inline(always)]
-            || bounding_box(state),
+            || state.bounding_box(),
         );
         self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), rc, n);
         self.far = sentinel(lo, hi, rc);

@@ -8,7 +8,7 @@
 //! Memory, kept between builds: per padded slot its particle and a copy of its position and
 //! strength; per particle its padded slot and the sort's scratch; per cluster its bounding box.
 
-use crate::kernels::cell_list::grid::bounding_box;
+use crate::geometry::Bounds;
 use crate::kernels::counting_sort::{CountingSort, order_of};
 use crate::par::{Disjoint, gather, pass_chunk, worth_forking};
 use crate::real::Real;
@@ -107,9 +107,9 @@ impl<T: Real, const D: usize> Layout<T, D> {
     /// search spans a few columns at most), and fills the padded copy.
     pub fn build(&mut self, state: &State<T, D>, radius: f64) {
         let n = state.len();
-        let (lo, hi) = simd::dispatch(
+        let Bounds { lo, hi } = simd::dispatch(
             #[inline(always)]
-            || bounding_box(state),
+            || state.bounding_box(),
         );
         self.grid(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
         self.sort(state);

@@ -20,6 +20,7 @@
 
 use super::expansion::{Expansion, MAX_ORDER, terms};
 use super::point;
+use crate::geometry::Bounds;
 use crate::kernels::octree::Tree;
 use crate::real::Real;
 use rayon::prelude::*;
@@ -37,8 +38,7 @@ pub(super) struct Cells {
     /// Σ|s| and Σ|s| x of every node, and the box of its particles.
     weight: Vec<f64>,
     weighted: Vec<[f64; 3]>,
-    lo: Vec<[f64; 3]>,
-    hi: Vec<[f64; 3]>,
+    bounds: Vec<Bounds<f64, 3>>,
     /// The leaves' sums and multipoles in `leaves` order, as the parallel pass writes them.
     leaf_sums: Vec<LeafSums>,
     leaf_multipoles: Vec<f64>,
@@ -49,8 +49,7 @@ pub(super) struct Cells {
 struct LeafSums {
     weight: f64,
     weighted: [f64; 3],
-    lo: [f64; 3],
-    hi: [f64; 3],
+    bounds: Bounds<f64, 3>,
     centre: [f64; 3],
     radius: f64,
 }
@@ -68,8 +67,7 @@ impl Cells {
             leaves: Vec::new(),
             weight: Vec::new(),
             weighted: Vec::new(),
-            lo: Vec::new(),
-            hi: Vec::new(),
+            bounds: Vec::new(),
             leaf_sums: Vec::new(),
             leaf_multipoles: Vec::new(),
         }
@@ -117,8 +115,7 @@ impl Cells {
         self.radius.resize(count, 0.0);
         self.weight.resize(count, 0.0);
         self.weighted.resize(count, [0.0; 3]);
-        self.lo.resize(count, [0.0; 3]);
-        self.hi.resize(count, [0.0; 3]);
+        self.bounds.resize(count, Bounds::empty());
         self.multipole.clear();
         self.multipole.resize(count * len, 0.0);
         for (k, (&i, sums)) in self.leaves.iter().zip(&self.leaf_sums).enumerate() {
@@ -127,8 +124,7 @@ impl Cells {
             self.radius[i] = sums.radius;
             self.weight[i] = sums.weight;
             self.weighted[i] = sums.weighted;
-            self.lo[i] = sums.lo;
-            self.hi[i] = sums.hi;
+            self.bounds[i] = sums.bounds;
             self.multipole[i * len..(i + 1) * len]
                 .copy_from_slice(&self.leaf_multipoles[k * len..(k + 1) * len]);
         }
@@ -143,16 +139,16 @@ impl Cells {
             }
             let kids = node.first as usize..(node.first + node.children) as usize;
             let (mut w, mut wx) = (0.0, [0.0; 3]);
-            let (mut l, mut h) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+            let mut bounds = Bounds::empty();
             for c in kids.clone() {
                 w += self.weight[c];
                 for d in 0..3 {
                     wx[d] += self.weighted[c][d];
-                    l[d] = l[d].min(self.lo[c][d]);
-                    h[d] = h[d].max(self.hi[c][d]);
                 }
+                bounds = bounds.union(self.bounds[c]);
             }
-            let z = centre_of(w, wx, l, h);
+            let z = centre_of(w, wx, &bounds);
+            let Bounds { lo: l, hi: h } = bounds;
             let mut through_children: f64 = 0.0;
             let (parent, below) = self.multipole.split_at_mut(kids.start * len);
             let m = &mut parent[i * len..(i + 1) * len];
@@ -172,8 +168,7 @@ impl Cells {
             self.radius[i] = through_children.min(corner);
             self.weight[i] = w;
             self.weighted[i] = wx;
-            self.lo[i] = l;
-            self.hi[i] = h;
+            self.bounds[i] = bounds;
         }
         self.local.clear();
         self.local.resize(count * len, 0.0);
@@ -211,21 +206,16 @@ fn leaf_sums<T: Real, const D: usize>(
 ) -> LeafSums {
     let node = &tree.nodes[i];
     let (start, end) = (node.start as usize, node.end as usize);
-    let mut sums = LeafSums {
-        lo: [f64::INFINITY; 3],
-        hi: [f64::NEG_INFINITY; 3],
-        ..Default::default()
-    };
+    let mut sums = LeafSums::default();
     for k in start..end {
         let (x, s) = (point(&tree.pos, k), tree.src[k].as_f64().abs());
         sums.weight += s;
         for d in 0..3 {
             sums.weighted[d] += s * x[d];
-            sums.lo[d] = sums.lo[d].min(x[d]);
-            sums.hi[d] = sums.hi[d].max(x[d]);
         }
+        sums.bounds.extend(x);
     }
-    let z = centre_of(sums.weight, sums.weighted, sums.lo, sums.hi);
+    let z = centre_of(sums.weight, sums.weighted, &sums.bounds);
     let mut mono = [0.0; terms(MAX_ORDER)];
     let mut r2: f64 = 0.0;
     for k in start..end {
@@ -268,10 +258,10 @@ pub(super) fn evaluate<T: Real, const D: usize>(
 }
 
 /// The |s|-weighted centre, or the centre of the box when every strength is zero.
-fn centre_of(w: f64, wx: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> [f64; 3] {
+fn centre_of(w: f64, wx: [f64; 3], bounds: &Bounds<f64, 3>) -> [f64; 3] {
     if w > 0.0 {
         wx.map(|x| x / w)
     } else {
-        std::array::from_fn(|d| 0.5 * (lo[d] + hi[d]))
+        bounds.center()
     }
 }

@@ -48,8 +48,6 @@ use std::time::Instant;
 use tree::Group;
 /// The tree build, shared with the fast multipole kernel.
 pub(in crate::kernels) use tree::Tree;
-/// Morton keys, for domains that follow the tree's order (`decomp::octants`).
-pub(crate) use tree::interleave;
 pub use view::TreeView;
 use walk::{Scratch, Totals, eval_groups, for_group_runs};
 

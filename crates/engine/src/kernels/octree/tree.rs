@@ -15,20 +15,17 @@
 
 use super::moments::Quadrupoles;
 pub(in crate::kernels) use super::node::Node;
+use crate::geometry::{interleave, morton_bits};
 use crate::real::Real;
 use crate::state::State;
 
 /// Top key bit: set for negative sources, so they sort after the non-negative ones.
 const NEGATIVE: u64 = 1 << 63;
 
-/// Levels of the tree below the root (= Morton bits per dimension): 21 in 3-D, 31 in 2-D.
+/// Levels of the tree below the root: the Morton bits per dimension, 21 in 3-D, 31 in 2-D.
 /// A cell at this depth is a leaf whatever its count (many coincident particles).
 pub(super) const fn max_depth(d: usize) -> u32 {
-    match 63usize.checked_div(d) {
-        Some(bits) if bits < 31 => bits as u32,
-        Some(_) => 31,
-        None => 0,
-    }
+    morton_bits(d)
 }
 
 /// A target group: a run of sibling subtrees whose particles share one interaction list.
@@ -126,15 +123,10 @@ impl<T: Real, const D: usize> Tree<T, D> {
             "the octree indexes particles with u32"
         );
         // The bounding cube, recomputed every step: the system is open and may expand.
-        let (lo, hi) = state.bounding_box();
-        let mut side = 0.0f64;
-        for d in 0..D {
-            self.lo[d] = lo[d].as_f64();
-            side = side.max(hi[d].as_f64() - self.lo[d]);
-        }
-        // All particles coincident (or n ≤ 1): any positive side will do. A non-finite side
-        // (NaN or infinite positions) gives keys of 0 and one big leaf, never a panic.
-        self.side = if side > 0.0 { side } else { 1.0 };
+        // All particles coincident (or n ≤ 1) give a side of 1. A non-finite side (infinite
+        // positions) gives keys of 0 and one big leaf, never a panic. The cube is in f64, as
+        // the keys are computed.
+        (self.lo, self.side) = state.bounding_box().to_f64().cube();
         for d in 0..D {
             // Far enough outside the cube that it never coincides with a particle, even when
             // the offset is small next to the coordinate.
@@ -335,45 +327,4 @@ fn common_level<const D: usize>(a: u64, b: u64) -> u32 {
     } else {
         (diff.leading_zeros() - (64 - bits)) / D as u32
     }
-}
-
-/// Interleaves the cell coordinates into a Morton key: bit `b` of dimension `d` goes to bit
-/// `D·b + d`, so that the top `D` bits are the root's child index.
-#[inline(always)]
-pub(crate) fn interleave<const D: usize>(cell: [u64; D]) -> u64 {
-    match D {
-        2 => spread2(cell[0]) | spread2(cell[1]) << 1,
-        3 => spread3(cell[0]) | spread3(cell[1]) << 1 | spread3(cell[2]) << 2,
-        _ => {
-            let mut key = 0;
-            for b in 0..max_depth(D) {
-                for (d, &c) in cell.iter().enumerate() {
-                    key |= ((c >> b) & 1) << (D as u32 * b + d as u32);
-                }
-            }
-            key
-        }
-    }
-}
-
-/// Spreads the low 31 bits of `x` to the even bits.
-#[inline(always)]
-fn spread2(x: u64) -> u64 {
-    let mut x = x & 0x7fff_ffff;
-    x = (x | x << 16) & 0x0000_ffff_0000_ffff;
-    x = (x | x << 8) & 0x00ff_00ff_00ff_00ff;
-    x = (x | x << 4) & 0x0f0f_0f0f_0f0f_0f0f;
-    x = (x | x << 2) & 0x3333_3333_3333_3333;
-    (x | x << 1) & 0x5555_5555_5555_5555
-}
-
-/// Spreads the low 21 bits of `x` to every third bit.
-#[inline(always)]
-fn spread3(x: u64) -> u64 {
-    let mut x = x & 0x1f_ffff;
-    x = (x | x << 32) & 0x001f_0000_0000_ffff;
-    x = (x | x << 16) & 0x001f_0000_ff00_00ff;
-    x = (x | x << 8) & 0x100f_00f0_0f00_f00f;
-    x = (x | x << 4) & 0x10c3_0c30_c30c_30c3;
-    (x | x << 2) & 0x1249_2492_4924_9249
 }

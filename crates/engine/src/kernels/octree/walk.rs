@@ -16,6 +16,7 @@
 
 use super::nodes::NodeList;
 use super::tree::{Group, Tree};
+use crate::geometry::Bounds;
 use crate::kernels::WorkCounters;
 use crate::kernels::broadcast::{Tile, tile_forces};
 use crate::kernels::rows::{LANES, Sources, Target, gather};
@@ -234,14 +235,7 @@ fn eval_order<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool, const Q
     for g in groups {
         let (start, end) = (g.start as usize, g.end as usize);
         // The group's bounding box (tighter than its cells).
-        let mut lo = [T::infinity(); D];
-        let mut hi = [T::neg_infinity(); D];
-        for d in 0..D {
-            for &x in &tree.pos[d][start..end] {
-                lo[d] = lo[d].min(x);
-                hi[d] = hi[d].max(x);
-            }
-        }
+        let Bounds { lo, hi } = Bounds::of_columns(tree.pos.each_ref().map(|x| &x[start..end]));
         let group = GroupBox {
             start: g.start,
             end: g.end,

@@ -5,7 +5,8 @@
 //! row-major with a phantom bin ending each row, so the bins `x−1 ..= x+1` of one row are a
 //! single run of sorted indices: the stencil of a bin is `3^(D−1)` runs.
 
-use crate::kernels::cell_list::grid::{Grid, bounding_box};
+use crate::geometry::Bounds;
+use crate::kernels::cell_list::grid::Grid;
 use crate::kernels::cell_list::strips::bin_all;
 use crate::kernels::counting_sort::{CountingSort, order_of};
 use crate::par::gather;
@@ -45,9 +46,9 @@ impl<T: Real, const D: usize> Bins<T, D> {
     /// rebuilds of a run allocate nothing after the first.
     pub fn sort(&mut self, state: &State<T, D>, radius: f64) {
         let n = state.len();
-        let (lo, hi) = simd::dispatch(
+        let Bounds { lo, hi } = simd::dispatch(
             #[inline(always)]
-            || bounding_box(state),
+            || state.bounding_box(),
         );
         self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
         self.bin.resize(n, 0);

@@ -10,12 +10,12 @@
 
 use super::Domain;
 use crate::decomp::regions::point_box_distance2;
-use crate::decomp::wire::{bytes_of, floats_of};
+use crate::decomp::wire::{bytes_of, push_source, unpack_sources};
 use crate::mpi::comm::Comm;
 use crate::mpi::driver::TAG_GHOSTS;
 use crate::mpi::error::MpiError;
 use crate::real::Real;
-use crate::state::{State, zero_field};
+use crate::state::zero_field;
 use std::time::Instant;
 
 impl<T: Real, const D: usize> Domain<T, D> {
@@ -113,27 +113,12 @@ impl<T: Real, const D: usize> Domain<T, D> {
         s.id.clear();
         let owned = &self.owned;
         for &i in self.border_slots.iter().chain(&self.shell_slots) {
-            push(s, owned.position(i), owned.source[i], owned.id[i]);
+            push_source(s, owned.position(i), owned.source[i], owned.id[i]);
         }
         let mut ghosts = 0;
         for bytes in arrived {
-            let values: Vec<T> = floats_of(bytes);
-            for g in values.chunks_exact(D + 1) {
-                push(s, std::array::from_fn(|d| g[d]), g[D], u32::MAX);
-                ghosts += 1;
-            }
+            ghosts += unpack_sources(bytes, s);
         }
         ghosts
     }
-}
-
-/// Appends a particle at rest with unit mass to `s`.
-fn push<T: Real, const D: usize>(s: &mut State<T, D>, x: [T; D], source: T, id: u32) {
-    for d in 0..D {
-        s.pos[d].push(x[d]);
-        s.vel[d].push(T::zero());
-    }
-    s.mass.push(T::one());
-    s.source.push(source);
-    s.id.push(id);
 }

@@ -22,8 +22,8 @@ use super::{Local, REBALANCE_GAP, Status, imbalance, new_tree};
 use crate::decomp::Aabb;
 use crate::decomp::Domains;
 use crate::decomp::essential::{open_at_walls, select};
-use crate::decomp::orb::{Orb, bounding_box};
-use crate::decomp::wire::{bytes_of, floats_of};
+use crate::decomp::orb::{Orb, root_box};
+use crate::decomp::wire::{bytes_of, unpack_sources};
 use crate::kernels::{ForceKernel, KernelParams, Octree};
 use crate::mpi::comm::Comm;
 use crate::mpi::driver::{Driver, Tally};
@@ -59,7 +59,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> EssentialTree<T, L, D> {
         let pos = &system.state.pos;
         let ones = vec![1.0; system.state.len()];
         let orb = Orb::over(comm.size(), pos, &ones)?;
-        let root = bounding_box(pos);
+        let root = root_box(pos);
         let owners = orb.assign(pos);
         let me = comm.rank();
         let local = Local::new(&system, params, |i| owners[i] == me);
@@ -84,7 +84,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> EssentialTree<T, L, D> {
     fn rebalance(&mut self, comm: &mut Comm, all: &[Status]) -> Result<(), MpiError> {
         let (pos, weights) = self.local.gather_sample(comm, all)?;
         self.orb = Orb::over(comm.size(), &pos, &weights)?;
-        self.root = bounding_box(&pos);
+        self.root = root_box(&pos);
         self.rebalances += 1;
         Ok(())
     }
@@ -125,16 +125,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> EssentialTree<T, L, D> {
             .filter(|&(r, _)| r != me)
             .map(|(_, b)| b)
         {
-            for e in floats_of::<T>(bytes).chunks_exact(D + 1) {
-                for d in 0..D {
-                    combined.pos[d].push(e[d]);
-                    combined.vel[d].push(T::zero());
-                }
-                combined.mass.push(T::one());
-                combined.source.push(e[D]);
-                combined.id.push(u32::MAX);
-                imported += 1;
-            }
+            imported += unpack_sources(bytes, combined) as u64;
         }
         let mut report = Default::default();
         local.costs.clear();

@@ -15,8 +15,9 @@
 use super::Local;
 use crate::decomp::Domains;
 use crate::decomp::octants::{Octants, root_cube};
-use crate::decomp::top_nodes::{TopNodes, TopWalk, bounding_box, group_forces};
+use crate::decomp::top_nodes::{TopNodes, TopWalk, group_forces};
 use crate::decomp::wire::{bytes_of, floats_of};
+use crate::geometry::Bounds;
 use crate::kernels::{ForceKernel, ForceReport, KernelParams, WorkCounters};
 use crate::mpi::comm::Comm;
 use crate::mpi::driver::{Driver, Tally};
@@ -96,7 +97,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> OctantTree<T, L, D> {
             let forces = &mut local.forces;
             for group in view.groups() {
                 let points: Vec<[T; D]> = group.clone().map(|k| view.position(k)).collect();
-                let (lo, hi) = bounding_box(&points);
+                let Bounds { lo, hi } = Bounds::of_points(points.iter().copied());
                 for (r, top) in tops.iter().enumerate() {
                     if r == me || top.is_empty() {
                         continue;
