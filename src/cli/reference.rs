@@ -254,24 +254,23 @@ struct Row {
 
 /// Every key of a sweep config, by table, with what it defaults to and accepts.
 pub fn config_page() -> anyhow::Result<String> {
-    let full: toml::Table = toml::from_str(FULL).expect("the full config is TOML");
+    let full: toml::Table = toml::from_str(FULL).context("the full example config as TOML")?;
     let parsed: SweepConfig = toml::from_str(FULL).context("the full example config")?;
     let serialized = toml::Table::try_from(&parsed).context("serializing the full config")?;
     // (section heading, its rows)
     let mut sections: Vec<(String, Vec<Row>)> = vec![("Top-level keys".into(), Vec::new())];
     for (key, value) in &serialized {
+        // (the table under the key, whether it is an array of tables)
         let nested = match value {
-            toml::Value::Table(_) => Some(false),
-            toml::Value::Array(a) if a.first().is_some_and(toml::Value::is_table) => Some(true),
+            toml::Value::Table(t) => Some((t.clone(), false)),
+            toml::Value::Array(a) => a
+                .first()
+                .and_then(toml::Value::as_table)
+                .map(|t| (t.clone(), true)),
             _ => None,
         };
         sections[0].1.push(row(&full, &[key], "")?);
-        if let Some(array) = nested {
-            let inner = match value {
-                toml::Value::Table(t) => t.clone(),
-                toml::Value::Array(a) => a[0].as_table().expect("a table").clone(),
-                _ => unreachable!(),
-            };
+        if let Some((inner, array)) = nested {
             let heading = if array {
                 format!("`[[{key}]]`")
             } else {
@@ -325,12 +324,17 @@ fn row(full: &toml::Table, path: &[&String], table: &str) -> anyhow::Result<Row>
         [_] => &mut without,
         [outer, _] => match without.get_mut(outer.as_str()) {
             Some(toml::Value::Table(t)) => t,
-            Some(toml::Value::Array(a)) => a[0].as_table_mut().expect("a table"),
+            Some(toml::Value::Array(a)) => match a.first_mut() {
+                Some(toml::Value::Table(t)) => t,
+                _ => bail!("`{outer}` is not an array of tables in the full config"),
+            },
             _ => bail!("`{outer}` is not a table of the full config"),
         },
         _ => bail!("keys are one or two levels deep"),
     };
-    let last = path.last().expect("a key").as_str();
+    let Some(last) = path.last().map(|k| k.as_str()) else {
+        bail!("an empty key path");
+    };
     holder.remove(last);
     let default = match toml::Value::Table(without).try_into::<SweepConfig>() {
         Err(_) => "*required*".to_string(),
