@@ -87,7 +87,6 @@ fn this_machine() -> RunInfo {
         cpu_model: Some(nbody_bench::calibrate::cpu_model()),
         cpu_signature: nbody_bench::calibrate::cpu_signature(),
         logical_cpus: Some(nbody_bench::run::logical_cpus()),
-        test_slowdown: None,
     }
 }
 

@@ -348,7 +348,7 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
         let probe = pool
             .install(|| {
                 let started = Instant::now();
-                let sim = stepper(&setup, this.1, &params, 1.0)?;
+                let sim = stepper(&setup, this.1, &params)?;
                 Ok::<_, SetupError>(sim.and_then(|sim| probe_one(sim, started, error_sample)))
             })
             .map_err(|source| ProbeError::Setup {

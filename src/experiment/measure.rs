@@ -3,6 +3,7 @@
 
 use super::plan::Case;
 use super::reference::time_reference;
+#[cfg(feature = "test-slowdown")]
 use super::slowdown::TestSlowdown;
 use crate::clock::{Clock, clock_cost};
 use crate::engine::PhaseTimes;
@@ -25,6 +26,7 @@ pub struct RoundSpec {
     /// Seconds of the reference workload to time before each sample (0 = none).
     pub reference_s: f64,
     /// The test-only slowdown knob, if set (see `experiment::slowdown`).
+    #[cfg(feature = "test-slowdown")]
     pub slowdown: Option<TestSlowdown>,
 }
 
@@ -79,20 +81,26 @@ pub fn measure_round<C: Clock>(
     spec: &RoundSpec,
     clock: &C,
 ) -> Result<Result<RoundOutcome, RunError>, SetupError> {
-    let slowdown = spec.slowdown.map_or(1.0, |s| s.factor_for(kernel));
     let params = case.kernel_params();
-    Ok(
-        stepper(setup, kernel, &params, slowdown)?.and_then(|mut sim| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(case.threads)
-                .build()
-                .map_err(|source| RunError::Pool {
-                    threads: case.threads,
-                    source,
-                })?;
-            pool.install(|| measure(spec, clock, sim.as_mut()))
-        }),
-    )
+    #[cfg(feature = "test-slowdown")]
+    let built = match spec.slowdown {
+        Some(knob) => {
+            crate::stepper::slowed_stepper(setup, kernel, &params, knob.factor_for(kernel))
+        }
+        None => stepper(setup, kernel, &params),
+    };
+    #[cfg(not(feature = "test-slowdown"))]
+    let built = stepper(setup, kernel, &params);
+    Ok(built?.and_then(|mut sim| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(case.threads)
+            .build()
+            .map_err(|source| RunError::Pool {
+                threads: case.threads,
+                source,
+            })?;
+        pool.install(|| measure(spec, clock, sim.as_mut()))
+    }))
 }
 
 fn measure<C: Clock>(

@@ -14,5 +14,6 @@ pub mod progress;
 pub mod reference;
 pub mod results;
 pub mod runner;
+#[cfg(feature = "test-slowdown")]
 pub mod slowdown;
 pub mod vet;

@@ -71,10 +71,6 @@ pub struct Metadata {
     pub os: String,
     /// UTC, ISO 8601, when the sweep started (the first run, not a resume).
     pub started: String,
-    /// The test-only slowdown knob (`NBODY_BENCH_TEST_SLOWDOWN`) the sweep ran with, if any:
-    /// such timings are deliberately wrong.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub test_slowdown: Option<String>,
     /// The version line of each external program of the config (`[[external]]`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub externals: Vec<super::external::ExternalVersion>,
@@ -396,11 +392,14 @@ impl Metadata {
             rustc_version: nbody_engine::RUSTC_VERSION.to_string(),
             simd: crate::simd::level().name().to_string(),
             target_features: compiled_features(),
-            cargo_features: [("mpi", cfg!(feature = "mpi"))]
-                .iter()
-                .filter(|(_, on)| *on)
-                .map(|(name, _)| name.to_string())
-                .collect(),
+            cargo_features: [
+                ("mpi", cfg!(feature = "mpi")),
+                ("test-slowdown", cfg!(feature = "test-slowdown")),
+            ]
+            .iter()
+            .filter(|(_, on)| *on)
+            .map(|(name, _)| name.to_string())
+            .collect(),
             profile: if cfg!(debug_assertions) {
                 "debug"
             } else {
@@ -412,7 +411,6 @@ impl Metadata {
                 .unwrap_or_else(|_| "unknown".into()),
             os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
             started: utc_now(),
-            test_slowdown: None,
             externals: Vec::new(),
         }
     }

@@ -7,6 +7,7 @@ use super::lock::WriterLock;
 use super::measure::{RoundSpec, measure_round};
 use super::plan::{Case, cases};
 use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
+#[cfg(feature = "test-slowdown")]
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
 use crate::clock::Clock;
 use crate::scenario::Setup;
@@ -75,6 +76,7 @@ pub enum SweepError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    #[cfg(feature = "test-slowdown")]
     #[error("{0}")]
     Slowdown(String),
     #[error(
@@ -187,6 +189,7 @@ pub fn run_sweep<C: Clock>(
         let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
         super::external::check_programs(ext, launcher, &context)?;
     }
+    #[cfg(feature = "test-slowdown")]
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
@@ -197,13 +200,13 @@ pub fn run_sweep<C: Clock>(
     // Held until the sweep returns: nobody else reads, backs up or saves this file meanwhile.
     let _writer = WriterLock::acquire(&path)?;
     let mut results = open(config, config_text, options, &path)?;
+    #[cfg(feature = "test-slowdown")]
     if let Some(s) = slowdown {
         observer.message(&format!(
             "warning: {SLOWDOWN_ENV}={s} is set: {} runs {} times per step (test-only)",
             s.kernel.name(),
             s.factor
         ));
-        results.metadata.test_slowdown = Some(s.to_string());
     }
     let logical = crate::run::logical_cpus();
     let rounds = config.measure.rounds;
@@ -285,6 +288,7 @@ pub fn run_sweep<C: Clock>(
                 steps_per_sample: (record.rounds_done > 0).then_some(record.steps_per_sample),
                 force_error_sample: config.measure.force_error_sample,
                 reference_s: config.measure.reference_s,
+                #[cfg(feature = "test-slowdown")]
                 slowdown,
             };
             let outcome =

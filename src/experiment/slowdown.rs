@@ -4,9 +4,9 @@
 //! computation (the engine's `kernels::repeated`), so `naive:1.2` is a 20 % slower force
 //! computation.
 //!
-//! Not for measurements: a sweep run with it records it in `metadata.test_slowdown`, and `gate`
-//! warns about such a file. When the variable is unset the knob costs nothing: it is read once
-//! per sweep, and no kernel is wrapped.
+//! Not for measurements: it exists only in a build with the `test-slowdown` feature (CI's, for
+//! the gate's tests), where a sweep that applies it says so. When the variable is unset it costs
+//! nothing: it is read once per sweep, and no kernel is wrapped.
 
 use crate::kernels::KernelKind;
 use std::fmt;

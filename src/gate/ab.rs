@@ -14,7 +14,6 @@ use crate::children::supervised::{self as child, ChildError};
 use crate::experiment::config::SweepConfig;
 use crate::experiment::plan::{Case, cases};
 use crate::experiment::results::{CaseRecord, ResultsFile};
-use crate::experiment::slowdown::SLOWDOWN_ENV;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -445,8 +444,9 @@ fn run_side(
         command.arg("--yes");
     }
     if side == Side::Base {
-        // The test-only slowdown knob is meant for this build only.
-        command.env_remove(SLOWDOWN_ENV);
+        // The test-only slowdown knob is meant for this build only (a base revision from before
+        // the knob became a test feature reads it in every build).
+        command.env_remove("NBODY_BENCH_TEST_SLOWDOWN");
     }
     let what = format!(
         "the {} build's sweep of {} (round {round})",

@@ -96,12 +96,6 @@ pub(super) fn check_comparable(
         ));
     }
     for (info, which) in [(&b, "baseline"), (&c, "current")] {
-        if let Some(knob) = &info.test_slowdown {
-            warnings.push(format!(
-                "the {which} run used the test-only slowdown knob ({knob}): its timings are \
-                 deliberately wrong"
-            ));
-        }
         if info.git_dirty {
             warnings.push(format!(
                 "the {which} run was measured with uncommitted changes (commit {})",

@@ -193,7 +193,6 @@ pub struct RunInfo {
     pub cpu_model: Option<String>,
     pub cpu_signature: Option<String>,
     pub logical_cpus: Option<usize>,
-    pub test_slowdown: Option<String>,
 }
 
 impl RunInfo {
@@ -241,7 +240,6 @@ impl RunInfo {
             cpu_model: cal.map(|c| c.cpu_model.clone()),
             cpu_signature: cal.and_then(|c| c.cpu_signature.clone()),
             logical_cpus: cal.map(|c| c.logical_cpus),
-            test_slowdown: file.metadata.test_slowdown.clone(),
         }
     }
 }

@@ -80,7 +80,6 @@ fn metadata() -> Metadata {
         host: "ci-1".into(),
         os: "linux x86_64".into(),
         started: "2026-11-22T00:00:00Z".into(),
-        test_slowdown: None,
         externals: Vec::new(),
     }
 }

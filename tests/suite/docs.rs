@@ -187,15 +187,14 @@ fn committed_results() -> Vec<PathBuf> {
 #[test]
 fn the_results_reference_lists_exactly_the_fields_written() {
     // Each committed file read by this version and written again (older files gain the
-    // fields added since), plus the fields only some sweeps write: a rejected value, the
-    // test-only slowdown, and an external program's failures and wall-timing overhead.
+    // fields added since), plus the fields only some sweeps write: a rejected value and an
+    // external program's failures and wall-timing overhead.
     let mut found = BTreeSet::new();
     let files = committed_results();
     assert!(files.len() > 5, "{files:?}");
     for (i, path) in files.iter().enumerate() {
         let mut file = ResultsFile::load(path).unwrap();
         if i == 0 {
-            file.metadata.test_slowdown = Some("symmetric:2".into());
             file.cases[0].rejected.push(Rejected {
                 round: 0,
                 what: "sample 0".into(),

@@ -1,7 +1,8 @@
 //! `nbody-bench export`: the files read back give our initial state (LAMMPS data in reduced
 //! units, the text table exactly, the .npy array exactly), and other laws are refused for LAMMPS.
 
-use nbody_bench::physics::{LawParameters, PairLaw};
+use nbody_bench::kernels::CompiledKernels;
+use nbody_bench::physics::LawParameters;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{ScenarioKind, Setup, System, SystemJob};
 use std::path::Path;
@@ -10,7 +11,10 @@ use std::path::Path;
 struct Rows;
 impl SystemJob for Rows {
     type Output = (Vec<[Vec<f64>; 4]>, LawParameters);
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, s: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        s: System<T, L, D>,
+    ) -> Self::Output {
         let st = &s.state;
         let rows = st
             .slots_by_id()

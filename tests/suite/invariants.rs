@@ -1,13 +1,13 @@
 //! Physical invariants of the force kernels, over random seeded configurations (proptest):
 //! Newton's third law (Σ F ≈ 0), translation invariance and permutation invariance.
 
-use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::physics::{Coulomb, Gravity, LennardJones, PairLaw};
+use nbody_bench::kernels::{CompiledKernels, KernelKind, KernelParams};
+use nbody_bench::physics::{Coulomb, Gravity, LennardJones};
 use nbody_bench::state::{Field, State, zero_field};
 use nbody_bench::testing::{random_state, spaced_state};
 use proptest::prelude::*;
 
-fn forces<L: PairLaw<f64>, const D: usize>(
+fn forces<L: CompiledKernels<f64, D>, const D: usize>(
     kind: KernelKind,
     law: L,
     s: &State<f64, D>,
@@ -39,7 +39,7 @@ fn net_force_ratio<const D: usize>(f: &Field<f64, D>) -> f64 {
         / scale
 }
 
-fn check_invariants<L: PairLaw<f64>, const D: usize>(
+fn check_invariants<L: CompiledKernels<f64, D>, const D: usize>(
     law: L,
     s: State<f64, D>,
     shift: f64,

@@ -5,8 +5,8 @@
 //! gives them to rounding (the symmetric kernels split the pair work, so the sums are grouped
 //! differently).
 
+use nbody_bench::kernels::CompiledKernels;
 use nbody_bench::kernels::{KernelKind, KernelParams, Share};
-use nbody_bench::physics::PairLaw;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{ScenarioKind, Setup, System, SystemJob};
 use nbody_bench::state::zero_field;
@@ -20,7 +20,10 @@ struct Parts {
 
 impl SystemJob for Parts {
     type Output = ();
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        sys: System<T, L, D>,
+    ) -> Self::Output {
         let n = sys.state.len();
         let (_, abs_sum) = reference_forces(&sys.law.widen(), &sys.state.convert::<f64>());
         let pool = rayon::ThreadPoolBuilder::new()

@@ -4,8 +4,8 @@
 //! orders, the quadrupole's below the monopole's; the fmm is exact at θ = 0 and within its
 //! tolerance on the scenarios, and `validate` skips it, visibly, at θ ≥ 1.
 
+use nbody_bench::kernels::CompiledKernels;
 use nbody_bench::kernels::{KernelKind, KernelParams, Multipole};
-use nbody_bench::physics::PairLaw;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
 use nbody_bench::state::zero_field;
@@ -37,7 +37,10 @@ struct Errors {
 
 impl SystemJob for Compare {
     type Output = (f64, Vec<Errors>);
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        sys: System<T, L, D>,
+    ) -> Self::Output {
         let n = sys.state.len();
         let (reference, abs_sum) = reference_forces(&sys.law.widen(), &sys.state.convert::<f64>());
         let pool = rayon::ThreadPoolBuilder::new()

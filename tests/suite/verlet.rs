@@ -4,9 +4,9 @@
 //! particle that moves exactly half the skin keeps the list and the forces exact.
 
 use nbody_bench::engine::Simulation;
+use nbody_bench::kernels::CompiledKernels;
 use nbody_bench::kernels::verlet::{parts_for, step_work};
 use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::physics::PairLaw;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{ScenarioKind, Setup, System, SystemJob};
 use nbody_bench::state::{Field, State, zero_field};
@@ -14,7 +14,7 @@ use nbody_bench::validate::{EXACT_ULPS, reference_forces};
 
 /// The largest |F − F_naive| / Σ_j |F_ij| over the particles of `state` (0 for particles
 /// without partners, which must then feel nothing).
-fn rounding_ratio<T: Real, L: PairLaw<T>, const D: usize>(
+fn rounding_ratio<T: Real, L: CompiledKernels<T, D>, const D: usize>(
     law: &L,
     state: &State<T, D>,
     forces: &Field<T, D>,
@@ -56,7 +56,7 @@ struct Ran {
 
 impl SystemJob for EveryStep {
     type Output = Ran;
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> Ran {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(self, sys: System<T, L, D>) -> Ran {
         let law = sys.law;
         let name = sys.info.scenario.name();
         let pool = rayon::ThreadPoolBuilder::new()
@@ -127,7 +127,7 @@ struct HalfSkin;
 
 impl SystemJob for HalfSkin {
     type Output = ();
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(self, sys: System<T, L, D>) {
         // A skin of 2^-9 (0.2σ): its half is a power of two, which f32 adds exactly to
         // coordinates in [1, 2).
         let skin = 1.0 / 512.0;

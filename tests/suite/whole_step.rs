@@ -5,8 +5,8 @@
 //! per-thread buffers and agree to rounding.
 
 use nbody_bench::engine::Simulation;
+use nbody_bench::kernels::CompiledKernels;
 use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::physics::PairLaw;
 use nbody_bench::real::Real;
 use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
 use nbody_bench::state::zero_field;
@@ -39,7 +39,10 @@ struct Trajectory {
 
 impl SystemJob for Trajectory {
     type Output = Vec<u64>;
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> Vec<u64> {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        sys: System<T, L, D>,
+    ) -> Vec<u64> {
         let kernel = self
             .kernel
             .build::<T, L, D>(sys.law, &KernelParams::default())
@@ -98,7 +101,10 @@ struct Forces {
 
 impl SystemJob for Forces {
     type Output = (f64, f64);
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, sys: System<T, L, D>) -> (f64, f64) {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        sys: System<T, L, D>,
+    ) -> (f64, f64) {
         let params = KernelParams::default();
         let n = sys.state.len();
         let law = sys.law;

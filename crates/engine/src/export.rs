@@ -11,6 +11,7 @@
 
 use crate::boundary::Boundary;
 use crate::geometry::Bounds;
+use crate::kernels::CompiledKernels;
 use crate::physics::{LawParameters, PairLaw};
 use crate::real::Real;
 use crate::scenario::{System, SystemJob};
@@ -52,7 +53,10 @@ pub struct ExportJob {
 impl SystemJob for ExportJob {
     type Output = Result<Vec<u8>, ExportError>;
 
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output {
         match self.format {
             ExportFormat::LammpsData => lammps_data(&system).map(String::into_bytes),
             ExportFormat::Text => Ok(text(&system).into_bytes()),

@@ -8,7 +8,8 @@
 
 use crate::boundary::BoundaryError;
 use crate::engine::{Energy, PhaseTimes, Simulation};
-use crate::kernels::{KernelKind, KernelParams, WorkCounters, repeated::repeated};
+use crate::kernels::CompiledKernels;
+use crate::kernels::{KernelKind, KernelParams, WorkCounters};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::run::RunError;
@@ -39,9 +40,24 @@ pub trait Stepper: Send {
     fn sampled_force_error(&self, sample: usize, seed: u64) -> (f64, f64);
 }
 
-/// The system of `setup` integrated with `kernel`. `slowdown` > 1 makes each timed force
-/// computation that many times as long ([`repeated`]; for the regression gate's tests).
+/// The system of `setup` integrated with `kernel`.
 pub fn stepper(
+    setup: &Setup,
+    kernel: KernelKind,
+    params: &KernelParams,
+) -> Result<Result<Box<dyn Stepper>, RunError>, SetupError> {
+    setup.dispatch(Build {
+        kernel,
+        params,
+        #[cfg(feature = "test-slowdown")]
+        slowdown: 1.0,
+    })
+}
+
+/// [`stepper`] with each timed force computation made `slowdown` times as long
+/// ([`crate::kernels::repeated`]): a genuinely slower build for the regression gate's tests.
+#[cfg(feature = "test-slowdown")]
+pub fn slowed_stepper(
     setup: &Setup,
     kernel: KernelKind,
     params: &KernelParams,
@@ -57,18 +73,21 @@ pub fn stepper(
 struct Build<'a> {
     kernel: KernelKind,
     params: &'a KernelParams,
+    #[cfg(feature = "test-slowdown")]
     slowdown: f64,
 }
 
 impl SystemJob for Build<'_> {
     type Output = Result<Box<dyn Stepper>, RunError>;
 
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output {
         let law = system.law;
-        let kernel = repeated(
-            self.kernel.build::<T, L, D>(law, self.params)?,
-            self.slowdown,
-        );
+        let kernel = self.kernel.build::<T, L, D>(law, self.params)?;
+        #[cfg(feature = "test-slowdown")]
+        let kernel = crate::kernels::repeated::repeated(kernel, self.slowdown);
         Ok(Box::new(WithLaw {
             sim: Simulation::new(system, kernel),
             law,

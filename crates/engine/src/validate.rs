@@ -1,5 +1,6 @@
 //! Force validation: every applicable kernel against the naive sum computed in f64.
 
+use crate::kernels::CompiledKernels;
 use crate::kernels::{ForceKernel, KernelKind, KernelParams, Naive};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -100,7 +101,10 @@ pub struct ValidateJob {
 impl SystemJob for ValidateJob {
     type Output = Result<ScenarioCheck, crate::run::RunError>;
 
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output {
         let state = &system.state;
         let n = state.len();
         let (reference, abs_sum) = reference_forces(&system.law.widen(), &state.convert::<f64>());

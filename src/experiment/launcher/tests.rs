@@ -160,6 +160,7 @@ d=$(dirname "$json"); stat -c %a "$d" > '{log}'; echo "$d" >> '{log}'; echo junk
         steps_per_sample: None,
         force_error_sample: 0,
         reference_s: 0.0,
+        #[cfg(feature = "test-slowdown")]
         slowdown: None,
     };
     let err = measure_round(&launch, &case, &spec).unwrap_err();

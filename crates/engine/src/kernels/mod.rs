@@ -9,12 +9,14 @@
 mod broadcast;
 mod cell_list;
 mod cluster_pair;
+mod compiled;
 mod counting_sort;
 mod fmm;
 pub mod footprint;
 mod naive;
 mod octree;
 mod per_thread;
+#[cfg(feature = "test-slowdown")]
 pub mod repeated;
 pub mod rows;
 mod share;
@@ -23,6 +25,7 @@ pub mod verlet;
 
 pub use cell_list::CellList;
 pub use cluster_pair::ClusterPair;
+pub use compiled::CompiledKernels;
 pub use fmm::{Fmm, MAX_ORDER as MAX_FMM_ORDER};
 pub use naive::Naive;
 pub use octree::{Multipole, Octree, TreeView, far_from_box};
@@ -133,8 +136,18 @@ impl KernelKind {
         )
     }
 
-    /// Builds the kernel for `law`, or explains which combinations exist.
-    pub fn build<T: Real, L: PairLaw<T>, const D: usize>(
+    /// Builds the kernel for `law`, or explains which combinations exist. The kernel is one
+    /// this crate compiled ([`CompiledKernels`]): a caller in another crate instantiates none.
+    pub fn build<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        law: L,
+        params: &KernelParams,
+    ) -> Result<Box<dyn ForceKernel<T, D>>, KernelError> {
+        law.build_kernel(self, params)
+    }
+
+    /// [`KernelKind::build`] for any law and dimension, instantiated where it is called.
+    pub(crate) fn instantiate<T: Real, L: PairLaw<T>, const D: usize>(
         self,
         law: L,
         params: &KernelParams,

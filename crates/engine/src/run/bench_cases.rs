@@ -7,6 +7,7 @@
 //! only criterion's loops.
 
 use crate::engine::Simulation;
+use crate::kernels::CompiledKernels;
 use crate::kernels::{CellList, Fmm, ForceKernel, KernelKind, KernelParams, Octree, Verlet};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -64,7 +65,10 @@ struct Prepare {
 impl SystemJob for Prepare {
     type Output = Result<Box<dyn BenchCase>, BenchCaseError>;
 
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output {
         let params = KernelParams::default();
         let kernel_error = |e: &dyn std::fmt::Display| BenchCaseError::Kernel(e.to_string());
         let build = || {

@@ -4,10 +4,10 @@
 use crate::clock::Clock;
 use crate::engine::Simulation;
 use crate::geometry::Bounds;
+use crate::kernels::CompiledKernels;
 use crate::kernels::{KernelKind, KernelParams, footprint};
 use crate::output::nbview::{self, NbviewFormat};
 use crate::output::{AtomicFile, WriteError, dump};
-use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::scenario::{Setup, System, SystemInfo, SystemJob};
 use std::path::PathBuf;
@@ -74,7 +74,10 @@ pub fn run_setup(
 impl<C: Clock> SystemJob for RunJob<'_, C> {
     type Output = Result<RunOutcome, RunError>;
 
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output {
         let spec = self.0;
         let kernel = spec.kernel.build::<T, L, D>(system.law, &spec.params)?;
         let pool = rayon::ThreadPoolBuilder::new()

@@ -9,7 +9,8 @@ pub mod galaxy;
 mod placement;
 
 use crate::boundary::Boundary;
-use crate::physics::{Coulomb, Gravity, LawKind, LennardJones, PairLaw};
+use crate::kernels::CompiledKernels;
+use crate::physics::{Coulomb, Gravity, LawKind, LennardJones};
 use crate::real::Real;
 use crate::state::State;
 use rand::SeedableRng;
@@ -411,7 +412,10 @@ pub struct System<T: Real, L, const D: usize> {
 /// Work that runs on a system whatever its types (the visitor of [`Setup::dispatch`]).
 pub trait SystemJob {
     type Output;
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output;
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output;
 }
 
 #[cfg(test)]
@@ -421,7 +425,10 @@ mod tests {
     struct Snapshot;
     impl SystemJob for Snapshot {
         type Output = (usize, Vec<f64>, Vec<f64>);
-        fn run<T: Real, L: PairLaw<T>, const D: usize>(self, s: System<T, L, D>) -> Self::Output {
+        fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+            self,
+            s: System<T, L, D>,
+        ) -> Self::Output {
             let pos = (0..s.state.len())
                 .flat_map(|i| s.state.position(i))
                 .map(|x| x.as_f64())

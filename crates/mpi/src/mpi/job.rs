@@ -13,9 +13,9 @@ use crate::decomp::check::{CheckReport, TreeCheck, compare, relative_drift};
 use crate::decomp::stats::{MasterSummary, MpiReport, RankStats, attribute_waits, reduce};
 use crate::decomp::wire::{bytes_of, floats_of, packed_id, particle_values, push_particle};
 use crate::engine::{PhaseTimes, Simulation};
+use crate::kernels::CompiledKernels;
 use crate::kernels::{KernelKind, KernelParams, WorkCounters};
 use crate::output::dump;
-use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::run::{Measured, RunOutcome};
 use crate::scenario::{System, SystemJob};
@@ -72,7 +72,10 @@ struct RankRecord {
 impl SystemJob for MpiJob<'_> {
     type Output = Result<Option<RootResult>, MpiError>;
 
-    fn run<T: Real, L: PairLaw<T>, const D: usize>(self, system: System<T, L, D>) -> Self::Output {
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        system: System<T, L, D>,
+    ) -> Self::Output {
         let MpiJob { spec, comm } = self;
         spec.decomp.check(spec.kernel)?;
         if spec.decomp != Decomposition::Domain && spec.domain.rank_grid.is_some() {
@@ -269,7 +272,7 @@ fn mpi_report(
 }
 
 /// Rank 0: energies, the dump, the result, and the comparison with a serial run.
-fn finish<T: Real, L: PairLaw<T>, const D: usize>(
+fn finish<T: Real, L: CompiledKernels<T, D>, const D: usize>(
     spec: &MpiSpec,
     reference: System<T, L, D>,
     state: State<T, D>,

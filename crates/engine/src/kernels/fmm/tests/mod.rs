@@ -307,7 +307,7 @@ fn bad_parameters_and_systems_are_refused() {
     );
     // A 2-D system, and a short-range law (the 2-D LJ scenarios).
     let err = KernelKind::Fmm
-        .build::<f64, _, 2>(gravity::<f64>(), &ok)
+        .instantiate::<f64, _, 2>(gravity::<f64>(), &ok)
         .map(|_| ())
         .unwrap_err();
     assert!(
