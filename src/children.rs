@@ -15,7 +15,7 @@ use std::time::{Duration, Instant};
 
 /// Seconds between SIGTERM and SIGKILL (an MPI launcher forwards SIGTERM to its ranks and
 /// needs a moment to do so).
-pub const KILL_GRACE_S: f64 = 2.0;
+pub(crate) const KILL_GRACE_S: f64 = 2.0;
 
 /// Process groups of the programs running now.
 static GROUPS: Mutex<Vec<i32>> = Mutex::new(Vec::new());
@@ -59,7 +59,7 @@ impl Group {
 
     /// SIGTERM to the group, up to [`KILL_GRACE_S`] for the leader to end, then SIGKILL to
     /// the group; always reaps the leader.
-    pub fn terminate(&self, leader: &mut Child) {
+    pub(crate) fn terminate(&self, leader: &mut Child) {
         use wait_timeout::ChildExt;
         self.signal(libc::SIGTERM);
         let ended = leader.wait_timeout(Duration::from_secs_f64(KILL_GRACE_S));
@@ -117,7 +117,7 @@ pub fn stop_all() -> MutexGuard<'static, Vec<i32>> {
 
 /// The pids of the live (not zombie) processes of group `pgid`, from `/proc`; for tests.
 #[doc(hidden)]
-pub fn live_members(pgid: i32) -> Vec<i32> {
+pub(crate) fn live_members(pgid: i32) -> Vec<i32> {
     let Ok(entries) = std::fs::read_dir("/proc") else {
         return Vec::new();
     };

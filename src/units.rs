@@ -17,7 +17,7 @@ impl Duration {
 
     /// The unit a span of `seconds` is written in, and its length in seconds: `(1e-3, "ms")`.
     /// The figures' axes take it too, so a plot and a table name a time alike.
-    pub fn unit_for(seconds: f64) -> (f64, &'static str) {
+    pub(crate) fn unit_for(seconds: f64) -> (f64, &'static str) {
         const UNITS: [(f64, &str); 4] = [(1.0, "s"), (1e-3, "ms"), (1e-6, "µs"), (1e-9, "ns")];
         let s = seconds.abs();
         *UNITS.iter().find(|(len, _)| s >= *len).unwrap_or(&UNITS[3])
@@ -72,7 +72,7 @@ pub struct Bytes(pub f64);
 impl Bytes {
     /// The unit a count of `bytes` is written in, and its size in bytes: `(1024.0, "KiB")`.
     /// The figures' axes take it too, so a plot and a table name a size alike.
-    pub fn unit_for(bytes: f64) -> (f64, &'static str) {
+    pub(crate) fn unit_for(bytes: f64) -> (f64, &'static str) {
         const UNITS: [&str; 5] = ["B", "KiB", "MiB", "GiB", "TiB"];
         let b = bytes.abs();
         let mut size = 1.0;
@@ -100,7 +100,7 @@ impl fmt::Display for Bytes {
 
 /// A fraction shown as a percentage: `3.1%`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Percent(pub f64);
+pub(crate) struct Percent(pub f64);
 
 impl fmt::Display for Percent {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {

@@ -10,24 +10,24 @@ use serde::Serialize;
 
 /// One predicted point: communication seconds per step with the 95% band of the fit.
 #[derive(Clone, Debug, Serialize)]
-pub struct Prediction {
+pub(crate) struct Prediction {
     pub ranks: usize,
     pub n: usize,
-    pub bytes_per_rank: f64,
-    pub messages_per_rank: f64,
+    pub(crate) bytes_per_rank: f64,
+    pub(crate) messages_per_rank: f64,
     pub seconds: f64,
     pub ci95: [f64; 2],
 }
 
 #[derive(Clone, Debug, Serialize)]
-pub struct CommModel {
+pub(crate) struct CommModel {
     pub source: String,
     /// Ranks and oversubscription of the benchmark the fit comes from.
-    pub bench_ranks: usize,
-    pub bench_oversubscribed: bool,
-    pub alpha_beta: Fitted<AlphaBetaFit>,
+    pub(crate) bench_ranks: usize,
+    pub(crate) bench_oversubscribed: bool,
+    pub(crate) alpha_beta: Fitted<AlphaBetaFit>,
     /// The workload predicted: particles per rank, dimension, bytes per value, density, cutoff.
-    pub n_per_rank: usize,
+    pub(crate) n_per_rank: usize,
     pub density: f64,
     pub cutoff: f64,
     pub allgather: Vec<Prediction>,
@@ -35,7 +35,7 @@ pub struct CommModel {
 }
 
 /// Rank counts the prediction covers (beyond this machine's).
-pub const PREDICTED_RANKS: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
+pub(crate) const PREDICTED_RANKS: [usize; 8] = [1, 2, 4, 8, 16, 32, 64, 128];
 
 /// Regions per axis of a 2-D rank grid as square as the rank count allows.
 fn grid(p: usize) -> Vec<usize> {
@@ -52,7 +52,7 @@ fn log2_ceil(p: usize) -> f64 {
 
 /// The α-β time of `msgs` latencies and `bytes` bytes, with the 95% band of the fit's
 /// bootstrap replicates.
-pub fn predict(f: &AlphaBetaFit, msgs: f64, bytes: f64) -> (f64, [f64; 2]) {
+pub(crate) fn predict(f: &AlphaBetaFit, msgs: f64, bytes: f64) -> (f64, [f64; 2]) {
     let at = |a: f64, b: f64| msgs * a + bytes * b;
     let mut reps: Vec<f64> = f.replicates().iter().map(|r| at(r[0], r[1])).collect();
     reps.sort_by(f64::total_cmp);
@@ -66,7 +66,7 @@ pub fn predict(f: &AlphaBetaFit, msgs: f64, bytes: f64) -> (f64, [f64; 2]) {
 }
 
 /// The α-β fit of the ping-pong of `bench`.
-pub fn fit_ping_pong(bench: &MpiBenchFile) -> Result<AlphaBetaFit, fit::FitError> {
+pub(crate) fn fit_ping_pong(bench: &MpiBenchFile) -> Result<AlphaBetaFit, fit::FitError> {
     let samples: Vec<Samples> = bench
         .ping_pong
         .points
@@ -78,7 +78,7 @@ pub fn fit_ping_pong(bench: &MpiBenchFile) -> Result<AlphaBetaFit, fit::FitError
 
 /// Fits the ping-pong of `bench` and predicts both decompositions for n = `n_per_rank`·p
 /// particles of a 2-D f32 system at `density` with cutoff `cutoff`.
-pub fn comm_model(
+pub(crate) fn comm_model(
     bench: &MpiBenchFile,
     source: &str,
     n_per_rank: usize,

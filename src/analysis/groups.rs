@@ -30,12 +30,12 @@ pub struct Point {
     /// MPI decomposition of a case run under a launcher.
     pub decomp: Option<Decomposition>,
     /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases).
-    pub comm_s_per_step: Option<f64>,
-    pub bytes_per_step: Option<f64>,
+    pub(crate) comm_s_per_step: Option<f64>,
+    pub(crate) bytes_per_step: Option<f64>,
     /// Of `comm_s_per_step`, the part left after the estimated wait for slower ranks: moving
     /// data and MPI overhead (MPI cases).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub transfer_s_per_step: Option<f64>,
+    pub(crate) transfer_s_per_step: Option<f64>,
     /// Mean over the rounds of max/mean over ranks of the compute time (MPI cases).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub compute_imbalance: Option<f64>,
@@ -61,7 +61,7 @@ impl Point {
     }
 
     /// Whether this case ran with `p` workers, `p` as a fit gives it back (a float).
-    pub fn has_workers(&self, p: f64) -> bool {
+    pub(crate) fn has_workers(&self, p: f64) -> bool {
         p.is_finite() && p >= 0.0 && self.p() == p.round() as usize
     }
 }
@@ -87,7 +87,7 @@ pub struct SeriesKey {
 
 impl SeriesKey {
     /// A short legend label, e.g. "octree θ=0.5" or "naive, 2 threads".
-    pub fn label(&self) -> String {
+    pub(crate) fn label(&self) -> String {
         let mut s = self.kernel.name().to_string();
         if let Some(t) = self.theta {
             s.push_str(&format!(" θ={t}"));
@@ -111,7 +111,7 @@ impl SeriesKey {
 
 /// The workers of a label: nothing for one, else ", 2 threads", ", 2 ranks" or
 /// ", 2 threads × 2 ranks".
-pub fn workers_suffix(threads: usize, ranks: usize) -> String {
+pub(crate) fn workers_suffix(threads: usize, ranks: usize) -> String {
     match (threads, ranks) {
         (1, 1) => String::new(),
         (t, 1) => format!(", {t} threads"),
@@ -123,7 +123,7 @@ pub fn workers_suffix(threads: usize, ranks: usize) -> String {
 /// What the p of a scaling series counts, for an axis, from its cases' `(threads, ranks)`:
 /// "threads" when every case ran one rank, "ranks" when every case ran one thread, else
 /// "workers (threads × ranks)".
-pub fn workers_noun(cases: impl IntoIterator<Item = (usize, usize)>) -> &'static str {
+pub(crate) fn workers_noun(cases: impl IntoIterator<Item = (usize, usize)>) -> &'static str {
     let (mut threads, mut ranks) = (false, false);
     for (t, r) in cases {
         threads |= t > 1;

@@ -23,7 +23,7 @@ use serde::Serialize;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-pub const FITS_SCHEMA: &str = "nbody-bench/fits/v1";
+pub(crate) const FITS_SCHEMA: &str = "nbody-bench/fits/v1";
 
 /// A fit, or why there is none (too few points, …): a series is never dropped silently.
 #[derive(Clone, Debug, Serialize)]
@@ -50,20 +50,20 @@ impl<T> Fitted<T> {
 #[derive(Clone, Debug, Serialize)]
 pub struct ComplexityAnalysis {
     pub series: SeriesKey,
-    pub label: String,
+    pub(crate) label: String,
     pub points: Vec<Point>,
     pub fit: Fitted<PowerFit>,
 }
 
 /// Where two kernels' fitted cost curves cross.
 #[derive(Clone, Debug, Serialize)]
-pub struct Crossover {
+pub(crate) struct Crossover {
     pub scenario: String,
     pub precision: String,
     pub threads: usize,
     /// The kernel that is faster above `n` and the one that is faster below it.
-    pub faster_above: String,
-    pub faster_below: String,
+    pub(crate) faster_above: String,
+    pub(crate) faster_below: String,
     /// Where the fitted curves cross; `None` when `faster_above` is faster over the whole
     /// measured range.
     pub n: Option<f64>,
@@ -72,7 +72,7 @@ pub struct Crossover {
 #[derive(Clone, Debug, Serialize)]
 pub struct StrongAnalysis {
     pub series: SeriesKey,
-    pub label: String,
+    pub(crate) label: String,
     pub points: Vec<Point>,
     /// Speedup and efficiency at every measured p, oversubscribed ones included.
     pub measured: Vec<fit::StrongPoint>,
@@ -81,14 +81,14 @@ pub struct StrongAnalysis {
     pub fit: Fitted<StrongFit>,
     /// The serial fraction from the one-worker case's phase timers (the Barnes-Hut report's method),
     /// and how it compares with the fitted one.
-    pub timed_serial: Option<TimedSerialFraction>,
-    pub serial_comparison: Option<SerialFractionComparison>,
+    pub(crate) timed_serial: Option<TimedSerialFraction>,
+    pub(crate) serial_comparison: Option<SerialFractionComparison>,
 }
 
 #[derive(Clone, Debug, Serialize)]
 pub struct WeakAnalysis {
     pub series: SeriesKey,
-    pub label: String,
+    pub(crate) label: String,
     pub rule: Option<WeakRule>,
     pub points: Vec<Point>,
     /// Efficiency at every measured p, oversubscribed ones included.
@@ -100,7 +100,7 @@ pub struct WeakAnalysis {
 #[derive(Clone, Debug, Serialize)]
 pub struct ThetaAnalysis {
     pub series: SeriesKey,
-    pub label: String,
+    pub(crate) label: String,
     pub points: Vec<Point>,
 }
 
@@ -114,7 +114,7 @@ pub struct Analysis {
     pub metadata: Metadata,
     pub calibration: Option<Calibration>,
     pub complexity: Vec<ComplexityAnalysis>,
-    pub crossovers: Vec<Crossover>,
+    pub(crate) crossovers: Vec<Crossover>,
     pub strong: Vec<StrongAnalysis>,
     pub weak: Vec<WeakAnalysis>,
     pub theta: Vec<ThetaAnalysis>,
@@ -123,7 +123,7 @@ pub struct Analysis {
     pub peers: Vec<peers::PeerRatio>,
     /// Tree codes at equal median force error ([`peers::EQUAL_ERROR`]).
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub peers_equal_error: Vec<peers::EqualErrorCost>,
+    pub(crate) peers_equal_error: Vec<peers::EqualErrorCost>,
     /// How each external program was run: its `[[external]]` entry as the sweep's config
     /// gives it (command, environment, steps, timing), so that a comparison says what it
     /// compares against.
@@ -132,7 +132,7 @@ pub struct Analysis {
     /// The tokens the config's `[mpi]` launcher puts before an external program's command
     /// (`mpirun ARGS -n {ranks}`); empty without one.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub external_launcher: Vec<String>,
+    pub(crate) external_launcher: Vec<String>,
     /// Every complete case, with its summary figures and physics checks.
     pub cases: Vec<Point>,
     /// Cases of the file still unmeasured or partly measured (left out of the analysis).
@@ -143,7 +143,7 @@ impl Analysis {
     /// The pair rate of `p` as a share of the calibrated FMA peak of its workers (f64 at half
     /// the f32 rate), at the law's nominal flops per pair; `None` without a calibration or a
     /// pair rate.
-    pub fn peak_share(
+    pub(crate) fn peak_share(
         &self,
         p: &Point,
         law: crate::physics::LawKind,
@@ -456,7 +456,7 @@ fn fit_weak_points(
 }
 
 /// "galaxy (f64, 1 thread): octree θ=0.5 is faster above n ≈ 574, naive below."
-pub fn crossover_sentence(x: &Crossover) -> String {
+pub(crate) fn crossover_sentence(x: &Crossover) -> String {
     let head = format!(
         "{} ({}, {} thread{})",
         x.scenario,

@@ -13,7 +13,7 @@ use serde::Serialize;
 
 /// The median relative force error at which tree codes are compared: the octree's target
 /// at θ = 0.5.
-pub const EQUAL_ERROR: f64 = 1e-3;
+pub(crate) const EQUAL_ERROR: f64 = 1e-3;
 
 /// The seed of the ratio bootstraps: the same results give the same intervals.
 const SEED: u64 = 0x9EE2;
@@ -28,17 +28,17 @@ pub struct PeerRatio {
     pub ours: String,
     pub theirs: String,
     /// Nanoseconds per particle-step: median and bootstrap 95% CI.
-    pub ours_ns: f64,
-    pub ours_ci_ns: [f64; 2],
+    pub(crate) ours_ns: f64,
+    pub(crate) ours_ci_ns: [f64; 2],
     pub theirs_ns: f64,
-    pub theirs_ci_ns: [f64; 2],
+    pub(crate) theirs_ci_ns: [f64; 2],
     /// Their time over ours (> 1: ours is faster), from the medians, with the bootstrap 95%
     /// CI of that ratio over both sets of samples.
     pub speedup: f64,
     pub speedup_ci: Option<[f64; 2]>,
     /// Median relative force errors, where measured.
-    pub ours_error: Option<f64>,
-    pub theirs_error: Option<f64>,
+    pub(crate) ours_error: Option<f64>,
+    pub(crate) theirs_error: Option<f64>,
     /// Either case ran more workers than logical CPUs.
     pub oversubscribed: bool,
     /// The other external cases of the same system and workers (the other ways a peer was
@@ -53,7 +53,7 @@ pub struct PeerRatio {
 pub struct PeerVariant {
     pub theirs: String,
     pub theirs_ns: f64,
-    pub theirs_ci_ns: [f64; 2],
+    pub(crate) theirs_ci_ns: [f64; 2],
     /// Its time over ours (from the medians).
     pub speedup: f64,
     pub oversubscribed: bool,
@@ -62,7 +62,7 @@ pub struct PeerVariant {
 /// Each code's time per step at the median force error [`EQUAL_ERROR`], interpolated on its
 /// sweep over θ (log time linear in log error between the two cases that bracket it).
 #[derive(Clone, Debug, Serialize)]
-pub struct EqualErrorCost {
+pub(crate) struct EqualErrorCost {
     pub scenario: String,
     pub n: usize,
     pub workers: usize,
@@ -70,17 +70,17 @@ pub struct EqualErrorCost {
     pub ours: String,
     pub theirs: String,
     /// Seconds per step at `error`; `None` when the code's measured errors do not bracket it.
-    pub ours_s: Option<f64>,
-    pub theirs_s: Option<f64>,
+    pub(crate) ours_s: Option<f64>,
+    pub(crate) theirs_s: Option<f64>,
     /// `theirs_s / ours_s`.
     pub speedup: Option<f64>,
     /// The range of median errors each code measured, to say why a cost is missing.
-    pub ours_errors: [f64; 2],
-    pub theirs_errors: [f64; 2],
+    pub(crate) ours_errors: [f64; 2],
+    pub(crate) theirs_errors: [f64; 2],
 }
 
 /// A case's legend label: code, θ, expansion order, workers.
-pub fn case_label(p: &Point) -> String {
+pub(crate) fn case_label(p: &Point) -> String {
     let mut s = p.case.kernel.name().to_string();
     if let Some(t) = p.theta {
         s.push_str(&format!(" θ={t}"));
@@ -111,7 +111,7 @@ fn same_case(o: &Point, t: &Point) -> bool {
 /// Each of our cases against the fastest (lowest median) external case of the same scenario, n
 /// and worker count (when the external case has a θ, the same θ), with the other external cases
 /// of that system beside it; our cases with no external counterpart are left out.
-pub fn ratios(cases: &[Point]) -> Vec<PeerRatio> {
+pub(crate) fn ratios(cases: &[Point]) -> Vec<PeerRatio> {
     let (theirs, ours): (Vec<&Point>, Vec<&Point>) =
         cases.iter().partition(|p| p.case.kernel.is_external());
     let mut out = Vec::new();
@@ -160,7 +160,7 @@ pub fn ratios(cases: &[Point]) -> Vec<PeerRatio> {
 /// The time at median error `target` from `(error, seconds)` points, interpolating log time
 /// linearly in log error between the first two neighbours (in error) that bracket it; `None`
 /// when no pair does.
-pub fn cost_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
+pub(crate) fn cost_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
     let mut v: Vec<(f64, f64)> = points
         .iter()
         .copied()
@@ -197,7 +197,7 @@ fn error_range(points: &[(f64, f64)]) -> [f64; 2] {
 
 /// Our tree series next to each external one of the same scenario, n and workers, at
 /// [`EQUAL_ERROR`].
-pub fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
+pub(crate) fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
     let (theirs, ours): (Vec<&ThetaAnalysis>, Vec<&ThetaAnalysis>) =
         theta.iter().partition(|t| t.series.kernel.is_external());
     let workers = |t: &ThetaAnalysis| t.series.threads.unwrap_or(1) * t.series.ranks.unwrap_or(1);

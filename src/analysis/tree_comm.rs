@@ -28,7 +28,7 @@ use serde::Serialize;
 pub const TOP_LEVELS: u32 = 3;
 
 /// The three decompositions a galaxy can run under.
-pub const TREE_DECOMPS: [Decomposition; 3] = [
+pub(crate) const TREE_DECOMPS: [Decomposition; 3] = [
     Decomposition::Allgather,
     Decomposition::Octants,
     Decomposition::Tree,
@@ -41,20 +41,20 @@ pub struct Counted {
     pub n: usize,
     pub decomp: Decomposition,
     /// Mean and largest over the ranks of the bytes sent per step.
-    pub bytes_mean: f64,
-    pub bytes_max: f64,
+    pub(crate) bytes_mean: f64,
+    pub(crate) bytes_max: f64,
     pub messages: f64,
     /// Max over mean of the bodies per rank (the load imbalance of the concentrated cloud).
-    pub bodies_imbalance: f64,
+    pub(crate) bodies_imbalance: f64,
 }
 
 /// One transport: its α-β fit, and per decomposition and rank count the predicted seconds
 /// next to the measured ones.
 #[derive(Clone, Debug, Serialize)]
-pub struct Transport {
+pub(crate) struct Transport {
     pub name: String,
     pub bench: String,
-    pub alpha_beta: Fitted<AlphaBetaFit>,
+    pub(crate) alpha_beta: Fitted<AlphaBetaFit>,
     pub sweep: Option<String>,
     pub rows: Vec<Row>,
 }
@@ -64,15 +64,15 @@ pub struct Row {
     pub ranks: usize,
     pub n: usize,
     pub decomp: Decomposition,
-    pub predicted_bytes: f64,
-    pub predicted_s: f64,
-    pub predicted_ci95: [f64; 2],
+    pub(crate) predicted_bytes: f64,
+    pub(crate) predicted_s: f64,
+    pub(crate) predicted_ci95: [f64; 2],
     /// Measured by the sweep under this transport (mean over ranks, per step): bytes sent, time
     /// inside MPI, and of it the transfer (without the estimated wait for slower ranks), which
     /// is what the α-β model predicts.
-    pub measured_bytes: Option<f64>,
-    pub measured_s: Option<f64>,
-    pub measured_transfer_s: Option<f64>,
+    pub(crate) measured_bytes: Option<f64>,
+    pub(crate) measured_s: Option<f64>,
+    pub(crate) measured_transfer_s: Option<f64>,
     pub compute_imbalance: Option<f64>,
     pub oversubscribed: bool,
 }
@@ -86,12 +86,12 @@ impl Row {
 }
 
 #[derive(Clone, Debug, Serialize)]
-pub struct TreeComm {
-    pub n_per_rank: usize,
+pub(crate) struct TreeComm {
+    pub(crate) n_per_rank: usize,
     pub theta: f64,
     pub leaf_size: usize,
     pub counted: Vec<Counted>,
-    pub transports: Vec<Transport>,
+    pub(crate) transports: Vec<Transport>,
 }
 
 fn log2_ceil(p: usize) -> f64 {
@@ -163,7 +163,7 @@ fn count_one(p: usize, n: usize, seed: u64, theta: f64, leaf: usize) -> Vec<Coun
 /// The model and the measured side by side: `benches` are (path, file) of `mpi-bench` runs,
 /// `sweeps` (name, points) of weak-scaling sweeps of the galaxy; a TCP bench goes with the
 /// sweep whose name ends in `-tcp`, the other with the rest.
-pub fn tree_comm(
+pub(crate) fn tree_comm(
     n_per_rank: usize,
     theta: f64,
     leaf_size: usize,

@@ -44,19 +44,19 @@ pub struct Calibration {
     pub fma_gflops_1t: f64,
     /// Throughput ratio of `p` threads to one thread on the FMA loop, one entry per requested
     /// thread count that could be measured, in the order requested.
-    pub parallel_ceiling: Vec<ThreadRatio>,
+    pub(crate) parallel_ceiling: Vec<ThreadRatio>,
     /// Median wall time of one rayon fork/join region on [`Self::fork_join_threads`] threads
     /// whose workers were idle (asleep) beforehand, as at the start of a step, in µs.
-    pub fork_join_us: f64,
+    pub(crate) fork_join_us: f64,
     /// The same with the workers still awake from the previous region (back-to-back regions).
-    pub fork_join_hot_us: f64,
+    pub(crate) fork_join_hot_us: f64,
     /// Pool size the fork/join costs were measured with.
-    pub fork_join_threads: usize,
+    pub(crate) fork_join_threads: usize,
     /// Single-thread streaming read bandwidth from memory, in GB/s (10⁹ bytes per second);
     /// 0 if the buffer could not be allocated (see `warnings`).
-    pub memory_bandwidth_gbs: f64,
+    pub(crate) memory_bandwidth_gbs: f64,
     /// Wall time of the whole calibration, in seconds.
-    pub duration_s: f64,
+    pub(crate) duration_s: f64,
     /// CPUs' worth of time that other processes (or the hypervisor, as steal time) used while
     /// calibrating, from `/proc/stat`; `None` where that is unavailable. Anything well above 0
     /// means the figures, the parallel ceiling first, are understated.
@@ -67,7 +67,7 @@ pub struct Calibration {
 
 /// The parallel ceiling at one thread count.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
-pub struct ThreadRatio {
+pub(crate) struct ThreadRatio {
     pub threads: usize,
     /// Total work rate with `threads` threads over the rate with one thread.
     pub ratio: f64,
@@ -77,13 +77,13 @@ pub struct ThreadRatio {
 
 /// How long each measurement may take, and how big the memory buffer is.
 #[derive(Clone, Debug, PartialEq)]
-pub struct CalibrationOptions {
+pub(crate) struct CalibrationOptions {
     /// Time budget of each measurement (FMA, each thread count, fork/join, bandwidth). A
     /// measurement always runs a few repetitions, so with tiny budgets it overruns them.
     pub budget: Duration,
     /// Size of the buffer streamed for the read bandwidth; must be well beyond the last-level
     /// cache for the figure to mean memory bandwidth.
-    pub memory_bytes: usize,
+    pub(crate) memory_bytes: usize,
 }
 
 impl Default for CalibrationOptions {
@@ -139,7 +139,7 @@ pub fn calibrate(threads: &[usize]) -> Calibration {
 }
 
 /// Calibrates, measuring the parallel ceiling at each of `threads`.
-pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibration {
+pub(crate) fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibration {
     let start = Instant::now();
     let ticks_before = cpu_ticks();
     let logical_cpus = std::thread::available_parallelism().map_or(1, |n| n.get());

@@ -18,7 +18,7 @@ pub enum Code {
 impl Code {
     /// The built-in kernel of this name, else the external program of that name (a config
     /// never gives an external a kernel's name).
-    pub fn from_name(name: &str) -> Code {
+    pub(crate) fn from_name(name: &str) -> Code {
         match KernelKind::ALL.iter().find(|k| k.name() == name) {
             Some(&k) => Code::Kernel(k),
             None => Code::External(name.to_string()),

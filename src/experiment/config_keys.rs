@@ -4,7 +4,7 @@
 
 /// The dotted key a parse error at byte `offset` of `text` is about: the nearest `key =` at or
 /// above the offset, prefixed by the table header it sits under.
-pub fn key_at(text: &str, offset: usize) -> Option<String> {
+pub(crate) fn key_at(text: &str, offset: usize) -> Option<String> {
     let upto = &text[..line_end(text, offset)];
     let mut key = None;
     for line in upto.lines().rev() {
@@ -53,7 +53,7 @@ fn assigned_key(line: &str) -> Option<&str> {
 }
 
 /// The forms `n` takes.
-pub const COUNTS_FORMS: &str = "a list of whole numbers, such as n = [1000, 2000], or a \
+pub(crate) const COUNTS_FORMS: &str = "a list of whole numbers, such as n = [1000, 2000], or a \
     geometric range, such as n = { from = 1000, to = 32000, factor = 2 }";
 
 /// What a key accepts, as a user would write it; `None` for a key the config does not have.

@@ -37,7 +37,7 @@ const PROBE_ERROR_SAMPLE: usize = 64;
 /// reductions take the rest.
 pub const EXTRA_THREAD_GAIN: f64 = 0.9;
 /// Starting an MPI job (launcher, ranks, MPI initialization) and reading its result, seconds.
-pub const MPI_LAUNCH_S: f64 = 0.5;
+pub(crate) const MPI_LAUNCH_S: f64 = 0.5;
 /// Per round of a case: its thread pool, the results file saved after it, the progress line
 /// and its share of the analysis at the end: a rough allowance, not measured separately.
 const ROUND_OVERHEAD_S: f64 = 0.01;
@@ -55,16 +55,16 @@ pub struct Probe {
     /// probe the simulation starts with.
     pub build_s: f64,
     /// One force computation with energy accounting (a round takes three).
-    pub energy_s: f64,
+    pub(crate) energy_s: f64,
     /// The force phase of a step.
     pub force_s: f64,
     /// The rest of a step: integration, walls, reordering.
-    pub other_s: f64,
+    pub(crate) other_s: f64,
     /// Candidate pairs examined per step (decides whether a step forks threads).
     pub pair_checks: f64,
     /// Seconds per sampled particle and source of the f64 force-error check, when the sweep
     /// measures it.
-    pub error_pair_s: Option<f64>,
+    pub(crate) error_pair_s: Option<f64>,
 }
 
 impl Probe {

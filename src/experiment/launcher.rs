@@ -16,7 +16,7 @@ use std::process::Command;
 use thiserror::Error;
 
 #[derive(Debug, Error)]
-pub enum LaunchError {
+pub(crate) enum LaunchError {
     #[error("`{command}`: {source}; is the MPI launcher installed and on PATH?")]
     Spawn {
         command: String,
@@ -70,7 +70,7 @@ struct EnergyRecord {
 }
 
 /// The launcher's arguments for one round of `case`, writing its result to `json`.
-pub fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> Vec<String> {
+pub(crate) fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> Vec<String> {
     let mut a: Vec<String> = launch.args.clone();
     a.push(launch.rank_flag.clone());
     a.push(case.ranks.to_string());
@@ -112,7 +112,11 @@ pub fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Path) -> 
 }
 
 /// A round from a run's result: its timed steps grouped into `samples` samples.
-pub fn round_from_json(text: &str, samples: usize, warmup: u64) -> Result<RoundOutcome, String> {
+pub(crate) fn round_from_json(
+    text: &str,
+    samples: usize,
+    warmup: u64,
+) -> Result<RoundOutcome, String> {
     let run: RunRecord = serde_json::from_str(text).map_err(|e| e.to_string())?;
     let step_ns = &run.mpi.step_ns;
     let samples = samples.max(1);
@@ -170,7 +174,7 @@ pub fn round_from_json(text: &str, samples: usize, warmup: u64) -> Result<RoundO
 /// link where the run writes (a predictable name in a shared `/tmp` let one overwrite any file
 /// of the user running the sweep). It and its contents are removed when dropped, after a
 /// round as after a failed one, and by the interrupt handler.
-pub fn private_dir() -> Result<crate::output::TemporaryDir, LaunchError> {
+pub(crate) fn private_dir() -> Result<crate::output::TemporaryDir, LaunchError> {
     crate::output::TemporaryDir::new("nbody-bench-round-").map_err(|source| LaunchError::TempDir {
         dir: std::env::temp_dir(),
         source,
@@ -182,7 +186,7 @@ pub fn private_dir() -> Result<crate::output::TemporaryDir, LaunchError> {
 const LAUNCH_LIMIT: std::time::Duration = std::time::Duration::from_secs(7 * 24 * 3600);
 
 /// Launches one round of `case` and reads its result.
-pub fn measure_round(
+pub(crate) fn measure_round(
     launch: &MpiLaunch,
     case: &Case,
     spec: &RoundSpec,

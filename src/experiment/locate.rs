@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// The sub-directory of the results root that holds user runs.
-pub const RUNS_DIR: &str = "runs";
+pub(crate) const RUNS_DIR: &str = "runs";
 
 /// Where configs named without a path are looked up: `configs/` where the user stands.
 fn config_dirs() -> Vec<PathBuf> {

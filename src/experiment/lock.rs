@@ -28,13 +28,13 @@ pub enum LockError {
 
 /// The lock on one results file, released (and its file removed) when dropped.
 #[derive(Debug)]
-pub struct WriterLock {
+pub(crate) struct WriterLock {
     path: PathBuf,
     file: File,
 }
 
 /// `dir/.results.json.lock` for `dir/results.json`.
-pub fn lock_path(results: &Path) -> PathBuf {
+pub(crate) fn lock_path(results: &Path) -> PathBuf {
     let name = results
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
@@ -44,7 +44,7 @@ pub fn lock_path(results: &Path) -> PathBuf {
 
 impl WriterLock {
     /// Takes the lock of `results` (whose directory must exist), or says who holds it.
-    pub fn acquire(results: &Path) -> Result<WriterLock, LockError> {
+    pub(crate) fn acquire(results: &Path) -> Result<WriterLock, LockError> {
         let path = lock_path(results);
         let io = |source| LockError::Io {
             path: path.clone(),
@@ -113,7 +113,7 @@ impl Drop for WriterLock {
 
 /// Keeps `path` under a new `.bak` name beside it, `<name>.<stamp>.bak` (`-2`, `-3`, ... when
 /// taken): a backup never replaces another. Returns the backup's path.
-pub fn back_up(path: &Path, stamp: &str) -> std::io::Result<PathBuf> {
+pub(crate) fn back_up(path: &Path, stamp: &str) -> std::io::Result<PathBuf> {
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

@@ -15,7 +15,7 @@ use serde::{Deserialize, Serialize};
 
 /// How one round of a case is measured.
 #[derive(Clone, Debug)]
-pub struct RoundSpec {
+pub(crate) struct RoundSpec {
     pub samples: usize,
     pub warmup_s: f64,
     pub min_sample_s: f64,
@@ -54,7 +54,7 @@ pub struct RoundOutcome {
     /// Particles actually simulated (fewer than asked only with `allow_fewer`).
     pub n: usize,
     /// Cost of one clock reading relative to the median step (the timing overhead).
-    pub clock_overhead: f64,
+    pub(crate) clock_overhead: f64,
     /// Mean wall time of one repetition of the reference workload on the case's threads, timed
     /// right before each sample (one value per sample, in the same order), seconds; empty when
     /// not asked.
@@ -74,7 +74,7 @@ pub struct RoundOutcome {
 
 /// Measures one round of `case` (a built-in kernel's: external programs are measured by
 /// `experiment::external`) on the system of `setup`.
-pub fn measure_round<C: Clock>(
+pub(crate) fn measure_round<C: Clock>(
     setup: &Setup,
     case: &Case,
     kernel: crate::kernels::KernelKind,

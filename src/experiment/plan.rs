@@ -83,7 +83,7 @@ impl Case {
 }
 
 /// Whether `m` is the default order (left out of case files and keys).
-pub fn is_monopole(m: &Multipole) -> bool {
+pub(crate) fn is_monopole(m: &Multipole) -> bool {
     *m == Multipole::Monopole
 }
 
@@ -261,7 +261,7 @@ fn external_cases(config: &SweepConfig, out: &mut Vec<Case>) {
 /// n (and simulated-time factor) at `p` threads so that the work per thread stays that of
 /// `base_n` on one thread. An external program (`None`) has no known cost model: its config
 /// names a rule (validation refuses `cost-model` for it), and `cost-model` reads as linear.
-pub fn weak_size(
+pub(crate) fn weak_size(
     kernel: Option<KernelKind>,
     rule: WeakRule,
     base_n: usize,

@@ -16,7 +16,7 @@ pub fn for_stderr() -> Box<dyn Observer> {
 }
 
 #[derive(Default)]
-pub struct Bar {
+pub(crate) struct Bar {
     bar: Option<ProgressBar>,
 }
 
@@ -53,7 +53,7 @@ impl Observer for Bar {
 }
 
 #[derive(Default)]
-pub struct Lines {
+pub(crate) struct Lines {
     total: usize,
     done: usize,
 }

@@ -35,7 +35,7 @@ const MIN_REPETITIONS: usize = 3;
 /// Runs repetitions of the reference workload on every thread of the current rayon pool until
 /// `budget_s` has passed (at least [`MIN_REPETITIONS`]); returns the mean wall time of one
 /// repetition, seconds.
-pub fn time_reference<C: Clock>(clock: &C, budget_s: f64) -> f64 {
+pub(crate) fn time_reference<C: Clock>(clock: &C, budget_s: f64) -> f64 {
     let start = clock.now();
     let mut reps = 0;
     while reps < MIN_REPETITIONS || (clock.now() - start).as_secs_f64() < budget_s {
@@ -74,7 +74,7 @@ fn particles() -> &'static Particles {
 
 /// One repetition: the softened 1/r² field at the first [`TARGETS`] particles from all
 /// [`SOURCES`], compiled for the kernels' instruction set; returns a checksum.
-pub fn reference_work() -> f32 {
+pub(crate) fn reference_work() -> f32 {
     let p = particles();
     simd::dispatch(
         #[inline(always)]

@@ -41,7 +41,7 @@ impl Calibrations {
     /// can do; another process or the hypervisor taking a core during one measurement only
     /// lowers it (a start calibration once read 1.01x at two threads between two readings of
     /// 1.98x), so the larger reading is the better estimate.
-    pub fn for_analysis(&self) -> Option<Calibration> {
+    pub(crate) fn for_analysis(&self) -> Option<Calibration> {
         let mut c = self.start.clone().or_else(|| self.end.clone())?;
         if let (Some(_), Some(end)) = (&self.start, &self.end) {
             for r in &mut c.parallel_ceiling {
@@ -65,7 +65,7 @@ pub struct Metadata {
     /// Instruction set the pair loops ran with, and the target features compiled in.
     pub simd: String,
     pub target_features: Vec<String>,
-    pub cargo_features: Vec<String>,
+    pub(crate) cargo_features: Vec<String>,
     pub profile: String,
     pub host: String,
     pub os: String,
@@ -109,8 +109,8 @@ pub struct Summary {
     pub median_s: f64,
     pub ci95_s: [f64; 2],
     pub mad_s: f64,
-    pub min_s: f64,
-    pub mean_s: f64,
+    pub(crate) min_s: f64,
+    pub(crate) mean_s: f64,
     pub samples: usize,
     /// Per-step percentiles from the histogram, nanoseconds.
     pub step_ns: StepPercentiles,
@@ -121,21 +121,21 @@ pub struct Summary {
     pub phases: PhaseTimes,
     /// Work per step.
     pub pair_checks_per_step: f64,
-    pub cells_visited_per_step: f64,
-    pub nodes_opened_per_step: f64,
-    pub nodes_accepted_per_step: f64,
+    pub(crate) cells_visited_per_step: f64,
+    pub(crate) nodes_opened_per_step: f64,
+    pub(crate) nodes_accepted_per_step: f64,
     /// Verlet list: rebuilds and list entries per step.
     #[serde(default)]
-    pub rebuilds_per_step: f64,
+    pub(crate) rebuilds_per_step: f64,
     #[serde(default)]
-    pub list_entries_per_step: f64,
+    pub(crate) list_entries_per_step: f64,
     pub pairs_interacting: u64,
     /// Largest |energy drift| of any round, and whether it exceeded the config's limit.
     pub max_energy_drift: f64,
     pub sanity_ok: bool,
     pub force_error: Option<[f64; 2]>,
     /// Largest timing overhead (clock readings) relative to the median step.
-    pub clock_overhead: f64,
+    pub(crate) clock_overhead: f64,
 }
 
 #[derive(Debug, Error)]
@@ -221,7 +221,7 @@ impl ResultsFile {
         Ok(())
     }
 
-    pub fn record_mut(&mut self, key: &str) -> Option<&mut CaseRecord> {
+    pub(crate) fn record_mut(&mut self, key: &str) -> Option<&mut CaseRecord> {
         self.cases.iter_mut().find(|c| c.key == key)
     }
 }
@@ -248,7 +248,7 @@ impl CaseRecord {
     }
 
     /// Adds a measured round and recomputes the summary from all raw values.
-    pub fn add_round(&mut self, round: RoundOutcome, max_drift: f64) {
+    pub(crate) fn add_round(&mut self, round: RoundOutcome, max_drift: f64) {
         let mut hist = StepHistogram::from_counts(&self.step_histogram);
         for &ns in &round.step_ns {
             hist.record(ns);
@@ -258,7 +258,7 @@ impl CaseRecord {
 
     /// Adds every round of `other`, the same case measured by another sweep (an A/B gate's
     /// one-case runs), with its step-time histogram.
-    pub fn absorb(&mut self, other: CaseRecord, max_drift: f64) {
+    pub(crate) fn absorb(&mut self, other: CaseRecord, max_drift: f64) {
         let mut hist = StepHistogram::from_counts(&self.step_histogram);
         for &[value, count] in &other.step_histogram {
             hist.record_n(value, count);

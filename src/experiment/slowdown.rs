@@ -12,14 +12,14 @@ use crate::kernels::KernelKind;
 use std::fmt;
 
 /// The environment variable the knob is read from.
-pub const SLOWDOWN_ENV: &str = "NBODY_BENCH_TEST_SLOWDOWN";
+pub(crate) const SLOWDOWN_ENV: &str = "NBODY_BENCH_TEST_SLOWDOWN";
 
 /// Largest accepted factor (a mistyped one should not make a sweep run for hours).
 const MAX_FACTOR: f64 = 100.0;
 
 /// One kernel's force computation made `factor` times as long.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct TestSlowdown {
+pub(crate) struct TestSlowdown {
     pub kernel: KernelKind,
     pub factor: f64,
 }
@@ -32,7 +32,7 @@ impl fmt::Display for TestSlowdown {
 
 impl TestSlowdown {
     /// The knob from the environment: `None` when unset or empty.
-    pub fn from_env() -> Result<Option<TestSlowdown>, String> {
+    pub(crate) fn from_env() -> Result<Option<TestSlowdown>, String> {
         match std::env::var(SLOWDOWN_ENV) {
             Ok(v) if !v.trim().is_empty() => Self::parse(&v).map(Some),
             _ => Ok(None),
@@ -63,7 +63,7 @@ impl TestSlowdown {
 
     /// How many times as long `kernel`'s timed force computations are to take (1 for a
     /// kernel the knob does not name); the engine's `kernels::repeated` does it.
-    pub fn factor_for(&self, kernel: KernelKind) -> f64 {
+    pub(crate) fn factor_for(&self, kernel: KernelKind) -> f64 {
         if self.kernel == kernel {
             self.factor
         } else {

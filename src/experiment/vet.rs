@@ -12,10 +12,10 @@ use serde::{Deserialize, Serialize};
 
 /// The longest time a step can take, seconds (about 116 days): a longer one is a unit or
 /// parsing error, and would overflow the nanosecond figures derived from it.
-pub const MAX_STEP_S: f64 = 1e7;
+pub(crate) const MAX_STEP_S: f64 = 1e7;
 /// The shortest (a picosecond, under one clock cycle): a shorter one is a unit error, and the
 /// rates derived from it (particle-steps per second) would overflow.
-pub const MIN_STEP_S: f64 = 1e-12;
+pub(crate) const MIN_STEP_S: f64 = 1e-12;
 
 /// A value taken out of a round, and why.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -30,7 +30,7 @@ pub struct Rejected {
 }
 
 /// `seconds` as a time per step, or why it cannot be one.
-pub fn step_time(seconds: f64) -> Result<f64, String> {
+pub(crate) fn step_time(seconds: f64) -> Result<f64, String> {
     if !seconds.is_finite() {
         Err("not a finite number".into())
     } else if seconds <= 0.0 {

@@ -2,7 +2,9 @@
 //! β, fitted on relative residuals so that small messages (which fix α) count as much as large
 //! ones (which fix β). Used to predict communication time beyond the sizes measured.
 
-use super::bootstrap::{bootstrap, estimate, percentile_ci};
+#[cfg(test)]
+use super::bootstrap::percentile_ci;
+use super::bootstrap::{bootstrap, estimate};
 use super::linear::{self, Goodness};
 use super::{CiMethod, Estimate, FitError, Input, RESAMPLES, Samples, XRule, prepare};
 use serde::Serialize;
@@ -10,13 +12,13 @@ use serde::Serialize;
 const MODEL: &str = "alpha-beta";
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct AlphaBetaFit {
+pub(crate) struct AlphaBetaFit {
     /// x = bytes, the median seconds per message and sample count at each size.
     pub inputs: Vec<Input>,
     /// Latency, seconds.
     pub alpha: Estimate,
     /// Seconds per byte.
-    pub beta: Estimate,
+    pub(crate) beta: Estimate,
     /// `1/β`, bytes per second (infinite, JSON null, when β's interval reaches 0).
     pub bandwidth: Estimate,
     /// Fit to the medians (r² on relative residuals).
@@ -30,10 +32,11 @@ pub struct AlphaBetaFit {
 }
 
 impl AlphaBetaFit {
+    #[cfg(test)]
     /// Predicted seconds for one message of `bytes`, with the 95% interval of the fitted line
     /// there (parameter uncertainty; a single message scatters more). Far beyond the measured
     /// sizes the interval only says how well the line is known, not that the line still holds.
-    pub fn predict(&self, bytes: f64) -> (f64, [f64; 2]) {
+    pub(crate) fn predict(&self, bytes: f64) -> (f64, [f64; 2]) {
         let point = self.alpha.estimate + self.beta.estimate * bytes;
         let band = percentile_ci(self.replicates.iter().map(|[a, b]| a + b * bytes));
         (point, band.unwrap_or([point, point]))
@@ -54,7 +57,7 @@ fn identity(bytes: f64) -> f64 {
 
 /// Fits `t = α + β·bytes` to samples at x = message size in bytes (>= 0), values = seconds per
 /// message. Needs 2 distinct sizes (3 when some size has a single sample).
-pub fn fit_alpha_beta(samples: &[Samples], seed: u64) -> Result<AlphaBetaFit, FitError> {
+pub(crate) fn fit_alpha_beta(samples: &[Samples], seed: u64) -> Result<AlphaBetaFit, FitError> {
     let data = prepare(MODEL, samples, XRule::NonNegative, 2)?;
     let line = |t: &[f64]| -> Option<[f64; 2]> {
         let beta = linear::fit_relative(&[&one, &identity], &data.xs, t)?;

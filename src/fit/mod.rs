@@ -29,19 +29,16 @@ pub mod weak;
 
 pub use crate::stats::BOOTSTRAP_RESAMPLES as RESAMPLES;
 pub use bootstrap::CiMethod;
-pub use comm::{AlphaBetaFit, fit_alpha_beta};
-pub use karp_flatt::{KarpFlattPoint, KarpFlattTrend, Trend};
-pub use linear::Goodness;
-pub use overhead::{OverheadCandidate, OverheadSelection, OverheadTerm, OverheadTermFit};
-pub use power::{ClassCandidate, ComplexityClass, PowerFit, SelectedClass, crossover, fit_power};
-pub use strong::{StrongFit, StrongPoint, fit_strong};
-pub use timed::{
+pub(crate) use comm::{AlphaBetaFit, fit_alpha_beta};
+pub(crate) use power::crossover;
+pub use power::{ComplexityClass, PowerFit, fit_power};
+pub(crate) use strong::StrongPoint;
+pub use strong::{StrongFit, fit_strong};
+pub(crate) use timed::{
     SerialFractionComparison, TimedSerialFraction, compare_serial_fractions, timed_serial_fraction,
 };
-pub use weak::{
-    EfficiencyPoint, ScaledSpeedupPoint, WeakFit, WeakSamples, WorkPerWorker, fit_weak,
-    fit_weak_with_n,
-};
+pub(crate) use weak::{EfficiencyPoint, WeakSamples};
+pub use weak::{WeakFit, fit_weak, fit_weak_with_n};
 
 use serde::Serialize;
 use thiserror::Error;

@@ -117,13 +117,8 @@ pub struct PowerFit {
 
 impl PowerFit {
     /// Time predicted at `n` by the selected class model (the one to extrapolate with).
-    pub fn predict(&self, n: f64) -> f64 {
+    pub(crate) fn predict(&self, n: f64) -> f64 {
         self.selected.constant.estimate + self.selected.coefficient.estimate * self.class.g(n)
-    }
-
-    /// Time predicted at `n` by the free power law `c·n^k`.
-    pub fn predict_power_law(&self, n: f64) -> f64 {
-        self.coefficient.estimate * n.powf(self.exponent.estimate)
     }
 }
 
@@ -209,7 +204,7 @@ pub fn fit_power(samples: &[Samples], seed: u64) -> Result<PowerFit, FitError> {
 
 /// The worst leave-one-out SMAPE, percent, at which a selected class still describes the
 /// data; the committed sweeps' selections miss by 25 % at most.
-pub const MAX_CLASS_SMAPE_PERCENT: f64 = 50.0;
+pub(crate) const MAX_CLASS_SMAPE_PERCENT: f64 = 50.0;
 
 /// A selection the data cannot support is an error, not a result: times that do not grow
 /// with n fit no growth class (the least bad one would be "chosen" all the same), and a class
@@ -237,7 +232,7 @@ fn refuse_unsupported(k: f64, chosen: &ClassCandidate) -> Result<(), FitError> {
 /// The n in `[lo, hi]` where the fitted curves ([`PowerFit::predict`]) of two kernels cross,
 /// the first crossing when there are several; `None` when they do not cross in the range (or
 /// the range is not `0 < lo < hi`).
-pub fn crossover(a: &PowerFit, b: &PowerFit, lo: f64, hi: f64) -> Option<f64> {
+pub(crate) fn crossover(a: &PowerFit, b: &PowerFit, lo: f64, hi: f64) -> Option<f64> {
     if !(lo > 0.0 && hi > lo && hi.is_finite()) {
         return None;
     }

@@ -41,7 +41,7 @@ pub struct StrongFit {
     /// Amdahl's serial fraction f, clamped to [0, 1] (see `clamped`).
     pub serial_fraction: Estimate,
     /// f as fitted, which can leave [0, 1] (superlinear speedup gives f < 0).
-    pub serial_fraction_unclamped: Estimate,
+    pub(crate) serial_fraction_unclamped: Estimate,
     /// Whether the estimate or an end of its interval was clamped to [0, 1].
     pub clamped: bool,
     /// `1/f`, the speedup Amdahl's law allows at any p; infinite (JSON null) when f reaches 0.
@@ -61,14 +61,15 @@ pub struct StrongFit {
 }
 
 impl StrongFit {
+    #[cfg(test)]
     /// Amdahl's time at any p with its 95% band (pointwise, from the replicates).
-    pub fn amdahl_time(&self, p: f64) -> (f64, [f64; 2]) {
+    pub(crate) fn amdahl_time(&self, p: f64) -> (f64, [f64; 2]) {
         let at = |[t1, f]: [f64; 2]| t1 * (f + (1.0 - f) / p);
         self.curve(at)
     }
 
     /// Amdahl's speedup `1/(f + (1−f)/p)` at any p with its 95% band.
-    pub fn amdahl_speedup(&self, p: f64) -> (f64, [f64; 2]) {
+    pub(crate) fn amdahl_speedup(&self, p: f64) -> (f64, [f64; 2]) {
         self.curve(|[_, f]| 1.0 / (f + (1.0 - f) / p))
     }
 

@@ -1,6 +1,7 @@
 use super::*;
+use crate::fit::karp_flatt::Trend;
+use crate::fit::overhead::OverheadTerm;
 use crate::fit::synthetic::{THREADS, count, noisy};
-use crate::fit::{OverheadTerm, Trend};
 
 fn amdahl(t1: f64, f: f64) -> impl Fn(f64) -> f64 {
     move |p| t1 * (f + (1.0 - f) / p)

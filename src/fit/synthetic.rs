@@ -7,7 +7,7 @@ use rand_distr::{Distribution, Normal};
 use rand_pcg::Pcg64Mcg;
 
 /// `per_x` samples of `model(x)` at every x, each times `exp(sigma · z)` with z ~ N(0, 1).
-pub fn noisy(
+pub(crate) fn noisy(
     xs: &[f64],
     per_x: usize,
     sigma: f64,
@@ -32,4 +32,4 @@ pub fn count(trials: u64, check: impl Fn(u64) -> bool) -> u64 {
 }
 
 /// The thread counts most scaling studies use.
-pub const THREADS: [f64; 5] = [1.0, 2.0, 4.0, 8.0, 16.0];
+pub(crate) const THREADS: [f64; 5] = [1.0, 2.0, 4.0, 8.0, 16.0];

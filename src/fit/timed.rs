@@ -9,16 +9,16 @@ use serde::Serialize;
 
 /// `f_timed = Σ serial / (Σ serial + Σ parallelisable)` of a one-worker run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub struct TimedSerialFraction {
-    pub serial_s: f64,
-    pub parallel_s: f64,
+pub(crate) struct TimedSerialFraction {
+    pub(crate) serial_s: f64,
+    pub(crate) parallel_s: f64,
     pub total_s: f64,
     pub fraction: f64,
 }
 
 /// The timed and the fitted serial fraction side by side.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct SerialFractionComparison {
+pub(crate) struct SerialFractionComparison {
     pub timed: f64,
     pub fitted: Estimate,
     /// `fitted − timed`, a fraction of the one-worker time.
@@ -26,13 +26,13 @@ pub struct SerialFractionComparison {
     /// Whether the timed fraction lies inside the fitted one's 95% interval.
     pub agree: bool,
     /// A sentence for a report saying what the difference means.
-    pub explanation: String,
+    pub(crate) explanation: String,
 }
 
 /// The serial fraction of a one-worker run from its phase times (seconds): the phases that
 /// stay serial and those that parallelise. When only the total was measured besides the serial
 /// phases, pass `total − Σ serial` as the one parallel phase.
-pub fn timed_serial_fraction(
+pub(crate) fn timed_serial_fraction(
     serial_s: &[f64],
     parallel_s: &[f64],
 ) -> Result<TimedSerialFraction, FitError> {
@@ -59,7 +59,7 @@ pub fn timed_serial_fraction(
 }
 
 /// Compares the timed serial fraction with the one fitted to the speedups.
-pub fn compare_serial_fractions(
+pub(crate) fn compare_serial_fractions(
     timed: &TimedSerialFraction,
     fitted: &Estimate,
 ) -> SerialFractionComparison {

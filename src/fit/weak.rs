@@ -5,7 +5,9 @@
 //! α is fitted by least squares on S with weights 1/p² (the noise of S grows like p), through
 //! the point `S(1) = 1` that the model passes by construction.
 
-use super::bootstrap::{bootstrap, estimate, percentile_ci};
+#[cfg(test)]
+use super::bootstrap::percentile_ci;
+use super::bootstrap::{bootstrap, estimate};
 use super::linear::Goodness;
 use super::power::ComplexityClass;
 use super::{CiMethod, Estimate, FitError, Input, RESAMPLES, Samples, XRule, clamp_unit, prepare};
@@ -54,7 +56,7 @@ pub struct WeakFit {
     pub scaled_speedup: Vec<ScaledSpeedupPoint>,
     /// Gustafson's α, clamped to [0, 1] (see `clamped`).
     pub serial_fraction: Estimate,
-    pub serial_fraction_unclamped: Estimate,
+    pub(crate) serial_fraction_unclamped: Estimate,
     pub clamped: bool,
     /// Fit of `p − α(p − 1)` to the measured scaled speedups (r² weighted by 1/p²).
     pub goodness: Goodness,
@@ -71,8 +73,9 @@ pub struct WeakFit {
 }
 
 impl WeakFit {
+    #[cfg(test)]
     /// Gustafson's scaled speedup `p − α(p − 1)` at any p with its 95% band.
-    pub fn scaled_speedup_curve(&self, p: f64) -> (f64, [f64; 2]) {
+    pub(crate) fn scaled_speedup_curve(&self, p: f64) -> (f64, [f64; 2]) {
         let at = |a: f64| p - a * (p - 1.0);
         let point = at(self.serial_fraction.estimate);
         let band = percentile_ci(self.replicates.iter().map(|&a| at(a)));

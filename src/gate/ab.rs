@@ -167,10 +167,10 @@ pub fn prepare(
 
 /// Floor of a child's time limit: starting a sweep, building its system and its energy
 /// probes take seconds even for a tiny case, on a machine busy with other work too.
-pub const CHILD_FLOOR: Duration = Duration::from_secs(120);
+pub(crate) const CHILD_FLOOR: Duration = Duration::from_secs(120);
 /// A child's limit is this many times its estimate (the estimate is a rule of thumb from a
 /// probe at small n; a shared 2-vCPU machine runs the same code up to 3x slower under load).
-pub const CHILD_ESTIMATE_FACTOR: f64 = 10.0;
+pub(crate) const CHILD_ESTIMATE_FACTOR: f64 = 10.0;
 /// Runs of an external program in one round besides its samples: the set-up, the empty runs
 /// that measure the launch overhead, and slack for its warm-up runs.
 const EXTERNAL_EXTRA_RUNS: usize = 12;

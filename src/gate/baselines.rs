@@ -13,8 +13,6 @@ use thiserror::Error;
 pub struct Chosen {
     pub path: PathBuf,
     pub file: ResultsFile,
-    /// Whether it was measured on the machine class asked for.
-    pub same_class: bool,
 }
 
 #[derive(Debug, Error)]
@@ -61,18 +59,10 @@ pub fn choose(dir: &Path, here: &RunInfo) -> Result<Chosen, BaselinesError> {
         .into_iter()
         .partition(|(_, f)| RunInfo::of(f).machine_class_differs(here).is_none());
     if let Some((path, file)) = newest(same) {
-        return Ok(Chosen {
-            path,
-            file,
-            same_class: true,
-        });
+        return Ok(Chosen { path, file });
     }
     match newest(other) {
-        Some((path, file)) => Ok(Chosen {
-            path,
-            file,
-            same_class: false,
-        }),
+        Some((path, file)) => Ok(Chosen { path, file }),
         None => Err(BaselinesError::Empty(dir.to_path_buf())),
     }
 }

@@ -56,7 +56,7 @@ pub const MAX_THRESHOLD: f64 = 1.0;
 pub const MIN_CI_SAMPLES: usize = 6;
 
 /// Schema of the JSON rendering of a [`GateReport`].
-pub const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
+pub(crate) const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
 
 /// How to compare.
 #[derive(Clone, Debug, PartialEq)]
@@ -149,10 +149,10 @@ pub struct CaseComparison {
     pub verdict: Verdict,
     pub normalization: Normalization,
     /// Raw median seconds per step in each run.
-    pub baseline_median_s: f64,
-    pub current_median_s: f64,
+    pub(crate) baseline_median_s: f64,
+    pub(crate) current_median_s: f64,
     /// Ratio of the raw medians, for reference.
-    pub raw_ratio: f64,
+    pub(crate) raw_ratio: f64,
     /// Ratio current / baseline of the normalised medians: the statistic.
     pub ratio: f64,
     /// Bootstrap 95% confidence interval of `ratio`.
@@ -162,7 +162,7 @@ pub struct CaseComparison {
     /// Deterministic work counters that differ between the runs.
     pub work_changes: Vec<WorkChange>,
     /// Whether the kernels' work counters were compared (both runs recorded them).
-    pub work_compared: bool,
+    pub(crate) work_compared: bool,
     /// Anything that weakens the comparison (incomplete case, failed sanity check, ...).
     pub notes: Vec<String>,
 }
@@ -265,7 +265,7 @@ impl GateReport {
         self.cases.iter().filter(|c| c.verdict == verdict).count()
     }
 
-    pub fn work_changed(&self) -> usize {
+    pub(crate) fn work_changed(&self) -> usize {
         self.cases
             .iter()
             .filter(|c| !c.work_changes.is_empty())

@@ -17,7 +17,7 @@ const MAX_MAJOR: usize = 9;
 
 /// An axis ready to draw.
 #[derive(Clone, Debug, PartialEq)]
-pub struct ResolvedAxis {
+pub(crate) struct ResolvedAxis {
     pub scale: Scale,
     pub lo: f64,
     pub hi: f64,
@@ -117,7 +117,7 @@ impl ResolvedAxis {
     }
 
     /// The label of a major tick at `value`, or a freshly formatted one for any other value.
-    pub fn label(&self, value: f64) -> String {
+    pub(crate) fn label(&self, value: f64) -> String {
         let tolerance = 1e-9 * (self.hi - self.lo).abs();
         match self
             .major
@@ -381,7 +381,7 @@ mod tests {
         let r = ResolvedAxis::resolve(&Axis::linear("s"), [0.0, 1.0, 2.0]);
         assert_eq!(r.lo, 0.0);
         assert!(r.major.iter().all(|(v, _)| *v >= 0.0));
-        let r = ResolvedAxis::resolve(&Axis::linear("s").from_zero(), [1.5, 2.0]);
+        let r = ResolvedAxis::resolve(&Axis::linear("s").starting_at_zero(), [1.5, 2.0]);
         assert_eq!(r.lo, 0.0);
     }
 

@@ -24,7 +24,7 @@ fn size(bars: &StackedBars, k: usize, i: usize) -> f64 {
     if v.is_finite() && v > 0.0 { v } else { 0.0 }
 }
 
-pub fn draw(root: &Area, bars: &StackedBars) -> DrawResult {
+pub(crate) fn draw(root: &Area, bars: &StackedBars) -> DrawResult {
     let count = bars.categories.len();
     // Only parts that show somewhere get a legend entry.
     let shown = |k: &usize| (0..count).any(|i| size(bars, *k, i) > 0.0);
@@ -36,7 +36,7 @@ pub fn draw(root: &Area, bars: &StackedBars) -> DrawResult {
         .map(|i| (0..bars.segments.len()).map(|k| size(bars, k, i)).sum())
         .collect();
     let largest = totals.iter().copied().fold(0.0, f64::max);
-    let value_axis = Axis::linear("").unit(bars.value_unit).from_zero();
+    let value_axis = Axis::linear("").unit(bars.value_unit).starting_at_zero();
     let value_axis = if largest > 0.0 {
         value_axis.range(0.0, largest * TOTAL_ROOM)
     } else {

@@ -15,7 +15,7 @@ use super::spec::{Chart, Point, Scale, SeriesStyle};
 const BAND_ALPHA: f64 = 0.18;
 const REGION_ALPHA: f64 = 0.09;
 
-pub fn draw(root: &Area, chart: &Chart) -> DrawResult {
+pub(crate) fn draw(root: &Area, chart: &Chart) -> DrawResult {
     let mut x = ResolvedAxis::resolve(&chart.x, x_values(chart));
     let y = ResolvedAxis::resolve(&chart.y, y_values(chart));
     let page = Page::new(root, &chart.title, &chart.caption, legend(chart))?;

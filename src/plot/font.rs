@@ -9,7 +9,7 @@ use std::sync::{Arc, LazyLock, Once};
 static DEJAVU_SANS: &[u8] = include_bytes!("../../assets/DejaVuSans.ttf");
 
 /// The family name every text style of this module uses.
-pub const FAMILY: &str = "sans-serif";
+pub(crate) const FAMILY: &str = "sans-serif";
 
 /// Registers the font with plotters for the normal and bold styles; later calls do nothing.
 pub fn register() {
@@ -25,7 +25,7 @@ pub fn register() {
 
 /// The only font resvg sees: it stands for every generic family, so the PNG looks the same
 /// on every machine.
-pub static FONTS: LazyLock<Arc<Database>> = LazyLock::new(|| {
+pub(crate) static FONTS: LazyLock<Arc<Database>> = LazyLock::new(|| {
     let mut db = Database::new();
     db.load_font_data(DEJAVU_SANS.to_vec());
     db.set_sans_serif_family("DejaVu Sans");

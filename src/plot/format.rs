@@ -53,7 +53,7 @@ fn scientific(value: f64) -> String {
 }
 
 /// Labels for the ticks of a linear axis whose ticks are multiples of `step`.
-pub fn linear_labels(ticks: &[f64], step: f64, unit: Unit) -> Vec<String> {
+pub(crate) fn linear_labels(ticks: &[f64], step: f64, unit: Unit) -> Vec<String> {
     let magnitude = ticks.iter().fold(0.0f64, |m, t| m.max(t.abs()));
     if wants_scientific(unit, magnitude) {
         return ticks
@@ -81,7 +81,7 @@ pub fn linear_labels(ticks: &[f64], step: f64, unit: Unit) -> Vec<String> {
 }
 
 /// The label of one tick on a logarithmic axis, with the prefix that suits it.
-pub fn log_label(value: f64, unit: Unit) -> String {
+pub(crate) fn log_label(value: f64, unit: Unit) -> String {
     if wants_scientific(unit, value.abs()) || (unit == Unit::Plain && value.abs() >= 1e4) {
         return scientific(value);
     }
@@ -106,7 +106,7 @@ fn significant(value: f64, digits: i32) -> String {
 
 /// Labels for the ticks of a logarithmic axis. Plain numbers switch to scientific notation
 /// for every tick as soon as one needs it, so that `1e-3` does not sit next to `0.01`.
-pub fn log_labels(ticks: &[f64], unit: Unit) -> Vec<String> {
+pub(crate) fn log_labels(ticks: &[f64], unit: Unit) -> Vec<String> {
     let labels: Vec<String> = ticks.iter().map(|&v| log_label(v, unit)).collect();
     if unit == Unit::Plain && labels.iter().any(|l| l.contains('e')) {
         return ticks.iter().map(|&v| scientific(v)).collect();
@@ -115,7 +115,7 @@ pub fn log_labels(ticks: &[f64], unit: Unit) -> Vec<String> {
 }
 
 /// A single value written with its unit for annotations (not ticks): `3.2 ms`, `12k`.
-pub fn value_label(value: f64, unit: Unit) -> String {
+pub(crate) fn value_label(value: f64, unit: Unit) -> String {
     if !value.is_finite() {
         return "-".into();
     }

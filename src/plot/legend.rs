@@ -10,8 +10,8 @@ use super::palette::Marker;
 use super::text::{Area, DrawResult, LEGEND_SIZE, err, style, width, wrap};
 
 const MARKER_RADIUS: i32 = 5;
-pub const LINE_WIDTH: u32 = 3;
-pub const DASH: (i32, i32) = (9, 6);
+pub(crate) const LINE_WIDTH: u32 = 3;
+pub(crate) const DASH: (i32, i32) = (9, 6);
 const SWATCH_WIDTH: i32 = 30;
 const GAP: i32 = 8;
 const PADDING: i32 = 10;
@@ -20,13 +20,13 @@ const LINE_HEIGHT: f64 = 1.25 * LEGEND_SIZE;
 /// The legend never takes more than this share of the figure width.
 const MAX_SHARE: f64 = 0.3;
 
-pub fn rgb((r, g, b): (u8, u8, u8)) -> RGBColor {
+pub(crate) fn rgb((r, g, b): (u8, u8, u8)) -> RGBColor {
     RGBColor(r, g, b)
 }
 
 /// How a legend entry's sample, or a data marker, is drawn.
 #[derive(Clone, Copy, Debug)]
-pub enum Swatch {
+pub(crate) enum Swatch {
     Line {
         color: RGBColor,
         dashed: bool,
@@ -44,7 +44,7 @@ pub enum Swatch {
 
 /// A [`Swatch`] as a plotters element, drawn in pixels centred on one point. It owns nothing
 /// of the backend, so plotters can box it as a legend sample.
-pub struct Glyph<C>(pub C, pub Swatch);
+pub(crate) struct Glyph<C>(pub C, pub Swatch);
 
 impl<'a, C> PointCollection<'a, C> for &'a Glyph<C> {
     type Point = &'a C;
@@ -124,7 +124,7 @@ fn draw_marker<DB: DrawingBackend>(
 }
 
 /// Legend entries laid out for the page: each label in one or two lines.
-pub struct Legend {
+pub(crate) struct Legend {
     entries: Vec<(Vec<String>, Swatch)>,
     /// The width of the legend box in pixels; 0 without entries.
     pub width: u32,
@@ -158,7 +158,7 @@ impl Legend {
     /// Draws the legend in `panel`, `top` pixels below its top edge. The panel gets a chart
     /// of its own with nothing in it but series labels, which plotters lays out and boxes;
     /// each line is a label of its own, and a continued label has no sample.
-    pub fn draw(&self, panel: &Area, top: i32) -> DrawResult {
+    pub(crate) fn draw(&self, panel: &Area, top: i32) -> DrawResult {
         if self.entries.is_empty() {
             return Ok(());
         }

@@ -32,11 +32,8 @@ mod render;
 mod tests;
 mod text;
 
-pub use format::value_label as format_value;
-pub use spec::{
-    Axis, Band, Chart, Point, RefLine, Region, Rendered, Scale, Series, SeriesStyle, StackedBars,
-    Unit,
-};
+pub use spec::{Axis, Chart, Scale, Series, SeriesStyle, Unit};
+pub(crate) use spec::{Rendered, StackedBars};
 
 use std::path::{Path, PathBuf};
 use thiserror::Error;

@@ -10,11 +10,11 @@ use super::axis::ResolvedAxis;
 use super::font::FAMILY;
 use super::legend::{Legend, Swatch};
 use super::text::{AXIS_LABEL_SIZE, CAPTION_SIZE, DrawResult, TEXT_COLOR, TITLE_SIZE, err};
-pub use super::text::{
-    Area, LEGEND_SIZE, MUTED_COLOR, NOTE_SIZE, TICK_SIZE, anchored, shorten, style, width,
-};
+pub(crate) use super::text::{Area, LEGEND_SIZE, MUTED_COLOR, NOTE_SIZE, TICK_SIZE, shorten};
+pub use super::text::{anchored, style, width};
 
-pub type Plot<'a, 'b> = ChartContext<'a, SVGBackend<'b>, Cartesian2d<ResolvedAxis, ResolvedAxis>>;
+pub(crate) type Plot<'a, 'b> =
+    ChartContext<'a, SVGBackend<'b>, Cartesian2d<ResolvedAxis, ResolvedAxis>>;
 
 const SIDE: u32 = 20;
 const CAPTION_ROOM: u32 = 24;
@@ -22,7 +22,7 @@ const CAPTION_ROOM: u32 = 24;
 const PLOT_TOP: i32 = 8;
 
 /// The page of one figure: where the plot goes, and whether a legend is beside it.
-pub struct Page<'a> {
+pub(crate) struct Page<'a> {
     pub plot: Area<'a>,
     legend: bool,
 }
@@ -110,7 +110,7 @@ impl<'a> Page<'a> {
 }
 
 /// Writes "no data to show" in the middle of the plot area.
-pub fn note_no_data(root: &Area, plot: &Plot) -> DrawResult {
+pub(crate) fn note_no_data(root: &Area, plot: &Plot) -> DrawResult {
     let (xs, ys) = plot.plotting_area().get_pixel_range();
     let style = anchored(LEGEND_SIZE, HPos::Center, VPos::Center).color(&MUTED_COLOR);
     let centre = ((xs.start + xs.end) / 2, (ys.start + ys.end) / 2);

@@ -3,7 +3,7 @@
 //! own marker shape so series differ in print and in greyscale too.
 
 /// Okabe-Ito colours as RGB, most contrasting on white first (yellow, the weakest, last).
-pub const PALETTE: [(u8, u8, u8); 8] = [
+pub(crate) const PALETTE: [(u8, u8, u8); 8] = [
     (0x00, 0x72, 0xB2), // blue
     (0xD5, 0x5E, 0x00), // vermillion
     (0x00, 0x9E, 0x73), // bluish green
@@ -15,10 +15,10 @@ pub const PALETTE: [(u8, u8, u8); 8] = [
 ];
 
 /// Reference lines and shaded regions: dark grey, apart from the data colours.
-pub const REFERENCE: (u8, u8, u8) = (0x55, 0x55, 0x55);
+pub(crate) const REFERENCE: (u8, u8, u8) = (0x55, 0x55, 0x55);
 
 /// The colour index that draws in [`REFERENCE`] grey (ideal lines, hardware ceilings).
-pub const REFERENCE_INDEX: usize = usize::MAX;
+pub(crate) const REFERENCE_INDEX: usize = usize::MAX;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Marker {

@@ -13,17 +13,18 @@ use super::{PlotError, font};
 use crate::output::write_atomic;
 
 /// Pixel size of both the SVG and the PNG.
-pub const SIZE: (u32, u32) = (1000, 650);
+pub(crate) const SIZE: (u32, u32) = (1000, 650);
 
 /// Only a regular face is embedded, so resvg would draw bold text (the title) regular; a
 /// 1 px outline gives it about the weight of a real bold. It applies to the PNG only: SVG
 /// viewers use their own bold face.
 const FAKE_BOLD: &str = "text[font-weight=bold] { stroke: #222222; stroke-width: 1.0 }";
 
-pub use super::text::{DrawResult, err};
+pub(crate) use super::text::DrawResult;
+pub use super::text::err;
 
 /// Draws a figure with `draw` into `dir/stem.svg` and `dir/stem.png`, creating `dir` if needed.
-pub fn render_figure(
+pub(crate) fn render_figure(
     draw: impl Fn(&Area) -> DrawResult,
     dir: &Path,
     stem: &str,
@@ -58,7 +59,7 @@ pub fn render_figure(
 }
 
 /// The PNG of `svg`, drawn with the embedded font only.
-pub fn rasterize(svg: &str) -> Result<Vec<u8>, String> {
+pub(crate) fn rasterize(svg: &str) -> Result<Vec<u8>, String> {
     let options = usvg::Options {
         fontdb: font::FONTS.clone(),
         style_sheet: Some(FAKE_BOLD.into()),

@@ -15,10 +15,10 @@ pub struct Chart {
     pub y: Axis,
     pub series: Vec<Series>,
     pub bands: Vec<Band>,
-    pub hlines: Vec<RefLine>,
+    pub(crate) hlines: Vec<RefLine>,
     pub regions: Vec<Region>,
     /// Legend text explaining hollow markers; shown only when some point is hollow.
-    pub hollow_label: String,
+    pub(crate) hollow_label: String,
 }
 
 impl Chart {
@@ -66,15 +66,15 @@ pub enum Unit {
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Axis {
-    pub label: String,
+    pub(crate) label: String,
     pub scale: Scale,
     pub unit: Unit,
     /// Fixed bounds; `None` fits the data. Points outside a fixed range are not drawn.
     pub range: Option<(f64, f64)>,
     /// Extend the fitted range to include zero (linear axes only).
-    pub include_zero: bool,
+    pub(crate) include_zero: bool,
     /// Names for the positions 0, 1, 2, ... ; when non-empty the axis is categorical and linear.
-    pub categories: Vec<String>,
+    pub(crate) categories: Vec<String>,
 }
 
 impl Axis {
@@ -96,7 +96,7 @@ impl Axis {
         }
     }
 
-    pub fn categorical(label: impl Into<String>, categories: Vec<String>) -> Self {
+    pub(crate) fn categorical(label: impl Into<String>, categories: Vec<String>) -> Self {
         Axis {
             categories,
             ..Axis::linear(label)
@@ -113,7 +113,7 @@ impl Axis {
         self
     }
 
-    pub fn from_zero(mut self) -> Self {
+    pub(crate) fn starting_at_zero(mut self) -> Self {
         self.include_zero = true;
         self
     }
@@ -130,7 +130,7 @@ pub enum SeriesStyle {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
     /// Legend text; an empty label keeps the series out of the legend.
-    pub label: String,
+    pub(crate) label: String,
     pub points: Vec<Point>,
     pub style: SeriesStyle,
     /// Index into the palette ([`super::palette::PALETTE`], wrapping); `None` uses the
@@ -170,11 +170,11 @@ pub struct Point {
     pub x: f64,
     pub y: f64,
     /// Error bar from `lo` to `hi` in y (e.g. a 95% confidence interval).
-    pub y_err: Option<(f64, f64)>,
+    pub(crate) y_err: Option<(f64, f64)>,
     /// Drawn as an outline marker, e.g. for an oversubscribed measurement.
-    pub hollow: bool,
+    pub(crate) hollow: bool,
     /// Text written next to the marker, e.g. `θ=0.5`.
-    pub label: Option<String>,
+    pub(crate) label: Option<String>,
 }
 
 impl Point {
@@ -193,12 +193,12 @@ impl Point {
         self
     }
 
-    pub fn hollow(mut self, hollow: bool) -> Self {
+    pub(crate) fn hollow(mut self, hollow: bool) -> Self {
         self.hollow = hollow;
         self
     }
 
-    pub fn label(mut self, label: impl Into<String>) -> Self {
+    pub(crate) fn label(mut self, label: impl Into<String>) -> Self {
         self.label = Some(label.into());
         self
     }
@@ -208,7 +208,7 @@ impl Point {
 /// The three vectors are read in step; extra entries of a longer one are ignored.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Band {
-    pub label: String,
+    pub(crate) label: String,
     pub x: Vec<f64>,
     pub lo: Vec<f64>,
     pub hi: Vec<f64>,
@@ -217,21 +217,21 @@ pub struct Band {
 
 /// A horizontal line across the whole plot at `y` (e.g. ideal efficiency 1).
 #[derive(Clone, Debug, PartialEq)]
-pub struct RefLine {
-    pub label: String,
+pub(crate) struct RefLine {
+    pub(crate) label: String,
     pub y: f64,
     /// Palette index; `None` draws it dark grey.
     pub color: Option<usize>,
-    pub dashed: bool,
+    pub(crate) dashed: bool,
 }
 
 /// A shaded vertical strip from `x_from` to `x_to`, labelled inside the plot and in the
 /// legend (e.g. where a curve is a prediction with no measurement behind it).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Region {
-    pub label: String,
-    pub x_from: f64,
-    pub x_to: f64,
+    pub(crate) label: String,
+    pub(crate) x_from: f64,
+    pub(crate) x_to: f64,
 }
 
 /// Horizontal stacked bars: one bar per category, one coloured segment per named part.
@@ -241,10 +241,10 @@ pub struct Region {
 pub struct StackedBars {
     pub title: String,
     pub caption: String,
-    pub value_label: String,
-    pub value_unit: Unit,
-    pub categories: Vec<String>,
-    pub segments: Vec<(String, Vec<f64>)>,
+    pub(crate) value_label: String,
+    pub(crate) value_unit: Unit,
+    pub(crate) categories: Vec<String>,
+    pub(crate) segments: Vec<(String, Vec<f64>)>,
 }
 
 /// The files a render wrote.

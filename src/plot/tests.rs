@@ -5,6 +5,7 @@
 use super::figures::{
     self, CommTimes, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
+use super::spec::{Band, Point, RefLine, Region};
 use super::*;
 use resvg::tiny_skia::Pixmap;
 use std::fs;

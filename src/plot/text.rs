@@ -7,23 +7,23 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::font::FAMILY;
 
-pub type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
+pub(crate) type Area<'a> = DrawingArea<SVGBackend<'a>, Shift>;
 
 /// The result of a drawing step; the error is plotters' message.
-pub type DrawResult = Result<(), String>;
+pub(crate) type DrawResult = Result<(), String>;
 
 pub fn err(e: impl std::fmt::Display) -> String {
     e.to_string()
 }
 
-pub const TITLE_SIZE: f64 = 22.0;
-pub const TICK_SIZE: f64 = 14.0;
-pub const AXIS_LABEL_SIZE: f64 = 16.0;
-pub const LEGEND_SIZE: f64 = 14.0;
-pub const CAPTION_SIZE: f64 = 13.0;
-pub const NOTE_SIZE: f64 = 12.0;
-pub const TEXT_COLOR: RGBColor = RGBColor(0x22, 0x22, 0x22);
-pub const MUTED_COLOR: RGBColor = RGBColor(0x55, 0x55, 0x55);
+pub(crate) const TITLE_SIZE: f64 = 22.0;
+pub(crate) const TICK_SIZE: f64 = 14.0;
+pub(crate) const AXIS_LABEL_SIZE: f64 = 16.0;
+pub(crate) const LEGEND_SIZE: f64 = 14.0;
+pub(crate) const CAPTION_SIZE: f64 = 13.0;
+pub(crate) const NOTE_SIZE: f64 = 12.0;
+pub(crate) const TEXT_COLOR: RGBColor = RGBColor(0x22, 0x22, 0x22);
+pub(crate) const MUTED_COLOR: RGBColor = RGBColor(0x55, 0x55, 0x55);
 
 pub fn style(size: f64) -> TextStyle<'static> {
     (FAMILY, size).into_font().color(&TEXT_COLOR)
@@ -39,7 +39,7 @@ pub fn width(area: &Area, text: &str, style: &TextStyle) -> u32 {
 }
 
 /// `text` cut short with `…` so that it is no wider than `max_width`.
-pub fn shorten(area: &Area, text: &str, style: &TextStyle, max_width: u32) -> String {
+pub(crate) fn shorten(area: &Area, text: &str, style: &TextStyle, max_width: u32) -> String {
     let chars: Vec<char> = text.chars().collect();
     let fits = |s: &str| width(area, s, style) <= max_width;
     if fits(text) {

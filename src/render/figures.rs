@@ -27,7 +27,7 @@ enum Drawing {
 
 /// Renders every figure the analysis supports into `dir`. A figure that fails is reported and
 /// the others are still drawn.
-pub fn render_all(analysis: &Analysis, dir: &Path) -> (Vec<Figure>, Vec<String>) {
+pub(crate) fn render_all(analysis: &Analysis, dir: &Path) -> (Vec<Figure>, Vec<String>) {
     let mut drawn = Vec::new();
     let mut errors = Vec::new();
     for (stem, drawing) in figures(analysis) {
@@ -349,7 +349,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
 
 /// "octree θ=0.5 p=2 n=16384" — short enough for a category axis: the case key (whose form
 /// the results file fixes) without its scenario, seed and single rank.
-pub fn case_label(c: &Point) -> String {
+pub(crate) fn case_label(c: &Point) -> String {
     let mut parts: Vec<&str> = c.key.split('/').collect();
     parts.retain(|p| !p.starts_with("seed=") && *p != "r=1");
     parts[1..].join(" ").replace("theta=", "θ=")

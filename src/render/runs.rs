@@ -93,7 +93,7 @@ fn timing(e: &External) -> String {
 
 /// Tokens as a shell would need them: a token with anything but plain characters in single
 /// quotes (placeholders stay as they are), so that the line reads as the argv it was.
-pub fn command_line(tokens: &[String]) -> String {
+pub(crate) fn command_line(tokens: &[String]) -> String {
     let plain = |c: char| c.is_ascii_alphanumeric() || "-_./{}=:,+@%".contains(c);
     tokens
         .iter()

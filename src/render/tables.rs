@@ -107,7 +107,7 @@ fn not_fitted<T>(f: &Fitted<T>) -> String {
 }
 
 /// The sentence that explains the peak column.
-pub fn peak_note() -> String {
+pub(crate) fn peak_note() -> String {
     format!(
         "\"Peak\" is the pair rate as a share of the calibrated FMA peak of the threads used, at a nominal \
          {} / {} / {} flops per LJ / gravity / Coulomb pair (f64 at half the f32 rate).",
@@ -161,7 +161,7 @@ pub fn complexity(a: &Analysis) -> String {
 }
 
 /// The crossovers of the fitted cost curves, one line each.
-pub fn crossovers(a: &Analysis) -> String {
+pub(crate) fn crossovers(a: &Analysis) -> String {
     let mut md = String::new();
     for x in &a.crossovers {
         let _ = writeln!(md, "- {}", crate::analysis::crossover_sentence(x));
@@ -236,7 +236,7 @@ pub fn strong(a: &Analysis) -> String {
 }
 
 /// Each strong series' timed serial fraction next to the fitted one, one line each.
-pub fn serial_comparisons(a: &Analysis) -> String {
+pub(crate) fn serial_comparisons(a: &Analysis) -> String {
     let mut md = String::new();
     for st in &a.strong {
         if let Some(c) = &st.serial_comparison {
@@ -454,7 +454,7 @@ pub fn peers(a: &Analysis) -> String {
 
 /// Tree codes at equal median force error: each code's time per step interpolated to it on
 /// its sweep over θ, and the ratio. Empty when the sweep has no such pair of series.
-pub fn peers_equal_error(a: &Analysis) -> String {
+pub(crate) fn peers_equal_error(a: &Analysis) -> String {
     if a.peers_equal_error.is_empty() {
         return String::new();
     }

@@ -16,7 +16,7 @@ use std::path::Path;
 /// The fitted model and where its figures are, relative to the report.
 pub struct Comm {
     pub model: CommModel,
-    pub figures_dir: String,
+    pub(crate) figures_dir: String,
     pub figures: Vec<Figure>,
 }
 
@@ -47,7 +47,7 @@ fn curve(label: &str, points: &[Prediction]) -> Curve {
 }
 
 /// Draws measured vs predicted communication for both decompositions into `dir`.
-pub fn comm_figures(
+pub(crate) fn comm_figures(
     model: &CommModel,
     weak_mpi: Option<&Sweep>,
     dir: &Path,

@@ -31,7 +31,7 @@ pub fn region(name: &str, default: &str) -> String {
 }
 
 /// The text of every kept region of `doc`, by name (markers excluded).
-pub fn extract(doc: &str) -> Result<BTreeMap<String, String>, KeepError> {
+pub(crate) fn extract(doc: &str) -> Result<BTreeMap<String, String>, KeepError> {
     let mut out = BTreeMap::new();
     let mut current: Option<(String, usize, Vec<&str>)> = None;
     for (i, line) in doc.lines().enumerate() {

@@ -53,7 +53,7 @@ pub enum ReportError {
 pub struct Sweep {
     pub analysis: Analysis,
     /// Directory of the figures relative to the report's directory, with `/` separators.
-    pub figures_dir: String,
+    pub(crate) figures_dir: String,
     pub figures: Vec<crate::render::figures::Figure>,
 }
 

@@ -11,7 +11,8 @@ use std::path::Path;
 const NO_NOTES: &str =
     "_No interpretation written yet: write it here; `nbody-bench report` keeps this region._";
 
-pub use super::comm_section::{Comm, comm_figures};
+pub use super::comm_section::Comm;
+pub(crate) use super::comm_section::comm_figures;
 
 pub fn document(
     sweeps: &[Sweep],

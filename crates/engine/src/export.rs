@@ -46,7 +46,7 @@ pub fn export_setup(
 }
 
 /// Writes the system's state in `format`.
-pub struct ExportJob {
+pub(crate) struct ExportJob {
     pub format: ExportFormat,
 }
 

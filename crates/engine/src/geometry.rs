@@ -44,7 +44,7 @@ impl<T: Real, const D: usize> Bounds<T, D> {
 
     /// The box of points given as one column of coordinates per axis (a state's layout).
     #[inline(always)]
-    pub fn of_columns(columns: [&[T]; D]) -> Self {
+    pub(crate) fn of_columns(columns: [&[T]; D]) -> Self {
         let mut b = Self::empty();
         for (d, xs) in columns.into_iter().enumerate() {
             (b.lo[d], b.hi[d]) = range_of(xs);
@@ -73,7 +73,7 @@ impl<T: Real, const D: usize> Bounds<T, D> {
 
     /// The smallest box holding both.
     #[inline(always)]
-    pub fn union(self, other: Self) -> Self {
+    pub(crate) fn union(self, other: Self) -> Self {
         Bounds {
             lo: std::array::from_fn(|d| smaller(other.lo[d], self.lo[d])),
             hi: std::array::from_fn(|d| larger(other.hi[d], self.hi[d])),
@@ -86,7 +86,7 @@ impl<T: Real, const D: usize> Bounds<T, D> {
     }
 
     /// The same box in f64 (exact: f32 widens without rounding).
-    pub fn to_f64(&self) -> Bounds<f64, D> {
+    pub(crate) fn to_f64(self) -> Bounds<f64, D> {
         Bounds {
             lo: self.lo.map(T::as_f64),
             hi: self.hi.map(T::as_f64),
@@ -94,13 +94,13 @@ impl<T: Real, const D: usize> Bounds<T, D> {
     }
 
     /// The midpoint of each axis.
-    pub fn center(&self) -> [T; D] {
+    pub(crate) fn center(&self) -> [T; D] {
         let half = T::of(0.5);
         std::array::from_fn(|d| half * (self.lo[d] + self.hi[d]))
     }
 
     /// The longest extent `hi − lo` over the axes; 0 for a point or an empty box.
-    pub fn longest_side(&self) -> T {
+    pub(crate) fn longest_side(&self) -> T {
         (0..D)
             .map(|d| self.hi[d] - self.lo[d])
             .fold(T::zero(), |a, b| larger(b, a))
@@ -153,7 +153,7 @@ fn larger<T: Real>(x: T, than: T) -> T {
 
 /// Bits of a Morton key per axis in `dim` dimensions: as many as fit in 63 bits, at most 31
 /// (21 in 3-D, 31 in 2-D); 0 for `dim = 0`.
-pub const fn morton_bits(dim: usize) -> u32 {
+pub(crate) const fn morton_bits(dim: usize) -> u32 {
     match 63usize.checked_div(dim) {
         Some(bits) if bits < 31 => bits as u32,
         Some(_) => 31,
@@ -165,7 +165,7 @@ pub const fn morton_bits(dim: usize) -> u32 {
 /// so that the top `D` bits of a `morton_bits(D)`-level key are the root's child index. Bits of
 /// a coordinate beyond `morton_bits(D)` are dropped.
 #[inline(always)]
-pub fn interleave<const D: usize>(cell: [u64; D]) -> u64 {
+pub(crate) fn interleave<const D: usize>(cell: [u64; D]) -> u64 {
     match D {
         2 => spread2(cell[0]) | spread2(cell[1]) << 1,
         3 => spread3(cell[0]) | spread3(cell[1]) << 1 | spread3(cell[2]) << 2,
@@ -183,7 +183,7 @@ pub fn interleave<const D: usize>(cell: [u64; D]) -> u64 {
 
 /// The cell coordinates of the low `levels` Morton digits of `key` (the inverse of
 /// [`interleave`] for cells below `2^levels` per axis).
-pub fn deinterleave<const D: usize>(key: u64, levels: u32) -> [u64; D] {
+pub(crate) fn deinterleave<const D: usize>(key: u64, levels: u32) -> [u64; D] {
     let mut cell = [0u64; D];
     for b in 0..levels {
         for (d, c) in cell.iter_mut().enumerate() {

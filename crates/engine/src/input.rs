@@ -7,11 +7,11 @@ use std::path::Path;
 
 /// The largest input read: far above any results file or table the tool writes (a long sweep's
 /// results are a few MB).
-pub const MAX_INPUT_BYTES: u64 = 1 << 30;
+pub(crate) const MAX_INPUT_BYTES: u64 = 1 << 30;
 
 /// How long a pipe may stay silent before reading it is given up, unless
 /// [`PIPE_WAIT_ENV`] says otherwise: a named pipe nobody writes to would block forever.
-pub const PIPE_WAIT_S: f64 = 60.0;
+pub(crate) const PIPE_WAIT_S: f64 = 60.0;
 /// The environment variable that sets that wait, in seconds.
 pub const PIPE_WAIT_ENV: &str = "NBODY_BENCH_PIPE_WAIT_S";
 

@@ -5,7 +5,7 @@ use rayon::join;
 
 /// Calls `f(offset, chunk)` on disjoint consecutive chunks of the `D` component slices, in
 /// parallel on the current rayon pool, splitting down to `min_len` elements.
-pub fn for_chunks<T: Send, const D: usize, F>(
+pub(crate) fn for_chunks<T: Send, const D: usize, F>(
     parts: [&mut [T]; D],
     offset: usize,
     min_len: usize,
@@ -32,7 +32,7 @@ pub fn for_chunks<T: Send, const D: usize, F>(
 }
 
 /// Chunk length that gives each of the pool's threads several chunks to balance load.
-pub fn chunk_len(n: usize) -> usize {
+pub(crate) fn chunk_len(n: usize) -> usize {
     (n / (8 * rayon::current_num_threads())).max(64)
 }
 
@@ -42,7 +42,7 @@ pub fn chunk_len(n: usize) -> usize {
 pub const MIN_FORK_ELEMENTS: usize = 16_384;
 
 /// Whether a pass over `elements` per-particle values should run on the pool's threads.
-pub fn worth_forking(elements: usize) -> bool {
+pub(crate) fn worth_forking(elements: usize) -> bool {
     elements >= MIN_FORK_ELEMENTS && rayon::current_num_threads() > 1
 }
 
@@ -62,7 +62,7 @@ pub fn gather<V: Copy + Send + Sync>(src: &[V], order: &[u32], dst: &mut Vec<V>)
 }
 
 /// A slice written from several threads at places that the caller guarantees distinct.
-pub struct Disjoint<'a, V> {
+pub(crate) struct Disjoint<'a, V> {
     ptr: *mut V,
     len: usize,
     _slice: std::marker::PhantomData<&'a mut [V]>,
@@ -97,7 +97,7 @@ impl<'a, V: Copy> Disjoint<'a, V> {
 
 /// The `D` slices cut into consecutive chunks of `len` elements (the last one shorter), each
 /// chunk the same range of every slice.
-pub fn chunks_of<T, const D: usize>(parts: [&mut [T]; D], len: usize) -> Vec<[&mut [T]; D]> {
+pub(crate) fn chunks_of<T, const D: usize>(parts: [&mut [T]; D], len: usize) -> Vec<[&mut [T]; D]> {
     let n = parts[0].len();
     let len = len.max(1);
     let mut chunks = Vec::with_capacity(n.div_ceil(len));
@@ -116,14 +116,14 @@ pub fn chunks_of<T, const D: usize>(parts: [&mut [T]; D], len: usize) -> Vec<[&m
 
 /// Chunk length of a per-particle pass over `n` particles that forks: a few chunks per thread,
 /// none below a few thousand particles.
-pub fn pass_chunk(n: usize) -> usize {
+pub(crate) fn pass_chunk(n: usize) -> usize {
     chunk_len(n).max(4096)
 }
 
 /// Overwrites `out` with the sum of `buffers`, buffer `k` holding the values of the slots
 /// `spans[k]` (from `spans[k].start`): the reduction of force buffers that each cover a part
 /// of the slots, on the pool's threads over chunks of slots.
-pub fn sum_spans<T: crate::real::Real, const D: usize>(
+pub(crate) fn sum_spans<T: crate::real::Real, const D: usize>(
     out: [&mut [T]; D],
     spans: &[std::ops::Range<usize>],
     buffers: &[[Vec<T>; D]],

@@ -122,12 +122,12 @@ impl<T: Real, const D: usize> State<T, D> {
     /// Axis-aligned bounding box of all positions (NaN skipped, empty without particles: see
     /// [`crate::geometry`]).
     #[inline(always)]
-    pub fn bounding_box(&self) -> Bounds<T, D> {
+    pub(crate) fn bounding_box(&self) -> Bounds<T, D> {
         Bounds::of_columns(self.pos.each_ref().map(Vec::as_slice))
     }
 
     /// Total kinetic energy, accumulated in f64.
-    pub fn kinetic_energy(&self) -> f64 {
+    pub(crate) fn kinetic_energy(&self) -> f64 {
         let mut e = 0.0;
         for i in 0..self.len() {
             let v2: f64 = (0..D).map(|d| self.vel[d][i].as_f64().powi(2)).sum();

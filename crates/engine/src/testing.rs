@@ -1,14 +1,18 @@
 //! Shared fixtures for tests and benches: seeded random configurations, and the comparisons
 //! of force fields that the kernels' tests make against the direct sum.
 
+#[cfg(test)]
 use crate::kernels::{ForceKernel, ForceReport};
 use crate::real::Real;
-use crate::state::{Field, State, zero_field};
+#[cfg(test)]
+use crate::state::zero_field;
+use crate::state::{Field, State};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 /// Runs `f` on a fresh rayon pool of `p` threads.
-pub fn on_threads<R: Send>(p: usize, f: impl FnOnce() -> R + Send) -> R {
+#[cfg(test)]
+pub(crate) fn on_threads<R: Send>(p: usize, f: impl FnOnce() -> R + Send) -> R {
     rayon::ThreadPoolBuilder::new()
         .num_threads(p)
         .build()
@@ -72,7 +76,8 @@ pub fn spaced_state<T: Real, const D: usize>(
 /// A Plummer sphere (scale radius 1, total mass 1), clustered: the centre is ~10⁴× denser than
 /// r = 5. In 2-D, the projected Plummer disc (surface density ∝ (1 + R²)⁻²), which is as
 /// centrally concentrated; radii of the 3-D profile with 2-D directions would leave a hole.
-pub fn plummer_state<T: Real, const D: usize>(n: usize, seed: u64) -> State<T, D> {
+#[cfg(test)]
+pub(crate) fn plummer_state<T: Real, const D: usize>(n: usize, seed: u64) -> State<T, D> {
     let mut rng = Pcg64Mcg::seed_from_u64(seed);
     let mut s = State::new(n);
     for i in 0..n {
@@ -105,7 +110,8 @@ pub fn plummer_state<T: Real, const D: usize>(n: usize, seed: u64) -> State<T, D
 }
 
 /// Forces (and the report, with the energy when `probe`) of a kernel on a state.
-pub fn forces_of<T: Real, const D: usize>(
+#[cfg(test)]
+pub(crate) fn forces_of<T: Real, const D: usize>(
     k: &mut dyn ForceKernel<T, D>,
     s: &State<T, D>,
     probe: bool,
@@ -129,14 +135,16 @@ pub fn diff<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>, i: usize)
 }
 
 /// max_i |a_i − b_i| / max_i |b_i|.
-pub fn max_rel_diff<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
+#[cfg(test)]
+pub(crate) fn max_rel_diff<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
     let n = a[0].len();
     let scale = (0..n).map(|i| norm(b, i)).fold(0.0, f64::max).max(1e-300);
     (0..n).map(|i| diff(a, b, i)).fold(0.0, f64::max) / scale
 }
 
 /// Median over particles of |a_i − b_i| / |b_i|.
-pub fn median_rel_err<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
+#[cfg(test)]
+pub(crate) fn median_rel_err<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
     let n = a[0].len();
     let mut errs: Vec<f64> = (0..n)
         .map(|i| diff(a, b, i) / norm(b, i).max(1e-300))

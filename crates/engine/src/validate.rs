@@ -46,7 +46,7 @@ pub struct KernelCheck {
     pub median_rel_error: f64,
     /// Max over particles of |F − F_naive| / Σ_j |F_ij| (naive in the run's precision): the
     /// difference relative to the rounding scale.
-    pub max_rounding_ratio: f64,
+    pub(crate) max_rounding_ratio: f64,
     pub passed: bool,
     /// Not run because the kernel refuses these parameters (the fmm at θ ≥ 1): neither passed
     /// nor failed, the errors NaN (null in JSON), the reason in `criterion`.

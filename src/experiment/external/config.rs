@@ -283,7 +283,7 @@ impl External {
     }
 
     /// Checks that cases differing in threads or ranks differ in what the program is told.
-    pub fn check_told(
+    pub(crate) fn check_told(
         &self,
         threads: &[usize],
         ranks: &[usize],
@@ -314,18 +314,21 @@ impl External {
 }
 
 /// What the rest of a sweep config says that the `[[external]]` entries depend on.
-pub struct Around<'a> {
+pub(crate) struct Around<'a> {
     pub threads: &'a [usize],
     /// The `[mpi]` table's rank counts, if it has one.
-    pub mpi_ranks: Option<&'a [usize]>,
+    pub(crate) mpi_ranks: Option<&'a [usize]>,
     pub strong: bool,
     /// A weak study whose rule is the kernels' cost model.
-    pub weak_cost_model: bool,
+    pub(crate) weak_cost_model: bool,
 }
 
 /// Checks the `[[external]]` entries against each other and the rest of the config;
 /// `(key, problem)` on failure.
-pub fn validate_entries(entries: &[External], around: &Around) -> Result<(), (String, String)> {
+pub(crate) fn validate_entries(
+    entries: &[External],
+    around: &Around,
+) -> Result<(), (String, String)> {
     for (i, e) in entries.iter().enumerate() {
         e.validate()?;
         if entries[..i].iter().any(|o| o.name == e.name) {

@@ -8,14 +8,15 @@ pub mod placeholders;
 pub mod process;
 pub mod run;
 
-pub use config::{External, TimeSource};
+pub use config::External;
+pub(crate) use config::TimeSource;
 
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// A launch overhead above this share of a sample's wall time is warned about.
-pub const OVERHEAD_WARN: f64 = 0.05;
+pub(crate) const OVERHEAD_WARN: f64 = 0.05;
 /// The version command is killed after this many seconds.
 const VERSION_TIMEOUT_S: f64 = 30.0;
 
@@ -105,18 +106,18 @@ pub struct Context {
     pub config_dir: PathBuf,
     pub nbody_bench: PathBuf,
     /// Case work directories are made under this one.
-    pub work_root: PathBuf,
+    pub(crate) work_root: PathBuf,
 }
 
 impl Context {
-    pub fn vars(&self) -> placeholders::Vars {
+    pub(crate) fn vars(&self) -> placeholders::Vars {
         placeholders::Vars::sweep(&self.config_dir, &self.nbody_bench)
     }
 }
 
 /// Checks that every program a case would start can be started, before anything runs: the
 /// same [`process::resolve`] that each launch uses, with the `PATH` the program's `env` sets.
-pub fn check_programs(
+pub(crate) fn check_programs(
     ext: &External,
     launcher: Option<&str>,
     context: &Context,
@@ -171,7 +172,7 @@ pub fn check_programs(
 
 /// The first line the version command prints (standard output, else standard error), or why
 /// there is none.
-pub fn version_line(ext: &External, context: &Context) -> ExternalVersion {
+pub(crate) fn version_line(ext: &External, context: &Context) -> ExternalVersion {
     let version = if ext.version.is_empty() {
         "(no version command)".to_string()
     } else {

@@ -7,11 +7,11 @@ use std::path::Path;
 use thiserror::Error;
 
 /// Placeholders that depend on the case.
-pub const CASE_PLACEHOLDERS: [&str; 8] = [
+pub(crate) const CASE_PLACEHOLDERS: [&str; 8] = [
     "n", "threads", "ranks", "steps", "seed", "theta", "scenario", "workdir",
 ];
 /// Placeholders known before any case (the only ones `version` may use).
-pub const SWEEP_PLACEHOLDERS: [&str; 2] = ["config_dir", "nbody_bench"];
+pub(crate) const SWEEP_PLACEHOLDERS: [&str; 2] = ["config_dir", "nbody_bench"];
 
 #[derive(Debug, Error, PartialEq)]
 pub enum PlaceholderError {
@@ -29,7 +29,7 @@ pub enum PlaceholderError {
 
 /// Values of the placeholders.
 #[derive(Clone, Debug, Default)]
-pub struct Vars {
+pub(crate) struct Vars {
     values: BTreeMap<&'static str, String>,
 }
 
@@ -52,7 +52,7 @@ impl Vars {
     }
 
     /// `token` with every placeholder replaced.
-    pub fn substitute(&self, token: &str) -> Result<String, PlaceholderError> {
+    pub(crate) fn substitute(&self, token: &str) -> Result<String, PlaceholderError> {
         expand(token, &mut |name| self.values.get(name).cloned()).map_err(|e| match e {
             PlaceholderError::Unknown { token, name, .. } => PlaceholderError::Unknown {
                 token,
@@ -68,7 +68,10 @@ impl Vars {
         })
     }
 
-    pub fn substitute_all(&self, tokens: &[String]) -> Result<Vec<String>, PlaceholderError> {
+    pub(crate) fn substitute_all(
+        &self,
+        tokens: &[String],
+    ) -> Result<Vec<String>, PlaceholderError> {
         tokens.iter().map(|t| self.substitute(t)).collect()
     }
 }

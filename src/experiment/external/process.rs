@@ -10,11 +10,11 @@ use wait_timeout::ChildExt;
 
 /// The longest timeout a config may set: 7 days. A longer one is surely a mistake, and it keeps
 /// every timeout a valid [`Duration`].
-pub const MAX_TIMEOUT_S: f64 = 7.0 * 24.0 * 3600.0;
+pub(crate) const MAX_TIMEOUT_S: f64 = 7.0 * 24.0 * 3600.0;
 /// Lines of output kept with a failed sample.
-pub const TAIL_LINES: usize = 20;
+pub(crate) const TAIL_LINES: usize = 20;
 /// At most this much of a run's output is read back.
-pub const MAX_OUTPUT_BYTES: u64 = 16 << 20;
+pub(crate) const MAX_OUTPUT_BYTES: u64 = 16 << 20;
 /// The end of an output longer than that, read for its last lines.
 const TAIL_BYTES: u64 = 64 << 10;
 
@@ -41,7 +41,7 @@ impl Finished {
     /// Why the output cannot be searched by the config's regular expressions, if it cannot:
     /// only its first [`MAX_OUTPUT_BYTES`] are read back, and a time printed after them would
     /// be missed without a word.
-    pub fn too_long(&self) -> Option<String> {
+    pub(crate) fn too_long(&self) -> Option<String> {
         let (name, o) = [
             ("standard output", &self.stdout),
             ("standard error", &self.stderr),
@@ -145,7 +145,7 @@ pub fn run(launch: &Launch, dir: &Path, timeout_s: f64) -> std::io::Result<Finis
 }
 
 /// The `PATH` an environment sets, if it sets one.
-pub fn path_of(env: &[(String, String)]) -> Option<&str> {
+pub(crate) fn path_of(env: &[(String, String)]) -> Option<&str> {
     env.iter()
         .find(|(k, _)| k == "PATH")
         .map(|(_, v)| v.as_str())

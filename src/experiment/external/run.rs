@@ -23,7 +23,7 @@ pub fn steps(ext: &External, case: &Case) -> u64 {
 }
 
 /// The placeholder values of `case`.
-pub fn case_vars(ext: &External, case: &Case, context: &Context, workdir: &Path) -> Vars {
+pub(crate) fn case_vars(ext: &External, case: &Case, context: &Context, workdir: &Path) -> Vars {
     let mut v = context.vars();
     v.set("n", case.n)
         .set("threads", case.threads)
@@ -79,7 +79,7 @@ fn launch(
 }
 
 /// Measures one round of the external case `case`.
-pub fn measure_round(
+pub(crate) fn measure_round(
     ext: &External,
     case: &Case,
     spec: &RoundSpec,

@@ -148,7 +148,7 @@ pub fn comm_time(comm: &CommTimes, caption: &str) -> Chart {
             scale: Scale::Linear,
             ..y
         }
-        .from_zero();
+        .starting_at_zero();
     }
     let mut chart =
         Chart::new("Communication: measured vs predicted", comm.x.clone(), y).caption(caption);

@@ -61,7 +61,7 @@ impl Measured {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Curve {
     /// Legend text, e.g. `naive: T ∝ n^1.98` or `Amdahl f = 0.031`.
-    pub label: String,
+    pub(crate) label: String,
     pub points: Vec<(f64, f64)>,
     pub band: Vec<(f64, f64, f64)>,
 }
@@ -126,8 +126,9 @@ impl KernelSeries {
         }
     }
 
+    #[cfg(test)]
     /// From `(x, median, ci_lo, ci_hi)` rows.
-    pub fn from_rows(name: impl Into<String>, rows: &[(f64, f64, f64, f64)]) -> Self {
+    pub(crate) fn from_rows(name: impl Into<String>, rows: &[(f64, f64, f64, f64)]) -> Self {
         let measured = rows
             .iter()
             .map(|&(x, m, lo, hi)| Measured::with_ci(x, m, lo, hi))

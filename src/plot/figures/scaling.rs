@@ -21,7 +21,7 @@ pub fn speedup(
     caption: &str,
 ) -> Chart {
     let x = Axis::linear(format!("{workers} p")).unit(Unit::Count);
-    let y = Axis::linear("speedup T(1) / T(p)").from_zero();
+    let y = Axis::linear("speedup T(1) / T(p)").starting_at_zero();
     let title = format!("Strong scaling: speedup vs {workers}");
     let mut chart = kernel_chart(&title, x, y, kernels, caption);
     let measured = kernels.iter().flat_map(|k| k.measured.iter().map(|m| m.x));
@@ -55,7 +55,7 @@ fn ideal_at_one() -> RefLine {
 /// Parallel efficiency S(p)/p against threads, with the ideal 1.
 pub fn efficiency(kernels: &[KernelSeries], workers: &str, caption: &str) -> Chart {
     let x = Axis::linear(format!("{workers} p")).unit(Unit::Count);
-    let y = Axis::linear("parallel efficiency S(p) / p").from_zero();
+    let y = Axis::linear("parallel efficiency S(p) / p").starting_at_zero();
     let title = format!("Strong scaling: parallel efficiency vs {workers}");
     let mut chart = kernel_chart(&title, x, y, kernels, caption);
     chart.hlines.push(ideal_at_one());
@@ -70,7 +70,7 @@ pub fn weak_efficiency(kernels: &[KernelSeries], workers: &str, caption: &str) -
         _ => "worker",
     };
     let x = Axis::linear(format!("{workers} p (work per {one} held constant)")).unit(Unit::Count);
-    let y = Axis::linear("weak-scaling efficiency T(1) / T(p)").from_zero();
+    let y = Axis::linear("weak-scaling efficiency T(1) / T(p)").starting_at_zero();
     let title = format!("Weak scaling: efficiency vs {workers}");
     let mut chart = kernel_chart(&title, x, y, kernels, caption);
     chart.hlines.push(ideal_at_one());

@@ -14,7 +14,7 @@
 //! what it got, and its forces are those of a walk at least as fine as the serial one.
 //!
 //! The LET of a domain grows like the domain's surface (the bodies and small nodes within a few
-//! leaf sizes over θ of its boundary), not like n: see `model::tree_bytes_per_rank`.
+//! leaf sizes over θ of its boundary), not like n (the test model `model::tree_bytes_per_rank`).
 
 use super::Aabb;
 use crate::kernels::TreeView;

@@ -12,7 +12,10 @@
 //! collective, `log2 p` latencies).
 
 use super::Domains;
-use super::essential::{self, body_entry_values, node_entry_values};
+use super::essential;
+#[cfg(test)]
+use super::essential::{body_entry_values, node_entry_values};
+#[cfg(test)]
 use super::regions::grid_dims;
 use super::top_nodes::{TopNodes, TopWalk};
 use crate::geometry::Bounds;
@@ -21,7 +24,7 @@ use crate::real::Real;
 use crate::state::State;
 
 /// Bytes per particle of a ghost: its coordinates and its source strength.
-pub fn ghost_bytes(dim: usize, value_bytes: usize) -> usize {
+pub(crate) fn ghost_bytes(dim: usize, value_bytes: usize) -> usize {
     (dim + 1) * value_bytes
 }
 
@@ -32,8 +35,9 @@ pub fn allgather_bytes_per_rank(n: usize, ranks: usize, dim: usize, value_bytes:
     (n - n / ranks) as f64 * (dim * value_bytes) as f64
 }
 
+#[cfg(test)]
 /// Replicated data: latencies per step of a ring Allgatherv, `p − 1`.
-pub fn allgather_messages_per_rank(ranks: usize) -> f64 {
+fn allgather_messages_per_rank(ranks: usize) -> f64 {
     ranks.saturating_sub(1) as f64
 }
 
@@ -42,7 +46,7 @@ pub fn allgather_messages_per_rank(ranks: usize) -> f64 {
 /// per step, the particles in the shell of width `rc` around its region,
 /// `ρ · (Π_a (e_a + m_a) − Π_a e_a)` with `e_a = L / dims[a]` and `m_a` = 0, `rc` or `2rc`
 /// as the region has 0, 1 or 2 neighbours along axis a.
-pub fn domain_ghosts_per_rank(n: usize, density: f64, rc: f64, dims: &[usize]) -> f64 {
+pub(crate) fn domain_ghosts_per_rank(n: usize, density: f64, rc: f64, dims: &[usize]) -> f64 {
     let d = dims.len() as i32;
     let side = (n as f64 / density).powf(1.0 / d as f64);
     density * shell_volume(side, rc, dims)
@@ -179,6 +183,7 @@ pub(crate) fn bodies_of<T: Real, const D: usize>(
     own
 }
 
+#[cfg(test)]
 /// The locally essential tree the busiest rank receives per step on a uniform cloud of `n`
 /// bodies over `ranks` compact domains (the grid of `regions::grid_dims`, as ORB gives on a
 /// uniform cloud), at opening angle `theta` and leaf size `leaf_size`: (bodies, nodes).
@@ -191,7 +196,7 @@ pub(crate) fn bodies_of<T: Real, const D: usize>(
 /// the domain's surface, `(n/p)^((D−1)/D)`, and not like n: doubling n at fixed p multiplies
 /// them by about `2^((D−1)/D)` (1.59 in 3-D) plus a logarithmic far-field term; at θ = 0 the
 /// shells cover the cloud and the receiver gets every other body.
-pub fn tree_entries_per_rank(
+fn tree_entries_per_rank(
     n: usize,
     ranks: usize,
     dim: usize,
@@ -219,9 +224,10 @@ pub fn tree_entries_per_rank(
     (bodies, nodes)
 }
 
+#[cfg(test)]
 /// [`tree_entries_per_rank`] in bytes: bodies with their strength, nodes with their strength
 /// and `moment_values` second moments (0 for monopoles, `D(D+1)/2 + 1` for quadrupoles).
-pub fn tree_bytes_per_rank(
+fn tree_bytes_per_rank(
     n: usize,
     ranks: usize,
     dim: usize,
@@ -260,6 +266,7 @@ pub fn tree_bytes_of_cloud<T: Real, const D: usize>(
     received
 }
 
+#[cfg(test)]
 fn grid_dims_of(ranks: usize, dim: usize, side: f64) -> Vec<usize> {
     match dim {
         2 => grid_dims::<2>(ranks, [side; 2]).to_vec(),

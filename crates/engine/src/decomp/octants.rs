@@ -23,10 +23,10 @@ use std::ops::Range;
 
 /// Levels added below the first level with at least p cells when the runs are balanced: 2^(2D)
 /// cells per rank on average, so a run's count is within a few per cent of n/p on smooth data.
-pub const REFINE: u32 = 2;
+pub(crate) const REFINE: u32 = 2;
 
 /// The most cells a level may have (2^21: a 16 MiB histogram), which bounds the refinement.
-pub const MAX_CELLS: u64 = 1 << 21;
+pub(crate) const MAX_CELLS: u64 = 1 << 21;
 
 /// The rank assignment of the cells of one level of the root cube.
 #[derive(Clone, Debug, PartialEq)]

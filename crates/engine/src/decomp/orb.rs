@@ -113,8 +113,9 @@ impl<const D: usize> Orb<D> {
         self.regions[rank]
     }
 
+    #[cfg(test)]
     /// The sum of `weights` over the bodies each rank owns.
-    pub fn weights_per_rank<T: Real>(&self, pos: &[Vec<T>; D], weights: &[f64]) -> Vec<f64> {
+    pub(crate) fn weights_per_rank<T: Real>(&self, pos: &[Vec<T>; D], weights: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; self.ranks()];
         for (r, w) in self.assign(pos).into_iter().zip(weights) {
             out[r] += w;

@@ -83,7 +83,7 @@ impl<const D: usize> Regions<D> {
     }
 
     /// Grid coordinates of a rank.
-    pub fn coords(&self, rank: usize) -> [usize; D] {
+    pub(crate) fn coords(&self, rank: usize) -> [usize; D] {
         let mut c = [0; D];
         let mut r = rank;
         for a in (0..D).rev() {
@@ -210,7 +210,7 @@ impl<const D: usize> Regions<D> {
 }
 
 /// Squared distance between two boxes (0 when they touch or overlap).
-pub fn box_distance2<const D: usize>(
+pub(crate) fn box_distance2<const D: usize>(
     lo_a: &[f64; D],
     hi_a: &[f64; D],
     lo_b: &[f64; D],

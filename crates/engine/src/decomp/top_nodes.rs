@@ -20,7 +20,7 @@ use crate::real::Real;
 
 /// Values per top node on the wire: D coordinates, strength, opening radius², first child,
 /// child count.
-pub const fn node_values(dim: usize) -> usize {
+pub(crate) const fn node_values(dim: usize) -> usize {
     dim + 4
 }
 

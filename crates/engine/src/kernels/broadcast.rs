@@ -14,7 +14,7 @@ use crate::real::{Real, select};
 
 /// Up to `LANES` targets: positions and strengths by lane. Lanes past the real targets repeat
 /// the first target's position with zero strength, so they stay finite and are ignored.
-pub struct Tile<T, const D: usize> {
+pub(crate) struct Tile<T, const D: usize> {
     pub x: [[T; LANES]; D],
     pub s: [T; LANES],
 }
@@ -38,7 +38,7 @@ impl<T: Real, const D: usize> Tile<T, D> {
 /// skips source `own + l` (its own slot, when the targets are also sources; `usize::MAX` when
 /// none is).
 #[inline(always)]
-pub fn tile_forces<T: Real, L: PairLaw<T>, const D: usize>(
+pub(crate) fn tile_forces<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,
     tile: &Tile<T, D>,
     src: &Sources<'_, T, D>,

@@ -15,7 +15,7 @@ use std::ops::Range;
 
 /// Scratch of the sort, kept between calls so that a run of equal sizes allocates once.
 #[derive(Default)]
-pub struct CountingSort {
+pub(crate) struct CountingSort {
     /// The particles in band order.
     by_band: Vec<u32>,
     /// Per band: its particles' count in each of its bins, then the next place to hand out.
@@ -172,7 +172,7 @@ fn sort_band(
 }
 
 /// The order of a sort, as `order[place] = particle`, on the pool's threads when worth it.
-pub fn order_of(place: &[u32], order: &mut Vec<u32>) {
+pub(crate) fn order_of(place: &[u32], order: &mut Vec<u32>) {
     let n = place.len();
     order.resize(n, 0);
     if worth_forking(n) {

@@ -51,7 +51,7 @@ fn kernel_bytes(kernel: KernelKind, params: &KernelParams, dim: usize, threads: 
 }
 
 /// Estimated peak bytes of a run of `n` particles.
-pub fn run_bytes(
+pub(crate) fn run_bytes(
     kernel: KernelKind,
     params: &KernelParams,
     n: usize,
@@ -64,7 +64,7 @@ pub fn run_bytes(
 }
 
 /// Memory the system can give this process without swapping (`MemAvailable`), when known.
-pub fn available_bytes() -> Option<u64> {
+pub(crate) fn available_bytes() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/meminfo").ok()?;
     parse_available(&text)
 }

@@ -28,7 +28,8 @@ pub use cluster_pair::ClusterPair;
 pub use compiled::CompiledKernels;
 pub use fmm::{Fmm, MAX_ORDER as MAX_FMM_ORDER};
 pub use naive::Naive;
-pub use octree::{Multipole, Octree, TreeView, far_from_box};
+pub(crate) use octree::far_from_box;
+pub use octree::{Multipole, Octree, TreeView};
 pub use per_thread::PerThread;
 pub use share::Share;
 pub use symmetric::Symmetric;
@@ -314,7 +315,7 @@ impl KernelParams {
 
 impl KernelParams {
     /// Whether θ is below 1, where the fmm's expansions converge (the fmm refuses the rest).
-    pub fn fmm_converges(&self) -> bool {
+    pub(crate) fn fmm_converges(&self) -> bool {
         self.theta < 1.0
     }
 
@@ -359,7 +360,7 @@ pub enum KernelError {
 
 /// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order), unless
 /// the kernel asks more often ([`ForceKernel::sort_every`]: the Verlet list, at its rebuilds).
-pub const SORT_EVERY: u64 = 20;
+pub(crate) const SORT_EVERY: u64 = 20;
 
 /// Deterministic work done by one force computation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, serde::Deserialize)]

@@ -96,7 +96,7 @@ impl Exclude {
 
 /// Sum of the lanes, as a tree (four dependent additions, not sixteen).
 #[inline(always)]
-pub fn lane_sum<T: Real>(mut v: [T; LANES]) -> T {
+pub(crate) fn lane_sum<T: Real>(mut v: [T; LANES]) -> T {
     let mut width = LANES / 2;
     while width > 0 {
         for l in 0..width {
@@ -328,7 +328,7 @@ macro_rules! for_blocks {
 
 /// Force on `t` from the sources in `src` that `exclude` keeps.
 #[inline(always)]
-pub fn gather_excluding<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+pub(crate) fn gather_excluding<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     law: &L,
     t: &Target<T, D>,
     src: &Sources<'_, T, D>,

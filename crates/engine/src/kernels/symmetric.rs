@@ -14,7 +14,7 @@ use crate::state::{Field, State};
 use std::ops::Range;
 
 /// Particles per tile: positions, source strength and forces of a tile stay inside L1.
-pub const BLOCK: usize = 512;
+pub(crate) const BLOCK: usize = 512;
 
 pub struct Symmetric<L> {
     law: L,
@@ -32,7 +32,7 @@ pub fn blocks(n: usize) -> usize {
 }
 
 /// Pair evaluations done for target tile `b` (its own triangle plus every later tile).
-pub fn tile_pairs(n: usize, b: usize) -> u64 {
+pub(crate) fn tile_pairs(n: usize, b: usize) -> u64 {
     let lo = b * BLOCK;
     let hi = ((b + 1) * BLOCK).min(n);
     let len = (hi - lo) as u64;
@@ -41,7 +41,7 @@ pub fn tile_pairs(n: usize, b: usize) -> u64 {
 
 /// Splits the target tiles `tiles` into `parts` contiguous ranges of near-equal pair work
 /// (some empty when there are fewer tiles than parts).
-pub fn split_tiles(n: usize, tiles: Range<usize>, parts: usize) -> Vec<Range<usize>> {
+pub(crate) fn split_tiles(n: usize, tiles: Range<usize>, parts: usize) -> Vec<Range<usize>> {
     let parts = parts.max(1);
     let total: u64 = tiles.clone().map(|b| tile_pairs(n, b)).sum();
     let mut ranges = Vec::with_capacity(parts);
@@ -62,14 +62,14 @@ pub fn split_tiles(n: usize, tiles: Range<usize>, parts: usize) -> Vec<Range<usi
 }
 
 /// The pair work of the target tiles `tiles`.
-pub fn pairs_of(n: usize, tiles: Range<usize>) -> u64 {
+pub(crate) fn pairs_of(n: usize, tiles: Range<usize>) -> u64 {
     tiles.map(|b| tile_pairs(n, b)).sum()
 }
 
 /// Adds the forces of every pair (i, j) with i in target tiles `tiles` and j > i to `out`
 /// (length n), both ends of each pair.
 #[inline(always)]
-pub fn add_tiles<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+pub(crate) fn add_tiles<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     law: &L,
     state: &State<T, D>,
     tiles: std::ops::Range<usize>,

@@ -87,7 +87,7 @@ pub fn state_dump<T: Real, const D: usize>(
 
 /// The force dump text: positions, the f64 reference and each named kernel's forces, all
 /// indexed by slot of `state` (written in id order).
-pub fn force_dump<T: Real, const D: usize>(
+pub(crate) fn force_dump<T: Real, const D: usize>(
     header: &str,
     law: &LawParameters,
     state: &State<T, D>,

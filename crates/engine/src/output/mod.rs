@@ -169,7 +169,7 @@ pub fn remove_temporaries_and_exit(code: i32) -> ! {
 /// A file written under a temporary name and renamed into place by [`AtomicFile::commit`];
 /// dropped without commit, or if the commit fails, the temporary file is removed and `path`
 /// is untouched. A symbolic link is written through: the file it points at is replaced.
-pub struct AtomicFile {
+pub(crate) struct AtomicFile {
     path: PathBuf,
     tmp: PathBuf,
     out: Option<BufWriter<File>>,
@@ -209,10 +209,6 @@ impl AtomicFile {
 
     pub fn writer(&mut self) -> &mut BufWriter<File> {
         self.out.as_mut().expect("writer present until commit")
-    }
-
-    pub fn path(&self) -> &Path {
-        &self.path
     }
 
     /// Flushes, syncs and renames the file into place.

@@ -20,11 +20,11 @@ pub enum NbviewFormat {
     NbviewBin,
 }
 
-pub const TEXT_TAG: &[u8; 8] = b"NBView00";
-pub const BINARY_TAG: &[u8; 8] = b"NBView01";
+pub(crate) const TEXT_TAG: &[u8; 8] = b"NBView00";
+pub(crate) const BINARY_TAG: &[u8; 8] = b"NBView01";
 
 /// Writes the tag and header.
-pub fn write_header(
+pub(crate) fn write_header(
     out: &mut impl Write,
     format: NbviewFormat,
     n: u32,
@@ -46,7 +46,11 @@ pub fn write_header(
 }
 
 /// Writes one frame of (x, y) pairs.
-pub fn write_frame(out: &mut impl Write, format: NbviewFormat, xy: &[[f32; 2]]) -> io::Result<()> {
+pub(crate) fn write_frame(
+    out: &mut impl Write,
+    format: NbviewFormat,
+    xy: &[[f32; 2]],
+) -> io::Result<()> {
     for p in xy {
         match format {
             NbviewFormat::NbviewBin => {

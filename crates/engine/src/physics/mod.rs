@@ -12,7 +12,8 @@ mod lj;
 
 pub use coulomb::Coulomb;
 pub use gravity::Gravity;
-pub use lj::{LJ_SIGMA, LennardJones};
+pub(crate) use lj::LJ_SIGMA;
+pub use lj::LennardJones;
 
 use crate::real::Real;
 use serde::Serialize;
@@ -36,12 +37,12 @@ impl LawKind {
     }
 
     /// Whether the law is short-ranged (has a cutoff), which the cell list needs.
-    pub fn has_cutoff(self) -> bool {
+    pub(crate) fn has_cutoff(self) -> bool {
         matches!(self, LawKind::LennardJones)
     }
 
     /// Whether distant sources can be lumped into a monopole (a 1/r² law), which Barnes-Hut needs.
-    pub fn is_inverse_square(self) -> bool {
+    pub(crate) fn is_inverse_square(self) -> bool {
         matches!(self, LawKind::Coulomb | LawKind::Gravity)
     }
 
@@ -139,7 +140,7 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
 /// law's pair interaction written out plainly, for the f64 reference sum of `validate` and the
 /// tests of the SIMD rows (the kernels themselves go through `kernels::rows`).
 #[inline(always)]
-pub fn pair_force<T: Real, L: PairLaw<T>, const D: usize>(
+pub(crate) fn pair_force<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,
     dx: [T; D],
     si: T,

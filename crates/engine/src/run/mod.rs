@@ -15,9 +15,7 @@ use std::path::PathBuf;
 pub mod bench_cases;
 mod outcome;
 
-pub use outcome::{
-    Counters, EnergyCheck, Measured, MomentumCheck, RUN_SCHEMA, RunOutcome, Throughput, Timing,
-};
+pub use outcome::{Counters, EnergyCheck, Measured, MomentumCheck, RunOutcome, Throughput, Timing};
 
 /// What to run, besides the system.
 #[derive(Clone, Debug)]

@@ -10,7 +10,7 @@ use crate::stats::{StepHistogram, StepPercentiles};
 use serde::Serialize;
 
 /// Schema tag of the `run --json` document.
-pub const RUN_SCHEMA: &str = "nbody-bench/run/v1";
+pub(crate) const RUN_SCHEMA: &str = "nbody-bench/run/v1";
 
 /// The result of a run, as written by `run --json`.
 #[derive(Clone, Debug, Serialize)]
@@ -87,7 +87,7 @@ pub struct EnergyCheck {
     /// (E_final − E_initial) / |E_initial|.
     pub rel_drift: f64,
     /// The Lennard-Jones energy is shifted to zero at the cutoff (the force is not).
-    pub lj_potential: &'static str,
+    pub(crate) lj_potential: &'static str,
 }
 
 #[derive(Clone, Debug, Serialize)]

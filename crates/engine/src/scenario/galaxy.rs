@@ -15,13 +15,13 @@ use std::f64::consts::PI;
 pub const G: f64 = 1.0;
 /// Plummer softening: small against the cloud's scale radius, large enough that close
 /// encounters of light bodies are resolved at dt = 1e-3.
-pub const SOFTENING: f64 = 0.05;
-pub const CLOUD_MASS: f64 = 1000.0;
-pub const CLOUD_SCALE: f64 = 1.0;
+pub(crate) const SOFTENING: f64 = 0.05;
+pub(crate) const CLOUD_MASS: f64 = 1000.0;
+pub(crate) const CLOUD_SCALE: f64 = 1.0;
 /// The cloud is truncated at this many scale radii (99% of the Plummer mass lies inside).
 const CLOUD_TRUNCATION: f64 = 10.0;
-pub const PLANETS: usize = 6;
-pub const PLANET_MASS: f64 = 1.0;
+pub(crate) const PLANETS: usize = 6;
+pub(crate) const PLANET_MASS: f64 = 1.0;
 const PLANET_RADII: [f64; PLANETS] = [3.0, 4.0, 5.0, 6.0, 7.0, 8.0];
 
 /// Builds the system with `n` bodies (the first min(n, 6) are the massive ones).

@@ -116,23 +116,23 @@ impl ScenarioKind {
 
 /// Largest particle count: particle indices are stored as `u32` in ids and in the cell list,
 /// and 2^29 particles already need tens of GB.
-pub const MAX_PARTICLES: usize = 1 << 29;
+pub(crate) const MAX_PARTICLES: usize = 1 << 29;
 
 /// Lennard-Jones parameters shared by the LJ scenarios (the LJ-box assignment's units); σ is
 /// the physics layer's, where the kernels' defaults also read it.
-pub const LJ_EPSILON: f64 = 1.0;
-pub use crate::physics::LJ_SIGMA;
+pub(crate) const LJ_EPSILON: f64 = 1.0;
+pub(crate) use crate::physics::LJ_SIGMA;
 pub const LJ_CUTOFF: f64 = 2.5 * LJ_SIGMA;
 /// The source's 500 particles in the unit square (≈1 neighbour inside rc: a dilute gas).
 pub const LJ_GAS_DENSITY: f64 = 500.0;
 /// Reduced density ρσ² = 0.8.
-pub const LJ_LIQUID_DENSITY: f64 = 0.8 / (LJ_SIGMA * LJ_SIGMA);
+pub(crate) const LJ_LIQUID_DENSITY: f64 = 0.8 / (LJ_SIGMA * LJ_SIGMA);
 /// Initial temperature: velocity components are N(0, √T0) for unit mass (k_B = 1).
-pub const LJ_T0: f64 = 1.0;
+pub(crate) const LJ_T0: f64 = 1.0;
 /// Downward acceleration of the lj-box field.
-pub const LJ_GRAVITY: f64 = 1.0;
+pub(crate) const LJ_GRAVITY: f64 = 1.0;
 /// Coulomb force quench distance (the source leaves it unset).
-pub const COULOMB_QUENCH: f64 = 1e-3;
+pub(crate) const COULOMB_QUENCH: f64 = 1e-3;
 
 /// A scenario's defaults.
 #[derive(Clone, Copy, Debug)]

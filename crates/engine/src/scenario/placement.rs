@@ -11,7 +11,7 @@ use thiserror::Error;
 pub struct PlacementError {
     pub placed: usize,
     pub requested: usize,
-    pub min_dist: f64,
+    pub(crate) min_dist: f64,
     pub side: f64,
 }
 
@@ -22,7 +22,7 @@ const ATTEMPTS: usize = 200;
 ///
 /// Rejection sampling against a grid of cells of side ≥ `min_dist` holding the particles placed
 /// so far, so each candidate is checked against its 3×3 neighbourhood only: O(n) overall.
-pub fn spaced_uniform(
+pub(crate) fn spaced_uniform(
     n: usize,
     side: f64,
     min_dist: f64,
@@ -87,7 +87,12 @@ pub fn spaced_uniform(
 
 /// `n` positions on a square lattice filling `[0, side)²`, each displaced by up to ±5% of
 /// `min_dist`, visited in a seeded random order so that which sites stay empty is random too.
-pub fn jittered_lattice(n: usize, side: f64, min_dist: f64, rng: &mut impl Rng) -> Vec<[f64; 2]> {
+pub(crate) fn jittered_lattice(
+    n: usize,
+    side: f64,
+    min_dist: f64,
+    rng: &mut impl Rng,
+) -> Vec<[f64; 2]> {
     let per_row = (n as f64).sqrt().ceil() as usize;
     let spacing = side / per_row as f64;
     let jitter = 0.05 * min_dist.min(spacing);

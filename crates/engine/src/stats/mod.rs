@@ -23,7 +23,7 @@ pub fn median(values: &[f64]) -> Option<f64> {
 }
 
 /// The median of a non-empty slice, reordering it (linear time: a bootstrap takes thousands).
-pub fn median_in_place(v: &mut [f64]) -> f64 {
+pub(crate) fn median_in_place(v: &mut [f64]) -> f64 {
     let (len, mid) = (v.len(), v.len() / 2);
     let (below, upper, _) = v.select_nth_unstable_by(mid, f64::total_cmp);
     let upper = *upper;
@@ -44,7 +44,7 @@ pub fn mad(values: &[f64]) -> Option<f64> {
 
 /// The nearest-rank quantile `q` (in [0, 1]) of values sorted in ascending order; `None` when
 /// there are none.
-pub fn quantile_of_sorted<T: Copy>(sorted: &[T], q: f64) -> Option<T> {
+pub(crate) fn quantile_of_sorted<T: Copy>(sorted: &[T], q: f64) -> Option<T> {
     let n = sorted.len();
     let rank = ((q.clamp(0.0, 1.0) * n as f64).ceil() as usize).clamp(1, n.max(1));
     sorted.get(rank - 1).copied()

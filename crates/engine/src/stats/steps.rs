@@ -67,7 +67,7 @@ impl StepHistogram {
     }
 
     /// Sum of the recorded step times, seconds.
-    pub fn sum_s(&self) -> f64 {
+    pub(crate) fn sum_s(&self) -> f64 {
         self.sum_ns as f64 * 1e-9
     }
 

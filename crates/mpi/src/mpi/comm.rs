@@ -15,7 +15,7 @@ use std::time::Instant;
 
 /// What a rank has spent and sent in MPI calls.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct CommCounters {
+pub(crate) struct CommCounters {
     /// Seconds inside MPI calls.
     pub seconds: f64,
     pub bytes_sent: u64,
@@ -93,7 +93,7 @@ impl Comm {
         self.size
     }
 
-    pub fn is_root(&self) -> bool {
+    pub(crate) fn is_root(&self) -> bool {
         self.rank == 0
     }
 
@@ -111,7 +111,7 @@ impl Comm {
         self.counters.bytes_sent += (bytes * (self.size - 1)) as u64;
     }
 
-    pub fn barrier(&mut self) {
+    pub(crate) fn barrier(&mut self) {
         self.counters.collectives += 1;
         self.timed(|w| w.barrier());
     }
@@ -138,7 +138,7 @@ impl Comm {
     }
 
     /// Every rank's `mine` (all of one length), concatenated in rank order.
-    pub fn all_gather_i64(&mut self, mine: &[i64]) -> Vec<i64> {
+    pub(crate) fn all_gather_i64(&mut self, mine: &[i64]) -> Vec<i64> {
         let mut all = vec![0i64; mine.len() * self.size];
         self.collective(std::mem::size_of_val(mine));
         self.timed(|w| w.all_gather_into(mine, &mut all[..]));
@@ -146,19 +146,19 @@ impl Comm {
     }
 
     /// Rank 0's `buf` on every rank (every rank passes a buffer of the same length).
-    pub fn broadcast_from_root(&mut self, buf: &mut [u8]) {
+    pub(crate) fn broadcast_from_root(&mut self, buf: &mut [u8]) {
         self.collective(if self.rank == 0 { buf.len() } else { 0 });
         self.timed(|w| w.process_at_rank(0).broadcast_into(buf));
     }
 
     /// Element-wise sum over the ranks.
-    pub fn all_reduce_sum_f64(&mut self, mine: &[f64], out: &mut [f64]) {
+    pub(crate) fn all_reduce_sum_f64(&mut self, mine: &[f64], out: &mut [f64]) {
         self.collective(std::mem::size_of_val(mine));
         self.timed(|w| w.all_reduce_into(mine, out, SystemOperation::sum()));
     }
 
     /// Element-wise sum over the ranks.
-    pub fn all_reduce_sum_u64(&mut self, mine: &[u64]) -> Vec<u64> {
+    pub(crate) fn all_reduce_sum_u64(&mut self, mine: &[u64]) -> Vec<u64> {
         let mut out = vec![0u64; mine.len()];
         self.collective(std::mem::size_of_val(mine));
         self.timed(|w| w.all_reduce_into(mine, &mut out[..], SystemOperation::sum()));
@@ -181,7 +181,7 @@ impl Comm {
     /// exchanged first (blocking, one small message each way), then the payloads are posted as
     /// nonblocking sends and receives, `work` runs, and the requests are completed. The time
     /// of `work` is not communication time.
-    pub fn exchange_overlapped<R>(
+    pub(crate) fn exchange_overlapped<R>(
         &mut self,
         peers: &[usize],
         send: &[Vec<u8>],
@@ -280,7 +280,7 @@ impl Comm {
     }
 
     /// Gathers every rank's bytes on rank 0, which receives them per rank; `None` elsewhere.
-    pub fn gather_to_root(&mut self, mine: &[u8]) -> Result<Option<Vec<Vec<u8>>>, MpiError> {
+    pub(crate) fn gather_to_root(&mut self, mine: &[u8]) -> Result<Option<Vec<Vec<u8>>>, MpiError> {
         let n = count(mine.len())?;
         self.counters.collectives += 2;
         if self.rank != 0 {
@@ -324,7 +324,7 @@ impl Comm {
 /// [`super::Mpi::init`]), which allows calls from any thread as long as they never overlap:
 /// the lending thread waits inside `install` until the closure returns, so only one thread
 /// uses the communicator at a time.
-pub struct Lent<'a>(&'a mut Comm);
+pub(crate) struct Lent<'a>(&'a mut Comm);
 
 // SAFETY: see the type's documentation: one thread at a time, at a thread level that allows it.
 unsafe impl Send for Lent<'_> {}
@@ -347,7 +347,7 @@ impl Comm {
         self.timed(|w| w.process_at_rank(to as i32).send_with_tag(buf, tag));
     }
 
-    pub fn receive(&mut self, from: usize, buf: &mut [u8], tag: Tag) {
+    pub(crate) fn receive(&mut self, from: usize, buf: &mut [u8], tag: Tag) {
         self.timed(|w| {
             w.process_at_rank(from as i32)
                 .receive_into_with_tag(buf, tag);
@@ -355,7 +355,7 @@ impl Comm {
     }
 
     /// Element-wise maximum over the ranks, on rank 0; `None` elsewhere.
-    pub fn reduce_max_to_root(&mut self, mine: &[f64]) -> Option<Vec<f64>> {
+    pub(crate) fn reduce_max_to_root(&mut self, mine: &[f64]) -> Option<Vec<f64>> {
         self.counters.collectives += 1;
         let root_rank = self.rank == 0;
         self.timed(|w| {

@@ -10,12 +10,12 @@ use crate::state::{Field, State};
 use std::time::Instant;
 
 /// Tag bases of the point-to-point exchanges (each uses the tag and the next one).
-pub const TAG_MIGRATE: i32 = 10;
-pub const TAG_GHOSTS: i32 = 20;
+pub(crate) const TAG_MIGRATE: i32 = 10;
+pub(crate) const TAG_GHOSTS: i32 = 20;
 
 /// Counters a driver keeps for the steps since the last reset.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct Tally {
+pub(crate) struct Tally {
     /// Seconds computing forces (part of the compute time).
     pub force_s: f64,
     /// Of `force_s`, building cells or trees.
@@ -28,7 +28,7 @@ pub struct Tally {
 }
 
 /// One rank's part of a distributed simulation.
-pub trait Driver<T: Real, const D: usize> {
+pub(crate) trait Driver<T: Real, const D: usize> {
     /// One velocity-Verlet step (number `step`, from 1) of this rank's particles, with the
     /// communication it needs. Every rank calls it for every step; an error on any rank stops
     /// all of them in the same step.
@@ -54,7 +54,10 @@ pub trait Driver<T: Real, const D: usize> {
 
 /// The owned particles and their forces as f64 records (a particle, then its force), for
 /// gathering the final state.
-pub fn pack_owned<T: Real, const D: usize>(state: &State<T, D>, forces: &Field<T, D>) -> Vec<f64> {
+pub(crate) fn pack_owned<T: Real, const D: usize>(
+    state: &State<T, D>,
+    forces: &Field<T, D>,
+) -> Vec<f64> {
     let mut out = Vec::with_capacity(state.len() * (crate::decomp::wire::particle_values(D) + D));
     for i in 0..state.len() {
         pack_particle(state, i, &mut out);
@@ -67,9 +70,9 @@ pub fn pack_owned<T: Real, const D: usize>(state: &State<T, D>, forces: &Field<T
 
 /// What one rank measured over the timed steps.
 #[derive(Clone, Debug, Default)]
-pub struct Timeline {
+pub(crate) struct Timeline {
     /// Wall time of each timed step, nanoseconds.
-    pub wall_ns: Vec<u64>,
+    pub(crate) wall_ns: Vec<u64>,
     /// Compute seconds of each timed step (wall time minus time inside MPI).
     pub compute_s: Vec<f64>,
     /// MPI counters over the timed steps.

@@ -52,7 +52,7 @@ pub struct RootResult {
 }
 
 /// Runs `spec` on the system it is given; `Some` on rank 0.
-pub struct MpiJob<'a> {
+pub(crate) struct MpiJob<'a> {
     pub spec: &'a MpiSpec,
     pub comm: &'a mut Comm,
 }

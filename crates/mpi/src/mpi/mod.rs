@@ -20,7 +20,8 @@ pub use crate::decomp::check::CheckReport;
 pub use bench::BenchOptions;
 pub use domain::DomainOptions;
 pub use error::MpiError;
-pub use job::{MpiSpec, RootResult};
+pub use job::MpiSpec;
+pub(crate) use job::RootResult;
 
 use crate::ranks::bench_file::MpiBenchFile;
 use crate::ranks::job::Job;

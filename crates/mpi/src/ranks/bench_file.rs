@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
-pub const MPI_BENCH_SCHEMA: &str = "nbody-bench/mpi-bench/v1";
+pub(crate) const MPI_BENCH_SCHEMA: &str = "nbody-bench/mpi-bench/v1";
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MpiBenchFile {
@@ -74,7 +74,7 @@ pub enum BenchFileError {
 }
 
 /// The byte-transfer layers this process's MPI runs were restricted to, if any.
-pub fn transport_from_env() -> Option<String> {
+pub(crate) fn transport_from_env() -> Option<String> {
     std::env::var("OMPI_MCA_btl")
         .ok()
         .filter(|v| !v.trim().is_empty())
@@ -144,7 +144,7 @@ pub fn sizes(max: u64) -> Vec<u64> {
 }
 
 /// Timed repetitions at message size `bytes`.
-pub fn reps_at(bytes: u64, reps: usize) -> usize {
+pub(crate) fn reps_at(bytes: u64, reps: usize) -> usize {
     let scaled = reps as u64 * FULL_REPS_UP_TO / bytes.max(FULL_REPS_UP_TO);
     (scaled as usize).max(10.min(reps)).max(1)
 }

@@ -43,7 +43,7 @@ fn hash(keys: (u64, u64), text: &str) -> [u8; 16] {
 
 impl JobDigest {
     /// Bytes of [`JobDigest::to_bytes`], the same on every rank and for every job.
-    pub const BYTES: usize = 32;
+    pub(crate) const BYTES: usize = 32;
 
     /// The digest of `job` run by the build described by `build` (see [`build_identity`]).
     pub fn of(job: &Job, build: &str) -> Self {
@@ -53,14 +53,14 @@ impl JobDigest {
         }
     }
 
-    pub fn to_bytes(self) -> [u8; Self::BYTES] {
+    pub(crate) fn to_bytes(self) -> [u8; Self::BYTES] {
         let mut out = [0u8; Self::BYTES];
         out[..16].copy_from_slice(&self.command);
         out[16..].copy_from_slice(&self.build);
         out
     }
 
-    pub fn from_bytes(bytes: [u8; Self::BYTES]) -> Self {
+    pub(crate) fn from_bytes(bytes: [u8; Self::BYTES]) -> Self {
         let mut d = JobDigest {
             command: [0; 16],
             build: [0; 16],
@@ -88,7 +88,7 @@ pub struct Difference;
 
 impl Difference {
     pub const COMMAND: u8 = 1;
-    pub const BUILD: u8 = 2;
+    pub(crate) const BUILD: u8 = 2;
 
     /// The differences in words: "arguments", "build", or both.
     fn describe(bits: u8) -> &'static str {
@@ -103,7 +103,7 @@ impl Difference {
 /// What identifies this program's build: version, compiler, target, features and a hash of
 /// the executable itself (two builds of one version differ; two copies of one build on
 /// different nodes agree). Read once per MPI job with more than one rank.
-pub fn build_identity() -> String {
+pub(crate) fn build_identity() -> String {
     let mut features = Vec::new();
     if cfg!(feature = "mpi") {
         features.push("mpi");

@@ -17,14 +17,14 @@ const MAX_BINS_PER_PARTICLE: usize = 4;
 
 /// Geometry of the bins for one step.
 #[derive(Clone, Copy, Debug)]
-pub struct Grid<const D: usize> {
+pub(crate) struct Grid<const D: usize> {
     lo: [f64; D],
     /// Bins per unit length along each axis (0 on an axis with a single bin).
     inv_side: [f64; D],
     /// Bins along each axis (the phantom bins not included).
     pub dims: [usize; D],
     /// Bins per row including the phantom: `dims[0] + 1`.
-    pub row_len: usize,
+    pub(crate) row_len: usize,
     /// Number of rows (product of `dims[1..]`).
     pub rows: usize,
 }
@@ -133,7 +133,7 @@ impl<const D: usize> Grid<D> {
 /// A position at least `rc` from every point of the box `[lo, hi]`, finite so that a zero force
 /// coefficient times the separation stays zero; `None` near overflow. Along axis 0 it sits at
 /// `|sentinel − x| ≥ |l| + |h| + 4rc`, far above rounding errors; on other axes at `lo`.
-pub fn sentinel<T: Real, const D: usize>(lo: [T; D], hi: [T; D], rc: f64) -> Option<[T; D]> {
+pub(crate) fn sentinel<T: Real, const D: usize>(lo: [T; D], hi: [T; D], rc: f64) -> Option<[T; D]> {
     let (l, h) = (lo[0].as_f64(), hi[0].as_f64());
     let far = T::of(l - (2.0 * (l.abs() + h.abs()) + 4.0 * rc));
     let finite = far.is_finite() && lo.iter().all(|x| x.is_finite());

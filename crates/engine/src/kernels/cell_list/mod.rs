@@ -83,7 +83,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
 /// a dilute gas a particle has ~3 candidates, and this fixed cost is most of its step. From
 /// the one-thread profile of lj-box at n = 1e5 on the 2-vCPU AMD EPYC: ~63 ns per particle-
 /// step, of which ~1 ns is pair arithmetic, against 0.22 ns per naive pair.
-pub const ROW_COST: u64 = 250;
+pub(crate) const ROW_COST: u64 = 250;
 
 /// The work of a step of `n` particles and `candidates` candidate pairs, in naive pair
 /// evaluations: what decides whether the step forks.

@@ -26,9 +26,9 @@ const PAD: usize = LANES - 1;
 
 /// Largest particle count whose strip slots (3 per particle, padding) and bins (≤ 4 per
 /// particle) fit in `u32`.
-pub const MAX_PARTICLES: usize = 1 << 29;
+pub(crate) const MAX_PARTICLES: usize = 1 << 29;
 
-pub struct Strips<T, const D: usize> {
+pub(crate) struct Strips<T, const D: usize> {
     pub grid: Grid<D>,
     /// Sentinel slots after each strip (0 when runs must not be lengthened).
     pub pad: usize,
@@ -121,7 +121,7 @@ impl<T: Real, const D: usize> Strips<T, D> {
     }
 
     /// Expected candidate pairs of a step: each particle sees 3^D bins of mean occupancy.
-    pub fn expected_candidates(&self) -> u64 {
+    pub(crate) fn expected_candidates(&self) -> u64 {
         let n = self.bin.len() as f64;
         let bins: usize = self.grid.dims.iter().product();
         (n * (n * 3f64.powi(D as i32) / bins as f64).min(n)) as u64
@@ -283,7 +283,7 @@ fn count(start: &[u32], b: usize) -> u32 {
 /// Writes the bin of every particle of `pos` into `out[0]`, and with two outputs its bin
 /// coordinate along axis 1 into `out[1]`; on the pool's threads when the particles are many,
 /// each chunk compiled for the selected instruction set.
-pub fn bin_all<T: Real, const D: usize, const K: usize>(
+pub(crate) fn bin_all<T: Real, const D: usize, const K: usize>(
     g: &Grid<D>,
     pos: [&[T]; D],
     out: [&mut [u32]; K],

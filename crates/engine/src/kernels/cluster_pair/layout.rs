@@ -18,9 +18,9 @@ use crate::state::State;
 use rayon::prelude::*;
 
 /// Particles per cluster.
-pub const CLUSTER: usize = 4;
+pub(crate) const CLUSTER: usize = 4;
 /// Clusters whose particles fill the `LANES` of a block: a run of the list.
-pub const GROUP: usize = LANES / CLUSTER;
+pub(crate) const GROUP: usize = LANES / CLUSTER;
 const _: () = assert!(GROUP * CLUSTER == LANES);
 
 pub struct Layout<T, const D: usize> {
@@ -31,16 +31,16 @@ pub struct Layout<T, const D: usize> {
     extent_last: f64,
     pub columns: [usize; D],
     /// First cluster of every column, then the number of clusters.
-    pub column_start: Vec<u32>,
+    pub(crate) column_start: Vec<u32>,
     /// The particles in cluster order (`order[k]` = state slot), padding left out: the order
     /// `spatial_order` hands out.
     pub order: Vec<u32>,
     /// Per padded slot, its particle's state slot; per state slot, its padded slot.
-    pub slot_of: Vec<u32>,
-    pub padded_of: Vec<u32>,
+    pub(crate) slot_of: Vec<u32>,
+    pub(crate) padded_of: Vec<u32>,
     /// Per column, the extent of its particles along each axis (in f64).
-    pub column_lo: [Vec<f64>; D],
-    pub column_hi: [Vec<f64>; D],
+    pub(crate) column_lo: [Vec<f64>; D],
+    pub(crate) column_hi: [Vec<f64>; D],
     /// Per cluster: real particles (`CLUSTER` at most; 0 for the empty ones at the end), and
     /// bounding box (in f64).
     pub count: Vec<u8>,
@@ -96,7 +96,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
     }
 
     /// The columns along axis `d` that the interval `lo..=hi` overlaps, clamped to the grid.
-    pub fn column_range(&self, d: usize, lo: f64, hi: f64) -> (usize, usize) {
+    pub(crate) fn column_range(&self, d: usize, lo: f64, hi: f64) -> (usize, usize) {
         let last = self.columns[d] - 1;
         let a = ((lo - self.origin[d]) / self.width).max(0.0) as usize;
         let b = ((hi - self.origin[d]) / self.width).max(0.0) as usize;
@@ -343,7 +343,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
     /// the engine does with the order `spatial_order` hands out: the clusters stay, their
     /// particles' slots change. Returns false (nothing changed) unless the positions of
     /// `state` are exactly those the layout expects. On the pool's threads when worth it.
-    pub fn adopt(&mut self, state: &State<T, D>) -> bool {
+    pub(crate) fn adopt(&mut self, state: &State<T, D>) -> bool {
         let n = state.len();
         if self.order.len() != n {
             return false;

@@ -13,7 +13,7 @@ use std::ops::Range;
 /// The list of a range of i-clusters, built and evaluated as a unit (one per chunk of work a
 /// thread takes).
 #[derive(Default)]
-pub struct Part {
+pub(crate) struct Part {
     pub clusters: Range<usize>,
     /// i-cluster `clusters.start + k` has the runs `first[k]..first[k + 1]`: run `r` is the
     /// clusters `start[r]..start[r] + GROUP`.
@@ -21,7 +21,7 @@ pub struct Part {
     pub start: Vec<u32>,
     /// Per run, for each particle `a` of the i-cluster, the lanes that act (lane `l` is
     /// particle `l % CLUSTER` of cluster `start + l / CLUSTER`).
-    pub masks: Vec<[u16; CLUSTER]>,
+    pub(crate) masks: Vec<[u16; CLUSTER]>,
     /// One past the highest cluster the part's runs touch (the lowest is `clusters.start`).
     pub end: usize,
 }
@@ -34,7 +34,7 @@ impl Part {
 
 /// The lanes of a run from cluster `j0` that act for particle `a` of i-cluster `c`: clusters
 /// below `end`, their real particles, and in the i-cluster itself only the particles after `a`.
-pub fn run_masks(count: &[u8], c: usize, j0: usize, end: usize) -> [u16; CLUSTER] {
+pub(crate) fn run_masks(count: &[u8], c: usize, j0: usize, end: usize) -> [u16; CLUSTER] {
     let mut valid = 0u16;
     for q in 0..GROUP {
         let j = j0 + q;

@@ -15,14 +15,14 @@ use crate::simd::LANES;
 
 /// What the tiles of a part add up when probing: energy and pairs inside the cutoff.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct TileSum {
+pub(crate) struct TileSum {
     pub energy: f64,
     pub interacting: u64,
 }
 
 /// The cluster arrays a force loop reads: positions and strengths per padded slot, `CLUSTER`
 /// slots per cluster.
-pub struct Clusters<'a, T, const D: usize> {
+pub(crate) struct Clusters<'a, T, const D: usize> {
     pub pos: [&'a [T]; D],
     pub src: &'a [T],
 }
@@ -39,7 +39,7 @@ impl<'a, T: Real, const D: usize> Clusters<'a, T, D> {
 /// Adds the forces of the runs of `part` to `out`, where padded slot `s` is at
 /// `out[d][s - base]`: both ends of every pair, each pair once.
 #[inline(always)]
-pub fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     law: &L,
     clusters: &Clusters<'_, T, D>,
     part: &Part,

@@ -28,7 +28,7 @@
 use crate::simd::LANES;
 
 /// One value per SIMD lane.
-pub type Lanes = [f64; LANES];
+pub(crate) type Lanes = [f64; LANES];
 
 /// Highest supported expansion order.
 pub const MAX_ORDER: usize = 8;
@@ -147,14 +147,14 @@ impl Expansion {
 
     /// The multiply-adds of one M2L's contraction: one per pair of indices `(n, m)` with
     /// `|n| + |m| ≤ p`, `(p+1)(p+2)...(p+6)/6!` (210 at order 4).
-    pub fn m2l_terms(&self) -> usize {
+    pub(crate) fn m2l_terms(&self) -> usize {
         self.row_len.iter().sum()
     }
 
     /// `out[n] = v^n / n!` for the first `out.len()` indices (all of order ≤ q when
     /// `out.len() = terms(q)`).
     #[inline(always)]
-    pub fn monomials(&self, v: [f64; 3], out: &mut [f64]) {
+    pub(crate) fn monomials(&self, v: [f64; 3], out: &mut [f64]) {
         out[0] = 1.0;
         for i in 1..out.len() {
             let (parent, d, inv) = self.step[i];
@@ -165,7 +165,7 @@ impl Expansion {
     /// P2M: adds source `s` at offset `w = z − x` from the centre z to the multipole `m`.
     /// `mono` is scratch of `len` values.
     #[inline(always)]
-    pub fn p2m(&self, w: [f64; 3], s: f64, m: &mut [f64], mono: &mut [f64]) {
+    pub(crate) fn p2m(&self, w: [f64; 3], s: f64, m: &mut [f64], mono: &mut [f64]) {
         self.monomials(w, mono);
         for (a, b) in m.iter_mut().zip(mono.iter()) {
             *a += s * b;
@@ -174,7 +174,7 @@ impl Expansion {
 
     /// M2M: adds the multipole `child` about its centre to `parent` about a centre at
     /// `d = z_parent − z_child` from it (`(d + w)^n/n! = Σ_k d^k/k! · w^{n−k}/(n−k)!`).
-    pub fn m2m(&self, d: [f64; 3], child: &[f64], parent: &mut [f64], mono: &mut [f64]) {
+    pub(crate) fn m2m(&self, d: [f64; 3], child: &[f64], parent: &mut [f64], mono: &mut [f64]) {
         self.monomials(d, mono);
         for (n, out) in parent.iter_mut().enumerate() {
             let mut sum = 0.0;
@@ -194,7 +194,7 @@ impl Expansion {
     /// `len` rows. Lanes never mix, so each lane's sum is the same whichever lanes share its
     /// batch.
     #[inline(always)]
-    pub fn m2l_lanes(
+    pub(crate) fn m2l_lanes(
         &self,
         r: &[Lanes; 3],
         dj: &[Lanes],
@@ -253,7 +253,7 @@ impl Expansion {
 
     /// L2L: adds the local expansion `parent` about its centre, moved to a centre at
     /// `d = z_child − z_parent`, to `child` (`L_c[m] = Σ_k L[m + k] d^k/k!`).
-    pub fn l2l(&self, d: [f64; 3], parent: &[f64], child: &mut [f64], mono: &mut [f64]) {
+    pub(crate) fn l2l(&self, d: [f64; 3], parent: &[f64], child: &mut [f64], mono: &mut [f64]) {
         self.monomials(d, mono);
         let len = self.len;
         for (m, out) in child.iter_mut().enumerate() {
@@ -269,7 +269,7 @@ impl Expansion {
     /// L2P: the gradient of the far field at offset `r` from the centre, and with `potential`
     /// also the field itself (else 0). `mono` holds at least `len` values.
     #[inline(always)]
-    pub fn l2p(
+    pub(crate) fn l2p(
         &self,
         r: [f64; 3],
         l: &[f64],
@@ -304,7 +304,7 @@ impl Expansion {
 /// and `D_1 = −(r² + ε²)^{-3/2}`, so `κ D_1 = coeff`. Then `D_0 = −D_1 (r² + ε²)` and
 /// `D_{j+1} = −(2j+1) D_j / (r² + ε²)`.
 #[inline(always)]
-pub fn scaled_derivatives(coeff: &Lanes, r2_soft: &Lanes, p: usize, out: &mut [Lanes]) {
+pub(crate) fn scaled_derivatives(coeff: &Lanes, r2_soft: &Lanes, p: usize, out: &mut [Lanes]) {
     for l in 0..LANES {
         out[1][l] = coeff[l];
         out[0][l] = -coeff[l] * r2_soft[l];

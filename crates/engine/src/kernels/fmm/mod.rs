@@ -57,13 +57,13 @@ use walk::Walk;
 /// these studies, order 4 was the cheapest on `galaxy` and level with orders 5 and 6 on
 /// `coulomb`; towards 1e-4 the higher orders at a larger θ cost less (REPORT.md's long-range
 /// accuracy section, `configs/octree-accuracy.toml`, has the sweep).
-pub const DEFAULT_ORDER: usize = 4;
+pub(crate) const DEFAULT_ORDER: usize = 4;
 
 /// Most particles in a leaf by default: on `galaxy` 32 and 128 were about 1.3 times slower
 /// per particle-step than 64 at equal θ and order; on `coulomb` (uniform charges, whose octree
 /// cells grow by 8 per level) 64 and 128 build the same tree, and 32 tripled the error for no
 /// gain.
-pub const DEFAULT_LEAF_SIZE: usize = 64;
+pub(crate) const DEFAULT_LEAF_SIZE: usize = 64;
 
 /// Cells (M2L) or leaves (near field, L2P) per parallel task.
 const CELLS_PER_TASK: usize = 16;

@@ -75,7 +75,7 @@ impl Cells {
 
     /// Centres, radii and multipoles of every node of `tree`, the leaves on the pool's
     /// threads when `parallel`; the locals zeroed.
-    pub fn upward<T: Real, const D: usize>(
+    pub(crate) fn upward<T: Real, const D: usize>(
         &mut self,
         tree: &Tree<T, D>,
         exp: &Expansion,
@@ -176,7 +176,7 @@ impl Cells {
 
     /// L2L: moves every internal node's local expansion to its children's centres and adds
     /// it there, top-down (a parent's arena index is below its children's).
-    pub fn downward<T, const D: usize>(&mut self, tree: &Tree<T, D>, exp: &Expansion) {
+    pub(crate) fn downward<T, const D: usize>(&mut self, tree: &Tree<T, D>, exp: &Expansion) {
         let len = exp.len;
         let mut mono = vec![0.0; len];
         for (i, node) in tree.nodes.iter().enumerate() {

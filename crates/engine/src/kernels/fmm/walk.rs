@@ -28,7 +28,7 @@ pub(super) struct WalkCounts {
     /// Pairs of distinct cells split because they were too close.
     pub opened: u64,
     /// Cell–cell interactions (each pair of cells once).
-    pub m2l: u64,
+    pub(crate) m2l: u64,
 }
 
 enum Task {

@@ -40,7 +40,7 @@ use crate::par::chunk_len;
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::state::{Field, State};
-pub use node::far_from_box;
+pub(crate) use node::far_from_box;
 use std::ops::Range;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU32, Ordering};
@@ -55,7 +55,7 @@ use walk::{Scratch, Totals, eval_groups, for_group_runs};
 /// tree fewer times but gather from longer lists (the box is larger, so fewer nodes pass).
 /// On a Plummer sphere of 1e5 at θ = 0.5 and leaf size 8, 16 and 32 are within 2 % of each
 /// other; 8 is 15 % slower (more walks), 64 is 7 % slower (longer lists).
-pub const GROUP_SIZE: usize = 32;
+pub(crate) const GROUP_SIZE: usize = 32;
 
 /// The order of the expansion of accepted nodes.
 #[derive(

@@ -8,12 +8,12 @@ use crate::real::Real;
 #[derive(Clone, Copy, Debug)]
 pub(in crate::kernels) struct Node<T, const D: usize> {
     /// Centre of strength (mass-weighted centre); the mean position if the strength is zero.
-    pub com: [T; D],
+    pub(crate) com: [T; D],
     /// Total source strength.
     pub strength: T,
     /// `(side/θ)²`: the node is accepted as a monopole when `d² > crit2` (i.e. `side/d < θ`);
     /// infinite for θ = 0, so that nothing is ever accepted.
-    pub crit2: T,
+    pub(crate) crit2: T,
     pub start: u32,
     pub end: u32,
     /// Index of the first child; the children are contiguous in the arena.
@@ -28,7 +28,7 @@ impl<T: Real, const D: usize> Node<T, D> {
     /// nearest point of the box (`d² > crit2`). A point is the box `[x, x]`. Branch-free, as the
     /// walk tests whole families with it; a NaN distance fails the test, so the node is opened.
     #[inline(always)]
-    pub fn far_from_box(&self, lo: &[T; D], hi: &[T; D]) -> bool {
+    pub(crate) fn far_from_box(&self, lo: &[T; D], hi: &[T; D]) -> bool {
         far_from_box(&self.com, self.crit2, lo, hi)
     }
 }
@@ -36,7 +36,7 @@ impl<T: Real, const D: usize> Node<T, D> {
 /// The opening test of a node given by its centre of strength and `crit2 = (side/θ)²` (see
 /// [`Node::far_from_box`]), for nodes that travel without their tree (`decomp::top_nodes`).
 #[inline(always)]
-pub fn far_from_box<T: Real, const D: usize>(
+pub(crate) fn far_from_box<T: Real, const D: usize>(
     com: &[T; D],
     crit2: T,
     lo: &[T; D],

@@ -64,11 +64,11 @@ pub(in crate::kernels) struct Tree<T, const D: usize> {
     pub src: Vec<T>,
     pub nodes: Vec<Node<T, D>>,
     /// One root per sign class present (non-negative, negative).
-    pub roots: Vec<u32>,
+    pub(crate) roots: Vec<u32>,
     /// Target groups in sorted order; their ranges tile `0..n`.
     pub groups: Vec<Group>,
     /// A point outside the bounding cube, where zero-strength padding sources sit.
-    pub dummy: [T; D],
+    pub(crate) dummy: [T; D],
     /// Second moments of every node, computed only for the quadrupole order (else empty).
     pub quad: Quadrupoles<T>,
     quadrupole: bool,
@@ -108,7 +108,7 @@ impl<T: Real, const D: usize> Tree<T, D> {
     /// A tree of one class whatever the signs of the sources, for the fast multipole kernel:
     /// leaves of at most `leaf_size` particles, no θ (the kernel tests its own criterion), no
     /// second moments.
-    pub fn one_class(leaf_size: usize) -> Self {
+    pub(crate) fn one_class(leaf_size: usize) -> Self {
         Tree {
             split_signs: false,
             ..Tree::new(0.0, leaf_size, leaf_size, false)
@@ -300,7 +300,7 @@ impl<T: Real, const D: usize> Tree<T, D> {
     }
 
     /// The sorted order of the last `sort`, as `order[new_slot] = old_slot`.
-    pub fn sorted_order(&self) -> Vec<u32> {
+    pub(crate) fn sorted_order(&self) -> Vec<u32> {
         self.keys.iter().map(|k| k.1).collect()
     }
 }

@@ -26,7 +26,7 @@ impl<L, T: Real, const D: usize> Octree<L, T, D> {
 
 impl<T: Real, const D: usize> TreeView<'_, T, D> {
     /// One root per sign class of sources present (one for gravity, none without bodies).
-    pub fn roots(&self) -> &[u32] {
+    pub(crate) fn roots(&self) -> &[u32] {
         &self.tree.roots
     }
 
@@ -36,7 +36,7 @@ impl<T: Real, const D: usize> TreeView<'_, T, D> {
         n.first..n.first + n.children
     }
 
-    pub fn is_leaf(&self, node: u32) -> bool {
+    pub(crate) fn is_leaf(&self, node: u32) -> bool {
         self.tree.nodes[node as usize].children == 0
     }
 
@@ -66,12 +66,13 @@ impl<T: Real, const D: usize> TreeView<'_, T, D> {
     }
 
     /// Number of bodies in the tree.
-    pub fn body_count(&self) -> usize {
+    pub(crate) fn body_count(&self) -> usize {
         self.tree.src.len()
     }
 
+    #[cfg(test)]
     /// Number of nodes in the arena.
-    pub fn node_count(&self) -> usize {
+    pub(crate) fn node_count(&self) -> usize {
         self.tree.nodes.len()
     }
 
@@ -92,13 +93,13 @@ impl<T: Real, const D: usize> TreeView<'_, T, D> {
 
     /// Values per node beyond the monopole: the components of Q and the trace T at quadrupole
     /// order (`D(D+1)/2 + 1`), 0 at monopole order.
-    pub fn moment_values(&self) -> usize {
+    pub(crate) fn moment_values(&self) -> usize {
         if self.tree.quadrupole() { stride(D) } else { 0 }
     }
 
     /// The second moments of `node` (Q in the order of `moments`, then T); empty at monopole
     /// order.
-    pub fn moments(&self, node: u32) -> &[T] {
+    pub(crate) fn moments(&self, node: u32) -> &[T] {
         let w = self.moment_values();
         &self.tree.quad.values[node as usize * w..(node as usize + 1) * w]
     }
@@ -106,13 +107,13 @@ impl<T: Real, const D: usize> TreeView<'_, T, D> {
     /// `(side/θ)²` of `node`: the node may act as a multipole on a point whose squared
     /// distance from its centre exceeds this (infinite at θ = 0), the test of
     /// [`TreeView::far_from_box`] for one point.
-    pub fn open_radius2(&self, node: u32) -> T {
+    pub(crate) fn open_radius2(&self, node: u32) -> T {
         self.tree.nodes[node as usize].crit2
     }
 
     /// The kernel's opening test: whether `node` may act as a multipole on every point of the
     /// box `[lo, hi]` (see `Node::far_from_box`).
-    pub fn far_from_box(&self, node: u32, lo: &[T; D], hi: &[T; D]) -> bool {
+    pub(crate) fn far_from_box(&self, node: u32, lo: &[T; D], hi: &[T; D]) -> bool {
         self.tree.nodes[node as usize].far_from_box(lo, hi)
     }
 }

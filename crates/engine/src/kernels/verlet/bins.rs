@@ -67,7 +67,7 @@ impl<T: Real, const D: usize> Bins<T, D> {
     /// permuted by the order of the last sort, as the engine does with the order
     /// `spatial_order` hands out): the bins stay valid and the order becomes the identity, so
     /// the rebuild after a re-ordering does not bin twice.
-    pub fn adopt(&mut self, state: &State<T, D>) -> bool {
+    pub(crate) fn adopt(&mut self, state: &State<T, D>) -> bool {
         let n = state.len();
         let same = self.order.len() == n && (0..D).all(|d| state.pos[d][..] == self.pos[d][..]);
         if same {

@@ -12,7 +12,7 @@ use std::ops::Range;
 
 /// Which pairs a list holds.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Cover {
+pub(crate) enum Cover {
     /// Each pair once, for Newton's third law: row `k` is the particle of sorted index `k` and
     /// holds its partners in the forward half of its stencil — later in its own row of bins,
     /// and in the rows of bins after it.
@@ -23,7 +23,7 @@ pub enum Cover {
 
 /// One part of a list: the rows `rows`, their entries, and the slots their pairs touch.
 #[derive(Default)]
-pub struct Part {
+pub(crate) struct Part {
     pub rows: Range<usize>,
     /// Row `rows.start + r` holds the entries `first[r]..first[r + 1]`.
     pub first: Vec<usize>,
@@ -47,7 +47,7 @@ impl Part {
 /// Work of a build: candidate pairs whose distance was computed, bins searched (summed over
 /// the rows), lists built.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct BuildWork {
+pub(crate) struct BuildWork {
     pub candidates: u64,
     pub bins: u64,
     pub rebuilds: u64,

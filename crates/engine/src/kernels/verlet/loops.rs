@@ -21,7 +21,7 @@ use crate::real::{Real, select};
 use crate::state::State;
 
 /// Slot-indexed inputs: positions and strengths, each slice of length n.
-pub struct Slots<'a, T, const D: usize> {
+pub(crate) struct Slots<'a, T, const D: usize> {
     pos: [&'a [T]; D],
     src: &'a [T],
 }
@@ -147,7 +147,7 @@ fn block_of(v: &[u32], e: usize) -> &[u32; LANES] {
 /// Adds the forces of the pairs of `part` to `out` (slot `s` at `out[d][s - base]`), both ends
 /// of each pair, in blocks of entries that ignore the rows.
 #[inline(always)]
-pub fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+pub(crate) fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     law: &L,
     slots: &Slots<'_, T, D>,
     part: &Part,
@@ -176,7 +176,7 @@ pub fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
 /// Overwrites `out[d][r]` with the force on the target of row `part.rows.start + r` from
 /// all its partners (a full list).
 #[inline(always)]
-pub fn target_rows<T: Real, L: PairLaw<T>, const D: usize>(
+pub(crate) fn target_rows<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,
     slots: &Slots<'_, T, D>,
     part: &Part,

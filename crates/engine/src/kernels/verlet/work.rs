@@ -8,7 +8,7 @@ use crate::real::Real;
 
 /// Parts per thread of a split list: several, so that work stealing evens out parts of unequal
 /// density (the gas of lj-box settles under gravity).
-pub const PARTS_PER_THREAD: usize = 4;
+pub(crate) const PARTS_PER_THREAD: usize = 4;
 
 /// Cost of one list entry and of one row (particle) of a step, the rebuild included (spread
 /// over the four steps or so it serves at the default skin), in the naive kernel's pair
@@ -16,8 +16,8 @@ pub const PARTS_PER_THREAD: usize = 4;
 /// EPYC under load (CPU time, n = 1e5): a naive LJ pair 0.22 ns; an entry 4.5 ns in the force
 /// loop and 8 ns in a rebuild (liquid); a row 45 ns in a rebuild (gas, where a row has half
 /// an entry) and under 1 ns in the force loop (the displacement test, zeroing the forces).
-pub const ENTRY_COST: u64 = 25;
-pub const ROW_COST: u64 = 50;
+pub(crate) const ENTRY_COST: u64 = 25;
+pub(crate) const ROW_COST: u64 = 50;
 
 /// The work of one step over a list of `rows` rows and `entries` entries, in naive pair
 /// evaluations.
@@ -39,7 +39,7 @@ pub fn parts_for(threads: usize, work: u64) -> usize {
 
 /// Entries a list of `cover` over `bins` can have at most: the candidates of the stencils
 /// (before the first build, when no earlier list tells).
-pub fn expected_entries<T: Real, const D: usize>(bins: &Bins<T, D>, cover: &Cover) -> u64 {
+pub(crate) fn expected_entries<T: Real, const D: usize>(bins: &Bins<T, D>, cover: &Cover) -> u64 {
     let n = bins.order.len() as f64;
     let cells: usize = bins.grid.dims.iter().product();
     let stencil = 3f64.powi(D as i32);
@@ -54,7 +54,11 @@ pub fn expected_entries<T: Real, const D: usize>(bins: &Bins<T, D>, cover: &Cove
 /// counts as far), in f64. Blocks of slots with an early exit: a rebuild that is due does not
 /// wait for the whole scan.
 #[inline(always)]
-pub fn moved_beyond<T: Real, const D: usize>(now: [&[T]; D], then: [&[T]; D], limit: f64) -> bool {
+pub(crate) fn moved_beyond<T: Real, const D: usize>(
+    now: [&[T]; D],
+    then: [&[T]; D],
+    limit: f64,
+) -> bool {
     const BLOCK: usize = 2048;
     let n = now[0].len();
     let mut start = 0;

@@ -34,7 +34,7 @@ use crate::scenario::System;
 use crate::state::{Field, State};
 use std::time::Instant;
 
-pub struct EssentialTree<T: Real, L, const D: usize> {
+pub(crate) struct EssentialTree<T: Real, L, const D: usize> {
     local: Local<T, L, D>,
     orb: Orb<D>,
     /// The box the bisection cut; faces on it are open in the selection.

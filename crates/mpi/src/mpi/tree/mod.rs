@@ -16,8 +16,8 @@
 mod essential;
 mod octants;
 
-pub use essential::EssentialTree;
-pub use octants::OctantTree;
+pub(crate) use essential::EssentialTree;
+pub(crate) use octants::OctantTree;
 
 use super::comm::Comm;
 use super::driver::Tally;
@@ -45,7 +45,7 @@ pub(super) struct Status {
     pub failed: bool,
     pub bodies: u64,
     /// Force nanoseconds and interactions of the previous step.
-    pub force_ns: u64,
+    pub(crate) force_ns: u64,
     pub interactions: u64,
 }
 
@@ -66,10 +66,10 @@ pub(super) struct Local<T: Real, L, const D: usize> {
     boundary: Boundary<T, D>,
     external: [T; D],
     dt: T,
-    pub tally: Tally,
+    pub(crate) tally: Tally,
     /// This rank's force time and interactions in the last step, for the next status.
-    pub last_force_ns: u64,
-    pub last_interactions: u64,
+    pub(crate) last_force_ns: u64,
+    pub(crate) last_interactions: u64,
     /// Each owned body's interaction count in the last force computation, when the driver
     /// records them (empty otherwise, and after migration until the next computation).
     pub costs: Vec<u32>,
@@ -103,19 +103,19 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
     }
 
     /// Half kick, drift and the walls; the wall error, if any, to be shared with every rank.
-    pub fn first_half(&mut self, step: u64) -> Option<BoundaryError> {
+    pub(crate) fn first_half(&mut self, step: u64) -> Option<BoundaryError> {
         let half = self.dt * T::of(0.5);
         kick_drift(&mut self.owned, &self.forces, self.external, half, self.dt);
         self.boundary.apply(&mut self.owned, step).err()
     }
 
-    pub fn second_half(&mut self) {
+    pub(crate) fn second_half(&mut self) {
         let half = self.dt * T::of(0.5);
         kick(&mut self.owned, &self.forces, self.external, half);
     }
 
     /// Every rank's status (one small Allgather); an error anywhere stops every rank here.
-    pub fn share_status(
+    pub(crate) fn share_status(
         &mut self,
         comm: &mut Comm,
         error: Option<BoundaryError>,
@@ -151,7 +151,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
 
     /// Sends every owned body whose owner is another rank to it (an all-to-all, as bodies may
     /// move to any rank) and takes in those sent here.
-    pub fn send_to_owners(
+    pub(crate) fn send_to_owners(
         &mut self,
         comm: &mut Comm,
         owner: impl Fn([f64; D]) -> usize,
@@ -202,7 +202,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> Local<T, L, D> {
     /// rank order, and each sampled body's weight: the interaction counts of the k bodies it
     /// stands for in the previous step (`decomp::orb::sample_weights`), or, where a rank has
     /// no per-body counts, its interactions per body times k.
-    pub fn gather_sample(
+    pub(crate) fn gather_sample(
         &mut self,
         comm: &mut Comm,
         all: &[Status],

@@ -32,7 +32,7 @@ use std::time::Instant;
 /// Levels of each rank's tree shared as its top nodes (at most 1 + 8 + 64 + 512 nodes in 3-D).
 pub const TOP_LEVELS: u32 = 3;
 
-pub struct OctantTree<T: Real, L, const D: usize> {
+pub(crate) struct OctantTree<T: Real, L, const D: usize> {
     local: Local<T, L, D>,
     octants: Octants<D>,
 }
