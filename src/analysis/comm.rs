@@ -2,11 +2,81 @@
 //! prediction of the communication time per step of the two MPI decompositions at rank counts
 //! beyond the machine, for a weak-scaling series of the 2-D LJ gas (n = n₀·p).
 
-use super::Fitted;
+use super::{Analysis, Fitted};
 use crate::decomp::model;
 use crate::fit::{self, AlphaBetaFit, Samples};
 use crate::ranks::bench_file::MpiBenchFile;
+use crate::scenario::ScenarioKind;
 use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// Particles per rank the model predicts for when no sweep ran the LJ gas under MPI: those of
+/// `configs/weak-mpi.toml`, the weak-scaling study the model accompanies.
+pub const DEFAULT_N_PER_RANK: usize = 20_000;
+
+/// The LJ model of a set of sweeps, with where it comes from.
+pub(crate) struct Chosen<'a> {
+    pub(crate) model: CommModel,
+    /// The mpi-bench file fitted.
+    pub(crate) bench: &'a Path,
+    /// The sweep that ran the LJ gas under MPI, if any (its n per rank is the model's).
+    pub(crate) weak_mpi: Option<&'a Analysis>,
+}
+
+/// The LJ communication model of `sweeps`, from one of `benches` (mpi-bench files with their
+/// paths): of those measured over the MPI library's own transport (a TCP run is the tree
+/// model's), the ones in the directory of the sweep that ran the LJ gas under MPI (the same
+/// machine) when there are any, else all; of those, the one with the most ranks that still had
+/// a CPU each, else the first. `None` without a benchmark.
+pub(crate) fn choose<'a>(
+    benches: &'a [(PathBuf, MpiBenchFile)],
+    sweeps: &[&'a Analysis],
+) -> Option<Chosen<'a>> {
+    let weak_mpi = sweeps.iter().copied().find(|a| {
+        a.cases
+            .iter()
+            .any(|c| c.decomp.is_some() && c.case.scenario != ScenarioKind::Galaxy)
+    });
+    let native: Vec<&(PathBuf, MpiBenchFile)> =
+        benches.iter().filter(|(_, b)| !b.over_tcp()).collect();
+    let own: Vec<_> = match weak_mpi {
+        Some(a) => native
+            .iter()
+            .copied()
+            .filter(|(p, _)| in_sweep_dir(p, &[a.name.as_str()]))
+            .collect(),
+        None => Vec::new(),
+    };
+    let pool = if own.is_empty() { native } else { own };
+    let (path, bench) = pool
+        .iter()
+        .copied()
+        .filter(|(_, b)| !b.oversubscribed)
+        .max_by_key(|(_, b)| b.ranks)
+        .or(pool.first().copied())?;
+    let n_per_rank = weak_mpi
+        .and_then(|a| a.cases.iter().find(|c| c.ranks == 1).map(|c| c.n))
+        .unwrap_or(DEFAULT_N_PER_RANK);
+    let model = comm_model(
+        bench,
+        &path.to_string_lossy().replace('\\', "/"),
+        n_per_rank,
+        crate::scenario::LJ_GAS_DENSITY,
+        crate::scenario::LJ_CUTOFF,
+    );
+    Some(Chosen {
+        model,
+        bench: path,
+        weak_mpi,
+    })
+}
+
+/// Whether `path` is a file directly in the results directory of one of the sweeps `names`.
+pub(crate) fn in_sweep_dir(path: &Path, names: &[&str]) -> bool {
+    path.parent()
+        .and_then(|d| d.file_name())
+        .is_some_and(|d| names.iter().any(|n| d == *n))
+}
 
 /// One predicted point: communication seconds per step with the 95% band of the fit.
 #[derive(Clone, Debug, Serialize)]

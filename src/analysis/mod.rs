@@ -8,6 +8,7 @@ pub mod comm;
 pub mod groups;
 pub mod peers;
 pub mod tree_comm;
+mod views;
 
 use crate::calibrate::Calibration;
 use crate::experiment::code::Code;

@@ -11,18 +11,20 @@
 //! (status, top-node sizes and nodes; migration, requests, answers); tree ⌈log2 p⌉ + 2(p − 1)
 //! (status; migration, essential trees).
 
-use super::Fitted;
-use super::comm::{PREDICTED_RANKS, fit_ping_pong, predict};
+use super::comm::{PREDICTED_RANKS, fit_ping_pong, in_sweep_dir, predict};
 use super::groups::Point;
+use super::{Analysis, Fitted};
 use crate::decomp::octants::{Octants, root_cube};
 use crate::decomp::orb::Orb;
 use crate::decomp::{Decomposition, Domains, model};
 use crate::fit::AlphaBetaFit;
 use crate::kernels::Multipole;
 use crate::ranks::bench_file::MpiBenchFile;
+use crate::scenario::ScenarioKind;
 use crate::scenario::galaxy::galaxy;
 use rayon::prelude::*;
 use serde::Serialize;
+use std::path::PathBuf;
 
 /// Levels of top nodes the octant driver shares (`mpi::tree::octants::TOP_LEVELS`).
 pub const TOP_LEVELS: u32 = 3;
@@ -158,6 +160,49 @@ fn count_one(p: usize, n: usize, seed: u64, theta: f64, leaf: usize) -> Vec<Coun
         out.push(summary(Decomposition::Tree, bytes, orb.counts(&s.pos)));
     }
     out
+}
+
+/// The distributed-tree model of `sweeps`, when one of them ran the galaxy under MPI: counted
+/// at its smallest n per rank and its θ, with the α-β of every transport an mpi-bench file in
+/// the directory of such a sweep (the same machine) was measured on.
+pub(crate) fn choose(
+    benches: &[(PathBuf, MpiBenchFile)],
+    sweeps: &[&Analysis],
+) -> Option<TreeComm> {
+    let galaxy: Vec<&Analysis> = sweeps
+        .iter()
+        .copied()
+        .filter(|a| {
+            a.cases
+                .iter()
+                .any(|c| c.decomp.is_some() && c.case.scenario == ScenarioKind::Galaxy)
+        })
+        .collect();
+    let cases = &galaxy.first()?.cases;
+    let n_per_rank = cases
+        .iter()
+        .filter(|c| c.ranks > 0)
+        .map(|c| c.n / c.ranks)
+        .min()?;
+    let defaults = crate::kernels::KernelParams::default();
+    let theta = cases.iter().find_map(|c| c.theta).unwrap_or(defaults.theta);
+    let names: Vec<&str> = galaxy.iter().map(|a| a.name.as_str()).collect();
+    let benches: Vec<(String, &MpiBenchFile)> = benches
+        .iter()
+        .filter(|(p, _)| in_sweep_dir(p, &names))
+        .map(|(p, b)| (p.to_string_lossy().replace('\\', "/"), b))
+        .collect();
+    let series: Vec<(String, &[Point])> = galaxy
+        .iter()
+        .map(|a| (a.name.clone(), a.cases.as_slice()))
+        .collect();
+    Some(tree_comm(
+        n_per_rank,
+        theta,
+        defaults.leaf_size,
+        &benches,
+        &series,
+    ))
 }
 
 /// The model and the measured side by side: `benches` are (path, file) of `mpi-bench` runs,

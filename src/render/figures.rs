@@ -99,65 +99,27 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
     let cap = caption(a);
     let mut out = Vec::new();
     // Cost vs n: one figure per scenario, precision and parallelism.
-    let mut seen: Vec<(String, String, usize, usize)> = Vec::new();
-    for c in &a.complexity {
-        let k = &c.series;
-        let id = (
-            k.scenario.name().to_string(),
-            k.precision.name().to_string(),
-            k.threads.unwrap_or(1),
-            k.ranks.unwrap_or(1),
-        );
-        if seen.contains(&id) {
-            continue;
-        }
-        let same: Vec<&ComplexityAnalysis> = a
-            .complexity
-            .iter()
-            .filter(|o| {
-                o.series.scenario == k.scenario
-                    && o.series.precision == k.precision
-                    && o.series.threads == k.threads
-                    && o.series.ranks == k.ranks
-            })
-            .collect();
+    for same in a.cost_groups() {
+        let k = &same[0].series;
+        let (scenario, precision) = (k.scenario.name(), k.precision.name());
+        let (threads, ranks) = (k.threads.unwrap_or(1), k.ranks.unwrap_or(1));
         let series: Vec<KernelSeries> = same.iter().map(|c| time_series(c)).collect();
         let mut chart = fig::time_per_step(&series, &cap);
         chart.title = format!(
-            "{} ({}, {} thread{}): time per step vs n",
-            id.0,
-            id.1,
-            id.2,
-            if id.2 == 1 { "" } else { "s" }
+            "{scenario} ({precision}, {threads} thread{}): time per step vs n",
+            if threads == 1 { "" } else { "s" }
         );
         out.push((
-            format!("time-vs-n-{}-{}-p{}-r{}", id.0, id.1, id.2, id.3),
+            format!("time-vs-n-{scenario}-{precision}-p{threads}-r{ranks}"),
             Drawing::Chart(chart),
         ));
-        seen.push(id);
     }
-    // Strong scaling: one set per scenario and n.
-    let mut strong_seen: Vec<(String, Option<usize>, String)> = Vec::new();
-    for s in &a.strong {
-        let id = (
-            s.series.scenario.name().to_string(),
-            s.series.n,
-            s.series.precision.name().to_string(),
-        );
-        if strong_seen.contains(&id) {
-            continue;
-        }
-        let same: Vec<&StrongAnalysis> = a
-            .strong
-            .iter()
-            .filter(|o| {
-                o.series.scenario == s.series.scenario
-                    && o.series.n == s.series.n
-                    && o.series.precision == s.series.precision
-            })
-            .collect();
-        let stem = format!("{}-n{}-{}", id.0, id.1.unwrap_or(0), id.2);
-        let title = format!("{} n={}", id.0, id.1.unwrap_or(0));
+    // Strong scaling: one set per scenario, n and precision.
+    for same in a.strong_groups() {
+        let k = &same[0].series;
+        let (scenario, n) = (k.scenario.name(), k.n.unwrap_or(0));
+        let stem = format!("{scenario}-n{n}-{}", k.precision.name());
+        let title = format!("{scenario} n={n}");
         let ceiling: Vec<(f64, f64)> = same
             .iter()
             .flat_map(|s| {
@@ -225,19 +187,12 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
             chart.title = format!("{title}: Karp-Flatt serial fraction e(p)");
             out.push((format!("karp-flatt-{stem}"), Drawing::Chart(chart)));
         }
-        strong_seen.push(id);
     }
     // Weak scaling: one figure per scenario.
-    let mut weak_seen: Vec<String> = Vec::new();
-    for w in &a.weak {
-        let scen = w.series.scenario.name().to_string();
-        if weak_seen.contains(&scen) {
-            continue;
-        }
-        let series: Vec<KernelSeries> = a
-            .weak
+    for same in a.weak_groups() {
+        let scenario = same[0].series.scenario.name();
+        let series: Vec<KernelSeries> = same
             .iter()
-            .filter(|o| o.series.scenario == w.series.scenario)
             .map(|o| {
                 let m: Vec<Measured> = o
                     .measured
@@ -251,23 +206,18 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
             })
             .collect();
         let workers = workers_noun(
-            a.weak
-                .iter()
-                .filter(|o| o.series.scenario == w.series.scenario)
+            same.iter()
                 .flat_map(|o| &o.points)
                 .map(|c| (c.threads, c.ranks)),
         );
         let mut chart = fig::weak_efficiency(&series, workers, &cap);
-        chart.title = format!("{scen}: weak-scaling efficiency T(1)/T(p)");
-        out.push((format!("weak-efficiency-{scen}"), Drawing::Chart(chart)));
-        weak_seen.push(scen);
+        chart.title = format!("{scenario}: weak-scaling efficiency T(1)/T(p)");
+        out.push((format!("weak-efficiency-{scenario}"), Drawing::Chart(chart)));
     }
     // Phase breakdown and step-time percentiles per scenario, at each case's largest n.
-    let mut scenarios: Vec<&str> = a.cases.iter().map(|c| c.case.scenario.name()).collect();
-    scenarios.sort_unstable();
-    scenarios.dedup();
-    for scen in scenarios {
-        let cases = representative_cases(a, scen);
+    for scenario in a.scenarios() {
+        let cases = a.representative_cases(scenario);
+        let scen = scenario.name();
         if cases.is_empty() {
             continue;
         }
@@ -353,33 +303,6 @@ pub(crate) fn case_label(c: &Point) -> String {
     let mut parts: Vec<&str> = c.key.split('/').collect();
     parts.retain(|p| !p.starts_with("seed=") && *p != "r=1");
     parts[1..].join(" ").replace("theta=", "θ=")
-}
-
-/// The cases of a scenario worth a bar each: for every kernel and p, the largest n measured.
-fn representative_cases<'a>(a: &'a Analysis, scenario: &str) -> Vec<&'a Point> {
-    let mut out: Vec<&Point> = Vec::new();
-    for c in a
-        .cases
-        .iter()
-        .filter(|c| c.case.scenario.name() == scenario)
-    {
-        let same = |o: &&Point| {
-            o.case.kernel == c.case.kernel
-                && o.threads == c.threads
-                && o.ranks == c.ranks
-                && o.theta == c.theta
-                && o.case.multipole == c.case.multipole
-                && o.case.order == c.case.order
-                && o.decomp == c.decomp
-        };
-        match out.iter().position(same) {
-            Some(i) if out[i].n < c.n => out[i] = c,
-            Some(_) => {}
-            None => out.push(c),
-        }
-    }
-    out.truncate(16);
-    out
 }
 
 fn oversubscribed_at(points: &[Point], p: f64) -> bool {

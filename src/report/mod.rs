@@ -13,6 +13,7 @@ mod tree_section;
 
 use crate::analysis::{self, Analysis};
 use crate::experiment::results::{ResultsError, ResultsFile};
+use crate::ranks::bench_file::MpiBenchFile;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -115,8 +116,10 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
             analysis: a,
         });
     }
-    let comm = comm_model(results_dir, &sweeps, report_dir, &mut figure_errors)?;
-    let tree = tree_comm(results_dir, &sweeps)?;
+    let benches = bench_files(results_dir)?;
+    let comm = comm_model(&benches, &sweeps, report_dir, &mut figure_errors);
+    let analyses: Vec<&Analysis> = sweeps.iter().map(|s| &s.analysis).collect();
+    let tree = analysis::tree_comm::choose(&benches, &analyses);
     let generated = sections::document(&sweeps, comm.as_ref(), tree.as_ref(), results_dir);
     let old = match crate::input::read_text(out) {
         Ok(text) => text,
@@ -143,79 +146,35 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
     })
 }
 
-/// The communication model and its figures, from the `mpi-bench-<ranks>.json` files under
-/// the results directory: the benchmark with the most ranks that still had a CPU each.
+/// The communication model ([`analysis::comm::choose`]) and its figures, drawn next to the
+/// mpi-bench file it was fitted on.
 fn comm_model(
-    results_dir: &Path,
+    benches: &[(PathBuf, MpiBenchFile)],
     sweeps: &[Sweep],
     report_dir: &Path,
     figure_errors: &mut Vec<String>,
-) -> Result<Option<sections::Comm>, ReportError> {
-    // The LJ model is fitted on the library's own transport; a TCP run is the tree section's.
-    let benches: Vec<_> = bench_files(results_dir)?
-        .into_iter()
-        .filter(|(_, b)| !b.over_tcp())
-        .collect();
-    let weak_mpi = sweeps.iter().find(|s| {
-        s.analysis
-            .cases
-            .iter()
-            .any(|c| c.decomp.is_some() && c.case.scenario != crate::scenario::ScenarioKind::Galaxy)
-    });
-    // The bench in the LJ sweep's own directory when there is one (the same machine).
-    let own: Vec<_> = match weak_mpi {
-        Some(s) => benches
-            .iter()
-            .filter(|(p, _)| in_sweep_dir(p, &[s.analysis.name.as_str()]))
-            .collect(),
-        None => Vec::new(),
-    };
-    let pool: Vec<_> = if own.is_empty() {
-        benches.iter().collect()
-    } else {
-        own
-    };
-    let Some((path, bench)) = pool
-        .iter()
-        .copied()
-        .filter(|(_, b)| !b.oversubscribed)
-        .max_by_key(|(_, b)| b.ranks)
-        .or(pool.first().copied())
-    else {
-        return Ok(None);
-    };
-    let n_per_rank = weak_mpi
-        .and_then(|s| s.analysis.cases.iter().find(|c| c.ranks == 1).map(|c| c.n))
-        .unwrap_or(20_000);
-    let model = crate::analysis::comm::comm_model(
-        bench,
-        &relative_source(path).to_string_lossy(),
-        n_per_rank,
-        crate::scenario::LJ_GAS_DENSITY,
-        crate::scenario::LJ_CUTOFF,
-    );
-    let dir = path.parent().expect("in a directory").join("analysis");
-    let (figures, errors) = sections::comm_figures(&model, weak_mpi, &dir);
+) -> Option<sections::Comm> {
+    let analyses: Vec<&Analysis> = sweeps.iter().map(|s| &s.analysis).collect();
+    let chosen = analysis::comm::choose(benches, &analyses)?;
+    let weak_mpi = chosen
+        .weak_mpi
+        .and_then(|a| sweeps.iter().find(|s| std::ptr::eq(&s.analysis, a)));
+    let dir = chosen
+        .bench
+        .parent()
+        .expect("in a directory")
+        .join("analysis");
+    let (figures, errors) = sections::comm_figures(&chosen.model, weak_mpi, &dir);
     figure_errors.extend(errors);
-    Ok(Some(sections::Comm {
-        model,
+    Some(sections::Comm {
+        model: chosen.model,
         figures_dir: relative(&dir, report_dir),
         figures,
-    }))
-}
-
-/// Whether `path` is a file directly in the results directory of one of the sweeps `names`.
-fn in_sweep_dir(path: &Path, names: &[&str]) -> bool {
-    path.parent()
-        .and_then(|d| d.file_name())
-        .is_some_and(|d| names.iter().any(|n| d == *n))
+    })
 }
 
 /// Every `mpi-bench*.json` file one level under the results directory, sorted by path.
-fn bench_files(
-    results_dir: &Path,
-) -> Result<Vec<(PathBuf, crate::ranks::bench_file::MpiBenchFile)>, ReportError> {
-    use crate::ranks::bench_file::MpiBenchFile;
+fn bench_files(results_dir: &Path) -> Result<Vec<(PathBuf, MpiBenchFile)>, ReportError> {
     let mut benches: Vec<(PathBuf, MpiBenchFile)> = Vec::new();
     for dir in std::fs::read_dir(results_dir)
         .map_err(|source| ReportError::Dir {
@@ -241,51 +200,6 @@ fn bench_files(
     }
     benches.sort_by(|a, b| a.0.cmp(&b.0));
     Ok(benches)
-}
-
-/// The distributed-tree model, when a sweep ran the galaxy over MPI: counted bytes, and the
-/// α-β prediction of every transport an mpi-bench file was measured on.
-fn tree_comm(
-    results_dir: &Path,
-    sweeps: &[Sweep],
-) -> Result<Option<crate::analysis::tree_comm::TreeComm>, ReportError> {
-    use crate::scenario::ScenarioKind;
-    let galaxy: Vec<&Sweep> = sweeps
-        .iter()
-        .filter(|s| {
-            s.analysis
-                .cases
-                .iter()
-                .any(|c| c.decomp.is_some() && c.case.scenario == ScenarioKind::Galaxy)
-        })
-        .collect();
-    let Some(first) = galaxy.first() else {
-        return Ok(None);
-    };
-    let cases = &first.analysis.cases;
-    let n_per_rank = cases
-        .iter()
-        .filter(|c| c.ranks > 0)
-        .map(|c| c.n / c.ranks)
-        .min()
-        .unwrap_or(10_000);
-    let theta = cases.iter().find_map(|c| c.theta).unwrap_or(0.5);
-    let leaf = crate::kernels::KernelParams::default().leaf_size;
-    // A sweep's α-β comes from the mpi-bench files in its own directory (the same machine).
-    let names: Vec<&str> = galaxy.iter().map(|s| s.analysis.name.as_str()).collect();
-    let files = bench_files(results_dir)?;
-    let benches: Vec<(String, &crate::ranks::bench_file::MpiBenchFile)> = files
-        .iter()
-        .filter(|(p, _)| in_sweep_dir(p, &names))
-        .map(|(p, b)| (relative_source(p).to_string_lossy().into_owned(), b))
-        .collect();
-    let series: Vec<(String, &[crate::analysis::groups::Point])> = galaxy
-        .iter()
-        .map(|s| (s.analysis.name.clone(), s.analysis.cases.as_slice()))
-        .collect();
-    Ok(Some(crate::analysis::tree_comm::tree_comm(
-        n_per_rank, theta, leaf, &benches, &series,
-    )))
 }
 
 /// The path as given, with `/` separators, so the report does not depend on the machine.
