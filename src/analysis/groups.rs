@@ -5,8 +5,8 @@
 
 use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
-use crate::experiment::code::Code;
 use crate::experiment::config::Study;
+use crate::experiment::kernel_or_program::KernelOrProgram;
 use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::{KernelKind, Multipole};
 use crate::scenario::{Precision, ScenarioKind};
@@ -70,7 +70,7 @@ impl Point {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SeriesKey {
     pub scenario: ScenarioKind,
-    pub kernel: Code,
+    pub kernel: KernelOrProgram,
     pub precision: Precision,
     pub theta: Option<f64>,
     /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
@@ -307,7 +307,7 @@ fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64)
 #[cfg(test)]
 mod tests {
     use super::{SeriesKey, workers_noun, workers_suffix};
-    use crate::experiment::code::Code;
+    use crate::experiment::kernel_or_program::KernelOrProgram;
     use crate::kernels::{KernelKind, Multipole};
     use crate::scenario::{Precision, ScenarioKind};
 
@@ -315,7 +315,7 @@ mod tests {
     fn the_fmm_order_is_named_apart_from_the_threads() {
         let key = SeriesKey {
             scenario: ScenarioKind::Coulomb,
-            kernel: Code::Kernel(KernelKind::Fmm),
+            kernel: KernelOrProgram::Kernel(KernelKind::Fmm),
             precision: Precision::F64,
             theta: Some(0.5),
             multipole: Multipole::Monopole,

@@ -11,8 +11,8 @@ pub mod tree_comm;
 mod views;
 
 use crate::calibrate::Calibration;
-use crate::experiment::code::Code;
 use crate::experiment::config::{Study, WeakRule};
+use crate::experiment::kernel_or_program::KernelOrProgram;
 use crate::experiment::results::{Metadata, ResultsFile};
 use crate::fit::{
     self, ComplexityClass, PowerFit, Samples, SerialFractionComparison, StrongFit,
@@ -384,7 +384,7 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
 
 /// The cost model a kernel's work per worker is held constant under; for an external
 /// program, the one of the weak rule its config names (linear or sqrt).
-fn cost_class(kernel: &Code, rule: Option<WeakRule>) -> ComplexityClass {
+fn cost_class(kernel: &KernelOrProgram, rule: Option<WeakRule>) -> ComplexityClass {
     match (kernel.kernel(), rule) {
         (Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread), _) => {
             ComplexityClass::N2
@@ -432,7 +432,7 @@ fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
 
 fn fit_weak_points(
     points: &[Point],
-    kernel: &Code,
+    kernel: &KernelOrProgram,
     rule: Option<WeakRule>,
 ) -> Result<WeakFit, fit::FitError> {
     if rule == Some(WeakRule::Time) {

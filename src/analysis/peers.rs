@@ -233,7 +233,7 @@ pub(crate) fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::code::Code;
+    use crate::experiment::kernel_or_program::KernelOrProgram;
     use crate::experiment::plan::Case;
     use crate::kernels::Multipole;
     use crate::scenario::ScenarioKind;
@@ -249,7 +249,7 @@ mod tests {
     ) -> Point {
         let case = Case {
             scenario,
-            kernel: Code::from_name(code),
+            kernel: KernelOrProgram::from_name(code),
             n,
             threads: t,
             ranks: r,

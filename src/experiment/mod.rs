@@ -1,10 +1,10 @@
 //! The experiment runner: sweep configs → planned cases → measured rounds → results file.
 
-pub mod code;
 pub mod config;
 pub mod config_keys;
 pub mod estimate;
 pub mod external;
+pub mod kernel_or_program;
 pub mod launcher;
 pub mod locate;
 pub mod lock;

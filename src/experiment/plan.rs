@@ -1,7 +1,7 @@
 //! Expands a sweep config into the list of cases to measure.
 
-use super::code::Code;
 use super::config::{Study, SweepConfig, WeakRule};
+use super::kernel_or_program::KernelOrProgram;
 use crate::decomp::Decomposition;
 use crate::kernels::{KernelKind, KernelParams, Multipole};
 use crate::scenario::{Precision, ScenarioKind};
@@ -12,7 +12,7 @@ use serde::{Deserialize, Serialize};
 pub struct Case {
     pub scenario: ScenarioKind,
     /// A built-in kernel or an external program, by name.
-    pub kernel: Code,
+    pub kernel: KernelOrProgram,
     pub n: usize,
     pub threads: usize,
     /// MPI ranks (1 without MPI).
@@ -164,7 +164,7 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                             for &(multipole, order) in &orders {
                                 out.push(Case {
                                     scenario,
-                                    kernel: Code::Kernel(kernel),
+                                    kernel: KernelOrProgram::Kernel(kernel),
                                     n,
                                     threads,
                                     ranks,
@@ -237,7 +237,7 @@ fn external_cases(config: &SweepConfig, out: &mut Vec<Case>) {
                             for &theta in &thetas {
                                 out.push(Case {
                                     scenario,
-                                    kernel: Code::External(ext.name.clone()),
+                                    kernel: KernelOrProgram::External(ext.name.clone()),
                                     n,
                                     threads: t,
                                     ranks: r,

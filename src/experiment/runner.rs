@@ -1,8 +1,8 @@
 //! Runs a sweep: plans the cases, measures them in interleaved rounds, saves the results
 //! file after every round of every case, and resumes an interrupted sweep.
 
-use super::code::Code;
 use super::config::SweepConfig;
+use super::kernel_or_program::KernelOrProgram;
 use super::lock::WriterLock;
 use super::measure::{RoundSpec, measure_round};
 use super::plan::{Case, cases};
@@ -333,8 +333,8 @@ fn measure_case<C: Clock>(
     context: &super::external::Context,
 ) -> Result<super::measure::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
     let kernel = match &case.kernel {
-        Code::Kernel(k) => *k,
-        Code::External(name) => {
+        KernelOrProgram::Kernel(k) => *k,
+        KernelOrProgram::External(name) => {
             let ext = config
                 .external
                 .iter()

@@ -190,7 +190,7 @@ pub fn child_limit(
     let mut limit = CHILD_FLOOR
         .as_secs_f64()
         .max(estimate_s.unwrap_or(0.0) * CHILD_ESTIMATE_FACTOR);
-    if let crate::experiment::code::Code::External(name) = &case.kernel
+    if let crate::experiment::kernel_or_program::KernelOrProgram::External(name) = &case.kernel
         && let Some(ext) = config.external.iter().find(|e| &e.name == name)
     {
         let runs = samples_per_round(config, rounds) + ext.warmup_runs + EXTERNAL_EXTRA_RUNS;
@@ -367,11 +367,11 @@ fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<S
     t.remove("out");
     t.insert("scenarios".into(), list(case.scenario.name().into()));
     match &case.kernel {
-        crate::experiment::code::Code::Kernel(k) => {
+        crate::experiment::kernel_or_program::KernelOrProgram::Kernel(k) => {
             t.insert("kernels".into(), list(k.name().into()));
             t.remove("external");
         }
-        crate::experiment::code::Code::External(name) => {
+        crate::experiment::kernel_or_program::KernelOrProgram::External(name) => {
             // The one `[[external]]` entry of the case, narrowed to its threads and ranks.
             t.insert("kernels".into(), toml::Value::Array(Vec::new()));
             if let Some(toml::Value::Array(entries)) = t.get_mut("external") {
