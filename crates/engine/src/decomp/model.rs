@@ -1,6 +1,6 @@
 //! How much each decomposition communicates per step, as a function of n, p, the density and
 //! the cutoff: the inputs of an α-β (latency-bandwidth) prediction of communication time,
-//! `T(p) = messages · α + bytes · β`, fitted on `mpi-bench` timings (see `docs/howto/run-mpi-studies.md`).
+//! `T(p) = messages · α + bytes · β`, fitted on `mpi-bench` timings (see `docs/explanation/mpi.md`).
 //!
 //! The tree decompositions of a Barnes-Hut run, counted on a given cloud: the gravity source's
 //! octants (top nodes to everyone, and the groups near another domain sent to it and

@@ -29,7 +29,7 @@ pub struct RankStats {
     pub wait_s: f64,
     /// `comm_s − wait_s`, at least 0: moving data and MPI overhead.
     pub transfer_s: f64,
-    /// Payload bytes and messages this rank sent (collectives: see `docs/howto/run-mpi-studies.md`).
+    /// Payload bytes and messages this rank sent (collectives: see `docs/explanation/mpi.md`).
     pub bytes_sent: u64,
     pub messages_sent: u64,
     /// Collective calls made.

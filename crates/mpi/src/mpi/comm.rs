@@ -1,7 +1,7 @@
 //! The communicator the drivers use: every MPI call goes through it, so that the time inside
 //! MPI, the bytes and the messages sent are counted in one place.
 //!
-//! Counting rules (also in `docs/howto/run-mpi-studies.md`): point-to-point messages count their payload and one
+//! Counting rules (also in `docs/explanation/mpi.md`): point-to-point messages count their payload and one
 //! message each (a size header is a message too); a collective counts one collective call and,
 //! as bytes, this rank's contribution times the number of other ranks that receive it.
 
