@@ -28,6 +28,7 @@ pub mod gate;
 pub use nbody_mpi::mpi;
 pub use nbody_mpi::ranks;
 pub mod plot;
+pub mod records;
 pub mod render;
 pub mod report;
 pub mod units;

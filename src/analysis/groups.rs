@@ -5,10 +5,10 @@
 
 use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
-use crate::experiment::config::Study;
-use crate::experiment::kernel_or_program::KernelOrProgram;
-use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::{KernelKind, Multipole};
+use crate::records::config::Study;
+use crate::records::kernel_or_program::KernelOrProgram;
+use crate::records::results::{CaseRecord, ResultsFile};
 use crate::scenario::{Precision, ScenarioKind};
 use crate::stats::StepPercentiles;
 use serde::Serialize;
@@ -19,7 +19,7 @@ pub struct Point {
     /// The case itself, typed; consumers read kernel, scenario and precision from here, never
     /// from the key.
     #[serde(skip)]
-    pub case: crate::experiment::plan::Case,
+    pub case: crate::records::plan::Case,
     pub key: String,
     pub n: usize,
     pub threads: usize,
@@ -74,7 +74,7 @@ pub struct SeriesKey {
     pub precision: Precision,
     pub theta: Option<f64>,
     /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
-    #[serde(skip_serializing_if = "crate::experiment::plan::is_monopole")]
+    #[serde(skip_serializing_if = "crate::records::plan::is_monopole")]
     pub multipole: Multipole,
     /// The fmm's expansion order.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -307,8 +307,8 @@ fn mpi_mean(r: &CaseRecord, f: &dyn Fn(&crate::decomp::stats::MpiReport) -> f64)
 #[cfg(test)]
 mod tests {
     use super::{SeriesKey, workers_noun, workers_suffix};
-    use crate::experiment::kernel_or_program::KernelOrProgram;
     use crate::kernels::{KernelKind, Multipole};
+    use crate::records::kernel_or_program::KernelOrProgram;
     use crate::scenario::{Precision, ScenarioKind};
 
     #[test]

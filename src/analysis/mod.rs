@@ -11,14 +11,14 @@ pub mod tree_comm;
 mod views;
 
 use crate::calibrate::Calibration;
-use crate::experiment::config::{Study, WeakRule};
-use crate::experiment::kernel_or_program::KernelOrProgram;
-use crate::experiment::results::{Metadata, ResultsFile};
 use crate::fit::{
     self, ComplexityClass, PowerFit, Samples, SerialFractionComparison, StrongFit,
     TimedSerialFraction, WeakFit, WeakSamples,
 };
 use crate::kernels::KernelKind;
+use crate::records::config::{Study, WeakRule};
+use crate::records::kernel_or_program::KernelOrProgram;
+use crate::records::results::{Metadata, ResultsFile};
 use groups::{Groups, Point, Series, SeriesKey};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -129,7 +129,7 @@ pub struct Analysis {
     /// gives it (command, environment, steps, timing), so that a comparison says what it
     /// compares against.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub external_runs: Vec<crate::experiment::external::External>,
+    pub external_runs: Vec<crate::records::external::External>,
     /// The tokens the config's `[mpi]` launcher puts before an external program's command
     /// (`mpirun ARGS -n {ranks}`); empty without one.
     #[serde(skip_serializing_if = "Vec::is_empty")]

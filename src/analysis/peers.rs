@@ -233,9 +233,9 @@ pub(crate) fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::experiment::kernel_or_program::KernelOrProgram;
-    use crate::experiment::plan::Case;
     use crate::kernels::Multipole;
+    use crate::records::kernel_or_program::KernelOrProgram;
+    use crate::records::plan::Case;
     use crate::scenario::ScenarioKind;
 
     /// A complete case of `code` on `scenario` whose samples are `median_s` per step ± 1%.

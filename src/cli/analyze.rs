@@ -2,8 +2,8 @@
 
 use crate::cli::args::AnalyzeArgs;
 use nbody_bench::analysis;
-use nbody_bench::experiment::locate;
-use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::records::locate;
+use nbody_bench::records::results::ResultsFile;
 use nbody_bench::render::Written;
 use std::path::{Path, PathBuf};
 

@@ -4,10 +4,10 @@
 //! here writes a file or creates a directory.
 
 use crate::cli::args::SweepArgs;
-use nbody_bench::experiment::config::SweepConfig;
 use nbody_bench::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
-use nbody_bench::experiment::plan::cases;
-use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::plan::cases;
+use nbody_bench::records::results::ResultsFile;
 use nbody_bench::units::{Duration, WallTime};
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::Path;
@@ -40,8 +40,7 @@ pub fn before_sweep(
         (true, Some(path)) if path.exists() => done_in(ResultsFile::load(path)?),
         _ => Done::default(),
     };
-    let planned =
-        nbody_bench::experiment::plan::unique_cases(config).map_err(anyhow::Error::msg)?;
+    let planned = nbody_bench::records::plan::unique_cases(config).map_err(anyhow::Error::msg)?;
     let probed = estimate::probe(config, &planned)?;
     let calibrate = !args.no_calibration;
     let logical = nbody_bench::run::logical_cpus();
@@ -209,7 +208,7 @@ fn print_plan(
         Some(path) => outln!("results would go to {}", path.display()),
         None => outln!(
             "results would go to a new run directory {}/<UTC time>/",
-            nbody_bench::experiment::locate::runs_dir(&config.out, &config.name).display()
+            nbody_bench::records::locate::runs_dir(&config.out, &config.name).display()
         ),
     }
     outln!("estimate_s: {:.3}", est.total_s);
@@ -230,7 +229,7 @@ pub fn refuse_long_run(
     if n <= SMALL_RUN_N && steps <= SMALL_RUN_STEPS {
         return Ok(());
     }
-    let case = nbody_bench::experiment::plan::Case {
+    let case = nbody_bench::records::plan::Case {
         scenario: setup.scenario,
         kernel: kernel.into(),
         n,

@@ -2,17 +2,17 @@
 //! baseline file on its machine class, else A/B against the baseline's revision).
 
 use crate::cli::args::GateArgs;
-use nbody_bench::experiment::config::SweepConfig;
 use nbody_bench::experiment::estimate::{self, Done};
-use nbody_bench::experiment::locate;
-use nbody_bench::experiment::plan::Case;
-use nbody_bench::experiment::results::{ResultsFile, utc_now};
 use nbody_bench::experiment::runner::{SweepOptions, run_sweep_wall};
 use nbody_bench::gate::ab::{self, AbPlan};
 use nbody_bench::gate::baselines;
 use nbody_bench::gate::{
     AB_THRESHOLD, FILE_THRESHOLD, GateOptions, GateReport, RunInfo, base_build, compare, render,
 };
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::locate;
+use nbody_bench::records::plan::Case;
+use nbody_bench::records::results::{ResultsFile, utc_now};
 use nbody_bench::units::WallTime;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -436,7 +436,7 @@ fn fast_path(
     text: &str,
     out: &Path,
 ) -> anyhow::Result<i32> {
-    let planned = nbody_bench::experiment::plan::cases(config);
+    let planned = nbody_bench::records::plan::cases(config);
     let probed = estimate::probe(config, &planned)?;
     let logical = nbody_bench::run::logical_cpus();
     let est = estimate::estimate(config, &probed.cases, &Done::default(), true, logical);

@@ -2,14 +2,14 @@
 //! the code and cannot drift from it. `cli` renders the help of every subcommand from the clap
 //! definitions in [`args`](crate::cli::args); `config` lists every key of a sweep config, with
 //! its default found by parsing a config without it and its forms from
-//! `experiment::config_keys::allowed`. The suite (`tests/suite/docs.rs`) compares both with the
+//! `records::config_keys::allowed`. The suite (`tests/suite/docs.rs`) compares both with the
 //! committed pages.
 
 use crate::cli::args::{Cli, ReferenceArgs, ReferencePage};
 use anyhow::{Context, bail};
 use clap::CommandFactory;
-use nbody_bench::experiment::config::SweepConfig;
-use nbody_bench::experiment::config_keys::allowed;
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::config_keys::allowed;
 
 /// Width the help is laid out for, whatever the terminal: the page is the same everywhere.
 const WIDTH: usize = 100;
@@ -229,7 +229,7 @@ fn external_forms(key: &str) -> Option<&'static str> {
             "a list of strings (argv), with the placeholders {config_dir} and {nbody_bench} only"
         }
         "external.steps" => "a whole number of at least 1, such as steps = 2000",
-        "external.time" => nbody_bench::experiment::external::config::TIME_FORMS,
+        "external.time" => nbody_bench::records::external::config::TIME_FORMS,
         "external.check" => "a regular expression, such as check = 'Total wall time'",
         "external.force_error" => {
             "a regular expression with one or two groups, such as force_error = 'median ([^ ]+) max ([^ ]+)'"
@@ -368,7 +368,7 @@ fn row(full: &toml::Table, path: &[&String], table: &str) -> anyhow::Result<Row>
         (None, "external") => "one `[[external]]` table per program",
         (None, _) => bail!(
             "config key `{dotted}` has no accepted forms: add them to \
-             experiment::config_keys::allowed (or, for [[external]], to src/cli/reference.rs)"
+             records::config_keys::allowed (or, for [[external]], to src/cli/reference.rs)"
         ),
     };
     let Some(meaning) = meaning(&dotted) else {

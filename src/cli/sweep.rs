@@ -1,9 +1,9 @@
 use crate::cli::args::SweepArgs;
-use nbody_bench::experiment::config::SweepConfig;
-use nbody_bench::experiment::locate;
 use nbody_bench::experiment::progress;
-use nbody_bench::experiment::results::{ResultsFile, utc_now};
 use nbody_bench::experiment::runner::{SweepOptions, run_sweep_wall};
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::locate;
+use nbody_bench::records::results::{ResultsFile, utc_now};
 use nbody_bench::units::Duration;
 use std::path::{Path, PathBuf};
 

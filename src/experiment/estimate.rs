@@ -13,10 +13,10 @@
 //! are warmer than at a large one, and the speedup is a rule of thumb (the calibrated ceiling
 //! of a 2-vCPU machine whose vCPUs are SMT siblings can be 1.0, not 1.9).
 
-use super::config::{MpiLaunch, SweepConfig};
-use super::plan::Case;
 use super::runner::samples_in_round;
 use crate::kernels::{Complexity, KernelKind, MIN_PARALLEL_PAIRS, Multipole};
+use crate::records::config::{MpiLaunch, SweepConfig};
+use crate::records::plan::Case;
 use crate::run::RunError;
 use crate::scenario::{Precision, ScenarioKind, Setup, SetupError};
 use crate::stepper::{Stepper, stepper};

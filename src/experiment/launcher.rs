@@ -3,13 +3,14 @@
 //! times (the slowest rank's) become the round's samples. The run's `mpi` block (per-rank
 //! compute, communication, waiting, traffic) is kept with the round.
 
-use super::config::MpiLaunch;
-use super::measure::{RoundOutcome, RoundSpec};
-use super::plan::Case;
+use super::measure::RoundSpec;
 use crate::clock::{WallClock, clock_cost};
 use crate::decomp::stats::MpiReport;
 use crate::engine::PhaseTimes;
 use crate::kernels::{KernelKind, WorkCounters};
+use crate::records::config::MpiLaunch;
+use crate::records::plan::Case;
+use crate::records::round::RoundOutcome;
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 use std::process::Command;

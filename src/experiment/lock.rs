@@ -93,7 +93,7 @@ impl WriterLock {
                 fs::read_to_string("/etc/hostname")
                     .map(|h| h.trim().to_string())
                     .unwrap_or_else(|_| "this host".into()),
-                super::results::utc_now()
+                crate::records::results::utc_now()
             );
             return Ok(WriterLock { path, file });
         }

@@ -1,19 +1,15 @@
-//! The experiment runner: sweep configs → planned cases → measured rounds → results file.
+//! The experiment runner: the cases of a sweep config ([`crate::records`]) measured round by
+//! round (`runner`, `measure`, with the `reference` workload and `progress` lines) into its
+//! results file, held by one writer (`lock`); external programs run (`external`) and rounds
+//! under an MPI launcher (`launcher`); the length estimate of a sweep (`estimate`).
 
-pub mod config;
-pub mod config_keys;
 pub mod estimate;
 pub mod external;
-pub mod kernel_or_program;
 pub mod launcher;
-pub mod locate;
 pub mod lock;
 pub mod measure;
-pub mod plan;
 pub mod progress;
 pub mod reference;
-pub mod results;
 pub mod runner;
 #[cfg(feature = "test-slowdown")]
 pub mod slowdown;
-pub mod vet;

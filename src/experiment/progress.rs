@@ -1,7 +1,7 @@
 //! Sweep progress: a bar with ETA on a terminal, one line per measured round otherwise.
 
-use super::results::CaseRecord;
 use super::runner::Observer;
+use crate::records::results::CaseRecord;
 use crate::units::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
 

@@ -1,15 +1,15 @@
 //! Runs a sweep: plans the cases, measures them in interleaved rounds, saves the results
 //! file after every round of every case, and resumes an interrupted sweep.
 
-use super::config::SweepConfig;
-use super::kernel_or_program::KernelOrProgram;
 use super::lock::WriterLock;
 use super::measure::{RoundSpec, measure_round};
-use super::plan::{Case, cases};
-use super::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
 #[cfg(feature = "test-slowdown")]
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
 use crate::clock::Clock;
+use crate::records::config::SweepConfig;
+use crate::records::kernel_or_program::KernelOrProgram;
+use crate::records::plan::{Case, cases};
+use crate::records::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
 use crate::scenario::Setup;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -156,7 +156,7 @@ pub fn run_sweep<C: Clock>(
     // system cannot be built (a box its precision cannot resolve, too many particles) would
     // otherwise fail only when its turn comes, after the cases before it ran, and again at
     // every --resume.
-    let planned = super::plan::unique_cases(config).map_err(SweepError::Plan)?;
+    let planned = crate::records::plan::unique_cases(config).map_err(SweepError::Plan)?;
     for case in planned {
         let setup = case_setup(&case);
         let copies = match case.decomp {
@@ -331,7 +331,7 @@ fn measure_case<C: Clock>(
     clock: &C,
     config: &SweepConfig,
     context: &super::external::Context,
-) -> Result<super::measure::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
+) -> Result<crate::records::round::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
     let kernel = match &case.kernel {
         KernelOrProgram::Kernel(k) => *k,
         KernelOrProgram::External(name) => {
@@ -384,7 +384,11 @@ fn external_context(
 }
 
 /// Tells the observer about an external round's failed samples and warnings.
-fn report_external(key: &str, outcome: &super::measure::RoundOutcome, observer: &mut dyn Observer) {
+fn report_external(
+    key: &str,
+    outcome: &crate::records::round::RoundOutcome,
+    observer: &mut dyn Observer,
+) {
     let Some(ext) = &outcome.external else {
         return;
     };
@@ -437,7 +441,7 @@ fn open(
         return Ok(fresh());
     }
     if options.fresh {
-        let stamp = super::results::utc_now().replace(':', "");
+        let stamp = crate::records::results::utc_now().replace(':', "");
         super::lock::back_up(path, &stamp).map_err(|source| SweepError::Backup {
             path: path.into(),
             source,
@@ -456,7 +460,7 @@ fn open(
                 detail: "the config in the file differs from the one given".into(),
             });
         }
-        let (commit, _) = super::results::git_state();
+        let (commit, _) = crate::records::results::git_state();
         if existing.metadata.git_commit != commit {
             return Err(SweepError::Mismatch {
                 path: path.into(),

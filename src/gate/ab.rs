@@ -11,9 +11,9 @@
 
 use super::base_build::BaseBinary;
 use crate::children::supervised::{self as child, ChildError};
-use crate::experiment::config::SweepConfig;
-use crate::experiment::plan::{Case, cases};
-use crate::experiment::results::{CaseRecord, ResultsFile};
+use crate::records::config::SweepConfig;
+use crate::records::plan::{Case, cases};
+use crate::records::results::{CaseRecord, ResultsFile};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -63,7 +63,7 @@ pub enum AbError {
         source: std::io::Error,
     },
     #[error(transparent)]
-    Results(#[from] crate::experiment::results::ResultsError),
+    Results(#[from] crate::records::results::ResultsError),
 }
 
 /// The two builds, A (the base) and B (this one).
@@ -190,7 +190,7 @@ pub fn child_limit(
     let mut limit = CHILD_FLOOR
         .as_secs_f64()
         .max(estimate_s.unwrap_or(0.0) * CHILD_ESTIMATE_FACTOR);
-    if let crate::experiment::kernel_or_program::KernelOrProgram::External(name) = &case.kernel
+    if let crate::records::kernel_or_program::KernelOrProgram::External(name) = &case.kernel
         && let Some(ext) = config.external.iter().find(|e| &e.name == name)
     {
         let runs = samples_per_round(config, rounds) + ext.warmup_runs + EXTERNAL_EXTRA_RUNS;
@@ -296,8 +296,8 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
     let [base_cases, current_cases] = merged;
     let [base_meta, current_meta] = metadata;
     let file = |cases: Vec<CaseRecord>, meta: Option<_>| ResultsFile {
-        schema: crate::experiment::results::RESULTS_SCHEMA.to_string(),
-        metadata: meta.unwrap_or_else(crate::experiment::results::Metadata::collect),
+        schema: crate::records::results::RESULTS_SCHEMA.to_string(),
+        metadata: meta.unwrap_or_else(crate::records::results::Metadata::collect),
         config: plan.config.clone(),
         config_text: plan.config_text.to_string(),
         calibration: Default::default(),
@@ -367,11 +367,11 @@ fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<S
     t.remove("out");
     t.insert("scenarios".into(), list(case.scenario.name().into()));
     match &case.kernel {
-        crate::experiment::kernel_or_program::KernelOrProgram::Kernel(k) => {
+        crate::records::kernel_or_program::KernelOrProgram::Kernel(k) => {
             t.insert("kernels".into(), list(k.name().into()));
             t.remove("external");
         }
-        crate::experiment::kernel_or_program::KernelOrProgram::External(name) => {
+        crate::records::kernel_or_program::KernelOrProgram::External(name) => {
             // The one `[[external]]` entry of the case, narrowed to its threads and ranks.
             t.insert("kernels".into(), toml::Value::Array(Vec::new()));
             if let Some(toml::Value::Array(entries)) = t.get_mut("external") {

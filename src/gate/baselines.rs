@@ -4,7 +4,7 @@
 //! new class costs one A/B run until its baseline is committed next to the others.
 
 use super::RunInfo;
-use crate::experiment::results::{ResultsError, ResultsFile};
+use crate::records::results::{ResultsError, ResultsFile};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 

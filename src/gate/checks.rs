@@ -4,7 +4,7 @@
 //! and then a warning in the report.
 
 use super::{GateError, RunInfo};
-use crate::experiment::results::ResultsFile;
+use crate::records::results::ResultsFile;
 
 /// Checks that the files are comparable; returns the warnings to carry in the report.
 pub(super) fn check_comparable(

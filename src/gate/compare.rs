@@ -6,8 +6,8 @@ use super::{
     CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, MAX_THRESHOLD, MIN_CI_SAMPLES,
     MissingCase, Normalization, NormalizationChoice, RunInfo, Verdict, WorkChange,
 };
-use crate::experiment::results::{CaseRecord, ResultsFile};
 use crate::kernels::WorkCounters;
+use crate::records::results::{CaseRecord, ResultsFile};
 use crate::stats::{bootstrap_ratio_ci, median};
 
 /// Compares `current` against `baseline`; see the module documentation for the rules.

@@ -31,7 +31,7 @@ pub use checks::{
 pub use compare::{check_threshold, compare};
 pub use render::{Format, render};
 
-use crate::experiment::results::ResultsFile;
+use crate::records::results::ResultsFile;
 use serde::Serialize;
 use thiserror::Error;
 

@@ -3,11 +3,11 @@
 use super::*;
 use crate::calibrate::Calibration;
 use crate::engine::PhaseTimes;
-use crate::experiment::config::SweepConfig;
-use crate::experiment::measure::RoundOutcome;
-use crate::experiment::plan::cases;
-use crate::experiment::results::{CaseRecord, Metadata, RESULTS_SCHEMA};
 use crate::kernels::WorkCounters;
+use crate::records::config::SweepConfig;
+use crate::records::plan::cases;
+use crate::records::results::{CaseRecord, Metadata, RESULTS_SCHEMA};
+use crate::records::round::RoundOutcome;
 use crate::testing::{SEED_1, SEED_2};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
@@ -130,7 +130,7 @@ fn results(run: Run) -> ResultsFile {
         metadata: metadata(),
         config,
         config_text: CONFIG.to_string(),
-        calibration: crate::experiment::results::Calibrations {
+        calibration: crate::records::results::Calibrations {
             start: Some(calibration(100.0 / run.machine)),
             end: Some(calibration(100.0 / run.machine)),
         },

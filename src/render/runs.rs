@@ -3,8 +3,8 @@
 //! config is expected to hold: a comparison names exactly what it compares against.
 
 use crate::analysis::Analysis;
-use crate::experiment::external::config::TimeUnit;
-use crate::experiment::external::{External, TimeSource};
+use crate::records::external::config::TimeUnit;
+use crate::records::external::{External, TimeSource};
 use std::fmt::Write;
 
 /// A Markdown list with one item per external program of the sweep: its version, command line

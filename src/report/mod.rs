@@ -12,8 +12,8 @@ mod sections;
 mod tree_section;
 
 use crate::analysis::{self, Analysis};
-use crate::experiment::results::{ResultsError, ResultsFile};
 use crate::ranks::bench_file::MpiBenchFile;
+use crate::records::results::{ResultsError, ResultsFile};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 

@@ -3,7 +3,7 @@
 use super::Sweep;
 use super::keep::region;
 use crate::calibrate::Calibration;
-use crate::experiment::config::Study;
+use crate::records::config::Study;
 use crate::render::tables::{self, Table};
 use std::fmt::Write;
 use std::path::Path;

@@ -6,9 +6,9 @@
 //! `NBODY_BENCH_UPDATE_DOCS=1 cargo test --test suite docs` rewrites the generated pages.
 
 use crate::{bin, text};
-use nbody_bench::experiment::external::SampleError;
-use nbody_bench::experiment::results::ResultsFile;
-use nbody_bench::experiment::vet::Rejected;
+use nbody_bench::records::external::SampleError;
+use nbody_bench::records::results::ResultsFile;
+use nbody_bench::records::vet::Rejected;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 

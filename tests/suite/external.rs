@@ -4,9 +4,9 @@
 //! as errors, resume, arguments passed literally, bad configs refused.
 
 use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::config::SweepConfig;
-use nbody_bench::experiment::results::ResultsFile;
 use nbody_bench::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::results::ResultsFile;
 use std::path::Path;
 use std::time::Duration;
 
@@ -70,7 +70,7 @@ rounds = 2
 min_sample_s = 0.002
 "#;
 
-fn record<'a>(r: &'a ResultsFile, key: &str) -> &'a nbody_bench::experiment::results::CaseRecord {
+fn record<'a>(r: &'a ResultsFile, key: &str) -> &'a nbody_bench::records::results::CaseRecord {
     r.cases.iter().find(|c| c.key == key).unwrap_or_else(|| {
         panic!(
             "no case {key} in {:?}",

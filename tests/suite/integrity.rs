@@ -4,7 +4,7 @@
 //! cases, unsupported fits, the wrong run to resume and a weak study's `n` are refused.
 
 use crate::{bin, refused};
-use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};

@@ -282,8 +282,10 @@ const HARNESS_LAYERS: &[&[&str]] = &[
     &["units"],
     // A figure names times and sizes in the units' words.
     &["plot"],
-    &["experiment"],
-    &["analysis"],
+    // The file formats a sweep is defined by and leaves behind.
+    &["records"],
+    // The runner writes them, analysis reads them: one layer, so neither may use the other.
+    &["experiment", "analysis"],
     &["render"],
     // The gate writes its Markdown through render's table builder.
     &["gate", "report"],

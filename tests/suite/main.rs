@@ -42,7 +42,7 @@ use std::process::{Command, Output, Stdio};
 pub struct StopAfter(pub usize);
 
 impl nbody_bench::experiment::runner::Observer for StopAfter {
-    fn round_done(&mut self, _: &nbody_bench::experiment::results::CaseRecord, _: usize) {
+    fn round_done(&mut self, _: &nbody_bench::records::results::CaseRecord, _: usize) {
         self.0 = self.0.saturating_sub(1);
     }
 

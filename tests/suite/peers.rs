@@ -5,9 +5,9 @@
 //! .peers/lammps (scripts/install-peers.sh), is left out here: CI does not install it.
 
 use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::config::SweepConfig;
-use nbody_bench::experiment::results::ResultsFile;
 use nbody_bench::experiment::runner::{Silent, SweepOptions, run_sweep};
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::results::ResultsFile;
 use std::path::Path;
 use std::time::Duration;
 

@@ -7,7 +7,7 @@
 
 use crate::{refused, text};
 use nbody_bench::children::{alive, members_left};
-use nbody_bench::experiment::results::ResultsFile;
+use nbody_bench::records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -88,7 +88,7 @@ fn workdir(out: &Path) -> PathBuf {
 }
 
 /// The runs of the one case of [`config`].
-fn runs(out: &Path) -> Vec<nbody_bench::experiment::external::ExternalRun> {
+fn runs(out: &Path) -> Vec<nbody_bench::records::external::ExternalRun> {
     let r = ResultsFile::load(&out.join("ext/results.json")).unwrap();
     r.cases[0]
         .rounds

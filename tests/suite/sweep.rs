@@ -2,9 +2,9 @@
 //! repetition) and an end-to-end sweep through the CLI.
 
 use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::config::SweepConfig;
-use nbody_bench::experiment::results::{RESULTS_SCHEMA, ResultsFile};
 use nbody_bench::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
+use nbody_bench::records::config::SweepConfig;
+use nbody_bench::records::results::{RESULTS_SCHEMA, ResultsFile};
 use std::path::Path;
 use std::time::Duration;
 

@@ -1,5 +1,5 @@
 use super::*;
-use crate::experiment::plan::cases;
+use crate::records::plan::cases;
 use std::path::Path;
 
 const TOL: f64 = 1e-12;

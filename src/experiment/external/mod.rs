@@ -1,17 +1,12 @@
-//! External programs in sweeps (`[[external]]`): their config ([`config`]), the placeholders
-//! of their commands ([`placeholders`]), one process ([`process`]) and one measured round
+//! Running external programs in sweeps (`[[external]]`, configured as
+//! [`crate::records::external`] says): one process ([`process`]) and one measured round
 //! ([`run`]). Each sample is one run of the program; what it measured, or why it failed, is
 //! kept with the round in the results file.
 
-pub mod config;
-pub mod placeholders;
 pub mod process;
 pub mod run;
 
-pub use config::External;
-pub(crate) use config::TimeSource;
-
-use serde::{Deserialize, Serialize};
+use crate::records::external::{External, ExternalVersion, placeholders};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -19,55 +14,6 @@ use thiserror::Error;
 pub(crate) const OVERHEAD_WARN: f64 = 0.05;
 /// The version command is killed after this many seconds.
 const VERSION_TIMEOUT_S: f64 = 30.0;
-
-/// What one round of an external case measured, sample by sample (raw values).
-#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
-pub struct ExternalRound {
-    /// Every timed run, failed ones included, in order.
-    pub runs: Vec<ExternalRun>,
-    /// Median wall time of the empty run (wall timing only), seconds.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub launch_overhead_s: Option<f64>,
-    /// That overhead over the median successful run's wall time.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub overhead_share: Option<f64>,
-    /// The set-up command failed: no sample was taken.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub setup_error: Option<SampleError>,
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub warnings: Vec<String>,
-}
-
-/// One run of the program.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ExternalRun {
-    /// Wall time of the process, seconds.
-    pub wall_s: f64,
-    /// The time it printed (regex timing), seconds.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub reported_s: Option<f64>,
-    /// The median (and largest) relative force error it printed.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub force_error: Option<[f64; 2]>,
-    /// Why the run is not a sample.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub error: Option<SampleError>,
-}
-
-/// A failed run: what went wrong and the program's last lines of output.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SampleError {
-    pub what: String,
-    pub command: String,
-    pub output_tail: Vec<String>,
-}
-
-/// An external's version line, in the results metadata.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct ExternalVersion {
-    pub name: String,
-    pub version: String,
-}
 
 #[derive(Debug, Error)]
 pub enum ExternalError {

@@ -8,9 +8,7 @@ use std::process::{Command, ExitStatus, Stdio};
 use std::time::{Duration, Instant};
 use wait_timeout::ChildExt;
 
-/// The longest timeout a config may set: 7 days. A longer one is surely a mistake, and it keeps
-/// every timeout a valid [`Duration`].
-pub(crate) const MAX_TIMEOUT_S: f64 = 7.0 * 24.0 * 3600.0;
+use crate::records::external::MAX_TIMEOUT_S;
 /// Lines of output kept with a failed sample.
 pub(crate) const TAIL_LINES: usize = 20;
 /// At most this much of a run's output is read back.

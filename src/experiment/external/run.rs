@@ -3,13 +3,14 @@
 //! status, timeout, no match of `check` or of the time regex) is kept as an error with the
 //! program's last lines of output, and the round goes on.
 
-use super::config::{External, TimeSource};
-use super::placeholders::Vars;
 use super::process::{self, Finished, Launch};
-use super::{Context, ExternalError, ExternalRound, ExternalRun, OVERHEAD_WARN, SampleError};
-use crate::experiment::config::MpiLaunch;
-use crate::experiment::measure::{RoundOutcome, RoundSpec};
-use crate::experiment::plan::Case;
+use super::{Context, ExternalError, OVERHEAD_WARN};
+use crate::experiment::measure::RoundSpec;
+use crate::records::config::MpiLaunch;
+use crate::records::external::placeholders::Vars;
+use crate::records::external::{External, ExternalRound, ExternalRun, SampleError, TimeSource};
+use crate::records::plan::Case;
+use crate::records::round::RoundOutcome;
 use crate::stats::median;
 use regex::Regex;
 use std::path::Path;
@@ -282,7 +283,7 @@ fn sample(
                     (Some(med), Some(Some(max))) => Some([med, max]),
                     _ => None,
                 };
-                match printed.map(|e| (e, crate::experiment::vet::force_error(e))) {
+                match printed.map(|e| (e, crate::records::vet::force_error(e))) {
                     Some((_, Ok(e))) => Some(e),
                     Some((e, Err(why))) => {
                         return fail(format!(

@@ -7,7 +7,7 @@
 //!
 //! [`CaseRecord`]: super::results::CaseRecord
 
-use super::measure::RoundOutcome;
+use super::round::RoundOutcome;
 use serde::{Deserialize, Serialize};
 
 /// The longest time a step can take, seconds (about 116 days): a longer one is a unit or

@@ -2,8 +2,8 @@
 //! samples and summaries. Written atomically after every measured round.
 
 use super::config::SweepConfig;
-use super::measure::RoundOutcome;
 use super::plan::Case;
+use super::round::RoundOutcome;
 use super::vet::Rejected;
 use crate::calibrate::Calibration;
 use crate::engine::PhaseTimes;

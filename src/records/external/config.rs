@@ -214,14 +214,14 @@ impl External {
         }
         if !(self.timeout_s.is_finite()
             && self.timeout_s > 0.0
-            && self.timeout_s <= super::process::MAX_TIMEOUT_S)
+            && self.timeout_s <= super::MAX_TIMEOUT_S)
         {
             return bad(
                 "timeout_s",
                 format!(
                     "is {}: it must be a number of seconds > 0 and at most {} (7 days)",
                     self.timeout_s,
-                    super::process::MAX_TIMEOUT_S
+                    super::MAX_TIMEOUT_S
                 ),
             );
         }

@@ -1,0 +1,16 @@
+//! The files a sweep is defined by and leaves behind, and their versions: the sweep config
+//! (`config`, with `config_keys` for its messages and the external programs' entries in
+//! `external`), the cases it plans (`plan`, each measuring a `kernel_or_program`), the results
+//! file with every round (`results`, `round`, the outlier rules of `vet`) and the run
+//! directories (`locate`). The runner (`experiment`) writes them and `analysis` reads them;
+//! neither needs the other.
+
+pub mod config;
+pub mod config_keys;
+pub mod external;
+pub mod kernel_or_program;
+pub mod locate;
+pub mod plan;
+pub mod results;
+pub mod round;
+pub mod vet;
