@@ -80,9 +80,10 @@ done
 # trees, with bodies crossing domains; the source's octants (8^k domains; other counts get
 # balanced runs of cells) and the locally essential trees over a rebalanced bisection.
 for ranks in 1 2 3 4; do
-    # The 300 steps are for bodies to cross between ranks' domains; one rank has none to cross.
+    # Bodies cross between ranks' domains within 30 steps; the 150 let the energy drift the
+    # check compares with the serial run's build up. One rank has no domains to cross.
     migration=() steps=30
-    if [ "$ranks" -gt 1 ]; then migration=(--expect-migration) steps=300; fi
+    if [ "$ranks" -gt 1 ]; then migration=(--expect-migration) steps=150; fi
     for decomp in octants tree; do
         check "$ranks" --scenario galaxy --kernel octree --decomp "$decomp" -n 2001 --steps "$steps" ${migration[@]+"${migration[@]}"}
         # (The plasma's charges barely leave their octants in 30 steps: the galaxy tests migration.)
