@@ -52,11 +52,11 @@ pub fn cli_page() -> String {
     }
     page.push_str("\n## nbody-bench\n\n");
     push_help(&mut page, &mut root);
-    for name in &names {
-        let sub = root
-            .find_subcommand_mut(name)
-            .expect("a subcommand listed above");
-        page.push_str(&format!("\n## nbody-bench {name}\n\n"));
+    for sub in root
+        .get_subcommands_mut()
+        .filter(|s| !s.is_hide_set() && s.get_name() != "help")
+    {
+        page.push_str(&format!("\n## nbody-bench {}\n\n", sub.get_name()));
         push_help(&mut page, sub);
     }
     page
