@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 # shellcheck source=scripts/lib/sweep.sh
 source scripts/lib/sweep.sh
 
-CONFIGS=(complexity complexity-large strong weak weak-time octree-accuracy
+CONFIGS=(complexity complexity-large strong strong-long-range weak weak-time octree-accuracy
     vs-lammps vs-lammps-liquid vs-pytreegrav vs-fmm3d)
 mode="${1:-}"
 cargo build --release --quiet

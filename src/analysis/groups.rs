@@ -1,7 +1,7 @@
 //! Reads the cases of a results file as series: the same code over n (complexity), over p at
 //! fixed n (strong scaling), over p with the work per worker held (weak scaling), and over θ
-//! (octree accuracy, one series per expansion order). Pure data; the fits and plots are
-//! elsewhere.
+//! (octree accuracy, one series per expansion order; an external family's settings likewise).
+//! Pure data; the fits and plots are elsewhere.
 
 use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
@@ -152,7 +152,8 @@ pub struct Groups {
     pub strong: Vec<Series>,
     /// Over p with n or simulated time grown by the weak rule (weak studies only).
     pub weak: Vec<Series>,
-    /// Octree cases over θ at fixed n and p.
+    /// Tree cases over θ at fixed n and p, and the members of an external family (one code at
+    /// several accuracy settings) as one series named after the family.
     pub theta: Vec<Series>,
     /// Every complete case, in file order.
     pub cases: Vec<Point>,
@@ -226,15 +227,36 @@ pub fn group(results: &ResultsFile) -> Groups {
     } else {
         (Vec::new(), parallel.into_iter().filter(from_one).collect())
     };
-    let theta = series(&|k| k.theta = None, &by_theta)
-        .into_iter()
-        .filter(|s| {
-            (s.key.kernel == KernelKind::Octree
-                || s.key.kernel == KernelKind::Fmm
-                || s.key.kernel.is_external())
-                && distinct(s, &by_theta) >= 2
-        })
-        .collect();
+    // Over θ, or over the members of an external family (one point each, in order of error).
+    let family = |k: &KernelOrProgram| {
+        results
+            .config
+            .external
+            .iter()
+            .find(|e| e.name == k.name())
+            .and_then(|e| e.family.clone())
+    };
+    let by_accuracy = |p: &Point| match family(&p.case.kernel) {
+        Some(_) => p.force_error.map_or(0.0, |e| e[0]),
+        None => by_theta(p),
+    };
+    let theta = series(
+        &|k| {
+            k.theta = None;
+            if let Some(f) = family(&k.kernel) {
+                k.kernel = KernelOrProgram::External(f);
+            }
+        },
+        &by_accuracy,
+    )
+    .into_iter()
+    .filter(|s| {
+        (s.key.kernel == KernelKind::Octree
+            || s.key.kernel == KernelKind::Fmm
+            || s.key.kernel.is_external())
+            && distinct(s, &by_accuracy) >= 2
+    })
+    .collect();
     Groups {
         complexity,
         strong,

@@ -122,7 +122,8 @@ pub struct Analysis {
     /// Our kernels next to the external programs of the same sweep.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub peers: Vec<peers::PeerRatio>,
-    /// Tree codes at equal median force error ([`peers::EQUAL_ERROR`]).
+    /// Tree codes at equal median force error ([`peers::EQUAL_ERROR`], and tighter where the
+    /// other code reaches it).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub(crate) peers_equal_error: Vec<peers::EqualErrorCost>,
     /// How each external program was run: its `[[external]]` entry as the sweep's config

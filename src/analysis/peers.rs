@@ -15,6 +15,10 @@ use serde::Serialize;
 /// at θ = 0.5.
 pub(crate) const EQUAL_ERROR: f64 = 1e-3;
 
+/// Tighter errors also compared at, where the other code's settings reach them (a fast
+/// multipole code's higher orders do; a θ sweep of a tree code usually does not).
+const TIGHTER_ERRORS: [f64; 1] = [1e-4];
+
 /// The seed of the ratio bootstraps: the same results give the same intervals.
 const SEED: u64 = 0x9EE2;
 
@@ -159,14 +163,21 @@ pub(crate) fn ratios(cases: &[Point]) -> Vec<PeerRatio> {
 
 /// The time at median error `target` from `(error, seconds)` points, interpolating log time
 /// linearly in log error between the first two neighbours (in error) that bracket it; `None`
-/// when no pair does.
+/// when no pair does. A point that another beats on both (no larger error, less time) is
+/// left out: nobody would choose that setting, so a code is compared at its best.
 pub(crate) fn cost_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
     let mut v: Vec<(f64, f64)> = points
         .iter()
         .copied()
         .filter(|&(e, s)| e > 0.0 && s > 0.0 && e.is_finite() && s.is_finite())
         .collect();
-    v.sort_by(|a, b| a.0.total_cmp(&b.0));
+    v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    let mut fastest = f64::INFINITY;
+    v.retain(|&(_, s)| {
+        let better = s < fastest;
+        fastest = fastest.min(s);
+        better
+    });
     v.windows(2).find_map(|w| {
         let ((e0, s0), (e1, s1)) = (w[0], w[1]);
         if !(e0 <= target && target <= e1) {
@@ -196,38 +207,60 @@ fn error_range(points: &[(f64, f64)]) -> [f64; 2] {
 }
 
 /// Our tree series next to each external one of the same scenario, n and workers, at
-/// [`EQUAL_ERROR`].
+/// [`EQUAL_ERROR`], and at each of [`TIGHTER_ERRORS`] that the external series reaches.
 pub(crate) fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
     let (theirs, ours): (Vec<&ThetaAnalysis>, Vec<&ThetaAnalysis>) =
         theta.iter().partition(|t| t.series.kernel.is_external());
-    let workers = |t: &ThetaAnalysis| t.series.threads.unwrap_or(1) * t.series.ranks.unwrap_or(1);
     let mut out = Vec::new();
-    for t in &theirs {
-        let tp = error_points(t);
-        let theirs_s = cost_at_error(&tp, EQUAL_ERROR);
-        for o in ours.iter().filter(|o| {
-            o.series.scenario == t.series.scenario
-                && o.series.n == t.series.n
-                && workers(o) == workers(t)
-        }) {
-            let op = error_points(o);
-            let ours_s = cost_at_error(&op, EQUAL_ERROR);
-            out.push(EqualErrorCost {
-                scenario: o.series.scenario.name().into(),
-                n: o.series.n.unwrap_or(0),
-                workers: workers(o),
-                error: EQUAL_ERROR,
-                ours: o.label.clone(),
-                theirs: t.label.clone(),
-                ours_s,
-                theirs_s,
-                speedup: ours_s.zip(theirs_s).map(|(o, t)| t / o),
-                ours_errors: error_range(&op),
-                theirs_errors: error_range(&tp),
-            });
+    let levels =
+        std::iter::once((EQUAL_ERROR, true)).chain(TIGHTER_ERRORS.iter().map(|&e| (e, false)));
+    for (error, always) in levels {
+        for t in &theirs {
+            let tp = error_points(t);
+            let theirs_s = cost_at_error(&tp, error);
+            if theirs_s.is_none() && !always {
+                continue;
+            }
+            for o in ours.iter().filter(|o| {
+                o.series.scenario == t.series.scenario
+                    && o.series.n == t.series.n
+                    && workers(o) == workers(t)
+            }) {
+                let op = error_points(o);
+                out.push(equal_error_row(o, t, error, &op, &tp, theirs_s));
+            }
         }
     }
     out
+}
+
+fn workers(t: &ThetaAnalysis) -> usize {
+    t.series.threads.unwrap_or(1) * t.series.ranks.unwrap_or(1)
+}
+
+/// Our series `o` against their series `t` at median error `error`.
+fn equal_error_row(
+    o: &ThetaAnalysis,
+    t: &ThetaAnalysis,
+    error: f64,
+    op: &[(f64, f64)],
+    tp: &[(f64, f64)],
+    theirs_s: Option<f64>,
+) -> EqualErrorCost {
+    let ours_s = cost_at_error(op, error);
+    EqualErrorCost {
+        scenario: o.series.scenario.name().into(),
+        n: o.series.n.unwrap_or(0),
+        workers: workers(o),
+        error,
+        ours: o.label.clone(),
+        theirs: t.label.clone(),
+        ours_s,
+        theirs_s,
+        speedup: ours_s.zip(theirs_s).map(|(o, t)| t / o),
+        ours_errors: error_range(op),
+        theirs_errors: error_range(tp),
+    }
 }
 
 #[cfg(test)]
@@ -366,5 +399,62 @@ mod tests {
         assert!(cost_at_error(&rev, 1e-3).is_some());
         // Points without an error or a time do not count.
         assert_eq!(cost_at_error(&[(0.0, 1.0), (f64::NAN, 1.0)], 1e-3), None);
+    }
+
+    #[test]
+    fn tighter_errors_are_compared_only_where_the_other_code_reaches_them() {
+        use crate::analysis::groups::SeriesKey;
+        use crate::scenario::Precision;
+        let series = |code: &str, errors: &[(f64, f64)]| {
+            let points: Vec<Point> = errors
+                .iter()
+                .map(|&(error, s)| {
+                    let mut p = point(ScenarioKind::Coulomb, code, 1000, 1, 1, s);
+                    p.force_error = Some([error, 10.0 * error]);
+                    p
+                })
+                .collect();
+            let series = SeriesKey {
+                scenario: ScenarioKind::Coulomb,
+                kernel: KernelOrProgram::from_name(code),
+                precision: Precision::F64,
+                theta: None,
+                multipole: Multipole::Monopole,
+                order: None,
+                n: Some(1000),
+                threads: Some(1),
+                ranks: Some(1),
+                decomp: None,
+            };
+            ThetaAnalysis {
+                label: series.label(),
+                series,
+                points,
+            }
+        };
+        let theta = [
+            series("fmm", &[(1e-5, 4.0), (1e-3, 1.0)]),
+            // Reaches 1e-4: compared there too.
+            series("fast-multipole", &[(1e-6, 8.0), (1e-2, 2.0)]),
+            // Does not: compared at 1e-3 only. Its setting at 2e-3 is slower than the one
+            // at 5e-4 and is left out.
+            series("tree", &[(5e-4, 6.0), (2e-3, 7.0), (1e-2, 3.0)]),
+        ];
+        let rows = equal_error(&theta);
+        let got: Vec<(f64, &str)> = rows.iter().map(|r| (r.error, r.theirs.as_str())).collect();
+        assert_eq!(
+            got,
+            [
+                (1e-3, "fast-multipole"),
+                (1e-3, "tree"),
+                (1e-4, "fast-multipole")
+            ]
+        );
+        // At 1e-4 theirs interpolates between 1e-6 (8 s) and 1e-2 (2 s): 4 s, ours between
+        // 1e-5 (4 s) and 1e-3 (1 s): 2 s.
+        let at = &rows[2];
+        assert!((at.theirs_s.unwrap() - 4.0).abs() < 1e-12);
+        assert!((at.ours_s.unwrap() - 2.0).abs() < 1e-12);
+        assert!((at.speedup.unwrap() - 2.0).abs() < 1e-12);
     }
 }

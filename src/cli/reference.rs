@@ -119,6 +119,7 @@ steps = 100
 time = { regex = 'took ([0-9.]+)', unit = "ms" }
 check = 'done'
 force_error = 'error ([^ ]+) ([^ ]+)'
+family = "other"
 env = { OMP_NUM_THREADS = "{threads}" }
 version = ["other", "--version"]
 empty = ["other", "--empty"]
@@ -200,6 +201,9 @@ fn meaning(key: &str) -> Option<&'static str> {
         "external.force_error" => {
             "a regular expression whose groups are the median (and largest) force error the program reports"
         }
+        "external.family" => {
+            "entries of one family are one code at several accuracy settings: their cases form one series of force error against cost, like a θ sweep"
+        }
         "external.env" => "environment variables set for the program (values with placeholders)",
         "external.version" => {
             "a command whose first line of output names the program's version (results metadata)"
@@ -233,6 +237,9 @@ fn external_forms(key: &str) -> Option<&'static str> {
         "external.check" => "a regular expression, such as check = 'Total wall time'",
         "external.force_error" => {
             "a regular expression with one or two groups, such as force_error = 'median ([^ ]+) max ([^ ]+)'"
+        }
+        "external.family" => {
+            "a plain name shared by the entries, such as family = \"fmm3d\"; needs force_error"
         }
         "external.env" => "a table of strings, such as env = { OMP_NUM_THREADS = \"{threads}\" }",
         "external.timeout_s" => "seconds above 0, at most 7 days, such as timeout_s = 600",

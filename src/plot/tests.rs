@@ -350,7 +350,7 @@ fn detail_figures_render_for_every_input() {
         max: f64::INFINITY,
     };
     let theta = |theta: f64, seconds: f64, error: f64| ThetaPoint {
-        theta,
+        setting: format!("θ={theta}"),
         seconds,
         error,
     };

@@ -10,6 +10,7 @@ use crate::plot::figures::{
     self as fig, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
 use crate::plot::{Chart, Scale, StackedBars};
+use crate::records::kernel_or_program::KernelOrProgram;
 use serde::Serialize;
 use std::path::Path;
 
@@ -279,7 +280,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 .iter()
                 .filter_map(|p| {
                     Some(ThetaPoint {
-                        theta: p.theta?,
+                        setting: setting_label(p, &t.series.kernel)?,
                         seconds: p.median_s,
                         error: p.force_error?[0],
                     })
@@ -295,6 +296,21 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         ));
     }
     out
+}
+
+/// What a point of an accuracy series was run at: "θ=0.5", or for a member of an external
+/// family (the series named after the family) its program's name without the family's
+/// prefix ("eps1e-2" of "fmm3d-eps1e-2"); `None` for a θ series point without a θ.
+fn setting_label(p: &Point, series: &KernelOrProgram) -> Option<String> {
+    if p.case.kernel != *series {
+        let name = p.case.kernel.name();
+        let short = name
+            .strip_prefix(series.name())
+            .map(|s| s.trim_start_matches(['-', '_', '.']))
+            .filter(|s| !s.is_empty());
+        return Some(short.unwrap_or(name).to_string());
+    }
+    Some(format!("θ={}", p.theta?))
 }
 
 /// "octree θ=0.5 p=2 n=16384" — short enough for a category axis: the case key (whose form

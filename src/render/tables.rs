@@ -314,7 +314,7 @@ pub fn theta(a: &Analysis) -> String {
             });
             table.row([
                 t.series.scenario.name().to_string(),
-                t.series.kernel.name().to_string(),
+                p.case.kernel.name().to_string(),
                 p.n.to_string(),
                 theta_cell(p),
                 Duration(p.median_s).to_string(),

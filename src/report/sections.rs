@@ -315,7 +315,7 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
         if !equal.is_empty() {
             md.push_str(
                 "At equal accuracy: each code's time per step interpolated (log-log) to the same median \
-                 relative force error on its sweep over θ.\n\n",
+                 relative force error on its sweep over θ (or over the settings of its `family`).\n\n",
             );
             md.push_str(&equal);
             md.push('\n');

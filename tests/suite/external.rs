@@ -289,6 +289,53 @@ env = {{ OMP_NUM_THREADS = "{{threads}}" }}
 }
 
 #[test]
+fn a_family_of_settings_reads_as_one_accuracy_series() {
+    let dir = program_dir();
+    // One code at three requested precisions (each its own entry) and a program of no family.
+    let entry = |name: &str, family: &str, ms: f64, error: f64| {
+        format!(
+            r#"
+[[external]]
+name = "{name}"
+command = ["sh", "-c", "echo 'elapsed {ms} ms'; echo 'error {error:e}'"]
+steps = 1
+time = {{ regex = 'elapsed ([0-9.]+) ms', unit = "ms" }}
+force_error = 'error (\S+)'
+{family}
+"#
+        )
+    };
+    let text = format!(
+        "{HEAD}{}{}{}{}{MEASURE}",
+        entry("code-eps1e-2", "family = \"code\"", 2.0, 1e-2),
+        entry("code-eps1e-4", "family = \"code\"", 8.0, 1e-4),
+        entry("code-eps1e-3", "family = \"code\"", 4.0, 1e-3),
+        entry("alone", "", 3.0, 5e-3),
+    );
+    let r = sweep(&text, dir.path());
+    let groups = nbody_bench::analysis::groups::group(&r);
+    let names: Vec<&str> = groups.theta.iter().map(|s| s.key.kernel.name()).collect();
+    // The program of no family has one setting: no series.
+    assert_eq!(names, ["code"]);
+    let series = &groups.theta[0];
+    let members: Vec<&str> = series.points.iter().map(|p| p.case.kernel.name()).collect();
+    // In order of error, most accurate first.
+    assert_eq!(members, ["code-eps1e-4", "code-eps1e-3", "code-eps1e-2"]);
+    let errors: Vec<f64> = series
+        .points
+        .iter()
+        .map(|p| p.force_error.unwrap()[0])
+        .collect();
+    assert_eq!(errors, [1e-4, 1e-3, 1e-2]);
+    // Their cases keep their own names everywhere else.
+    assert!(
+        r.cases
+            .iter()
+            .any(|c| c.key == "lj-box/code-eps1e-3/n=50/p=1/r=1/seed=1")
+    );
+}
+
+#[test]
 fn failing_samples_are_errors_with_the_programs_output_and_the_sweep_goes_on() {
     let dir = program_dir();
     let mut text = format!("{HEAD}\nkernels = [\"naive\"]\n");
@@ -425,6 +472,11 @@ fn bad_external_configs_are_refused_before_anything_runs() {
         (
             "name = \"x\"\nsteps = 0\ntime = \"wall\"\ncommand = [\"p\"]".into(),
             "at least 1",
+        ),
+        (format!("{base}command = [\"p\"]\nfamily = \"f\""), "give `force_error` too"),
+        (
+            format!("{base}command = [\"p\"]\nforce_error = 'e (.+)'\nfamily = \"a b\""),
+            "it must be letters",
         ),
     ] {
         let message = parse(&ext);

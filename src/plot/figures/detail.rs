@@ -92,31 +92,33 @@ pub fn step_percentiles(rows: &[Percentiles], caption: &str) -> Chart {
     chart
 }
 
-/// One octree run: opening angle, cost (seconds per step) and median relative force error.
+/// One run of a tree code: its setting (e.g. "θ=0.5", or an external code's requested
+/// precision), cost (seconds per step) and median relative force error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ThetaPoint {
-    pub theta: f64,
+    pub setting: String,
     pub seconds: f64,
     pub error: f64,
 }
 
-/// Octree runs over θ for one scenario, in the order to join them (usually by θ).
+/// Runs of one code over its accuracy settings, in the order to join them (usually by θ).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ThetaSweep {
     pub name: String,
     pub points: Vec<ThetaPoint>,
 }
 
-/// Force error against cost over θ on log-log axes, each point labelled with its θ.
+/// Force error against cost over each code's settings on log-log axes, each point labelled
+/// with its setting.
 pub fn octree_accuracy(sweeps: &[ThetaSweep], caption: &str) -> Chart {
     let x = Axis::log("time per step").unit(Unit::Seconds);
     let y = Axis::log("median relative force error");
-    let mut chart = Chart::new("Octree: force error vs cost over θ", x, y).caption(caption);
+    let mut chart = Chart::new("Long-range codes: force error vs cost", x, y).caption(caption);
     for (k, sweep) in sweeps.iter().enumerate() {
         let points = sweep
             .points
             .iter()
-            .map(|p| Point::new(p.seconds, p.error).label(format!("θ={}", p.theta)))
+            .map(|p| Point::new(p.seconds, p.error).label(p.setting.clone()))
             .collect();
         chart
             .series

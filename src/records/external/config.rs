@@ -28,6 +28,11 @@ pub struct External {
     /// relative force error the program reports, kept like the built-in kernels' force error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force_error: Option<String>,
+    /// Entries of one family are one code at several accuracy settings (a requested
+    /// precision, say): the analysis joins their cases into one series of force error against
+    /// cost, as it does a kernel's θ sweep, and interpolates it at equal error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub family: Option<String>,
     /// Environment variables set for the program (values with placeholders).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub env: BTreeMap<String, String>,
@@ -52,6 +57,14 @@ pub struct External {
     /// Rank counts [default: the `[mpi]` table's, else 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ranks: Option<Vec<usize>>,
+}
+
+/// Letters, digits, '-', '_' and '.', not empty: what names a case or a family.
+fn plain_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
 }
 
 fn default_timeout() -> f64 {
@@ -135,12 +148,7 @@ impl External {
     pub fn validate(&self) -> Result<(), (String, String)> {
         let key = |k: &str| format!("external.{}.{k}", self.name);
         let bad = |k: &str, p: String| Err((key(k), p));
-        if self.name.is_empty()
-            || !self
-                .name
-                .chars()
-                .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
-        {
+        if !plain_name(&self.name) {
             return Err((
                 "external.name".into(),
                 format!(
@@ -252,6 +260,21 @@ impl External {
                     );
                 }
                 Ok(_) => {}
+            }
+        }
+        if let Some(f) = &self.family {
+            if !plain_name(f) {
+                return bad(
+                    "family",
+                    format!("is `{f}`: it must be letters, digits, '-', '_' and '.'"),
+                );
+            }
+            if self.force_error.is_none() {
+                return bad(
+                    "family",
+                    "joins entries by their force error against cost: give `force_error` too"
+                        .into(),
+                );
             }
         }
         if let Some(t) = &self.threads
