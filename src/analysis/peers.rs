@@ -63,8 +63,8 @@ pub struct PeerVariant {
     pub oversubscribed: bool,
 }
 
-/// Each code's time per step at the median force error [`EQUAL_ERROR`], interpolated on its
-/// sweep over θ (log time linear in log error between the two cases that bracket it).
+/// Each code's time per step at a median force error, interpolated over its settings (log
+/// time linear in log error between the two settings that bracket it).
 #[derive(Clone, Debug, Serialize)]
 pub(crate) struct EqualErrorCost {
     pub scenario: String,
@@ -78,6 +78,10 @@ pub(crate) struct EqualErrorCost {
     pub(crate) theirs_s: Option<f64>,
     /// `theirs_s / ours_s`.
     pub speedup: Option<f64>,
+    /// The two settings each time was interpolated between (the same one twice when a
+    /// setting has exactly that error).
+    pub(crate) ours_between: Option<[String; 2]>,
+    pub(crate) theirs_between: Option<[String; 2]>,
     /// The range of median errors each code measured, to say why a cost is missing.
     pub(crate) ours_errors: [f64; 2],
     pub(crate) theirs_errors: [f64; 2],
@@ -161,41 +165,138 @@ pub(crate) fn ratios(cases: &[Point]) -> Vec<PeerRatio> {
     out
 }
 
+#[cfg(test)]
+fn cost_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
+    bracket(points, target).map(|(s, _)| s)
+}
+
 /// The time at median error `target` from `(error, seconds)` points, interpolating log time
-/// linearly in log error between the first two neighbours (in error) that bracket it; `None`
-/// when no pair does. A point that another beats on both (no larger error, less time) is
-/// left out: nobody would choose that setting, so a code is compared at its best.
-pub(crate) fn cost_at_error(points: &[(f64, f64)], target: f64) -> Option<f64> {
-    let mut v: Vec<(f64, f64)> = points
+/// linearly in log error between the first two neighbours (in error) that bracket it, with
+/// their indices in `points`; `None` when no pair does. A point that another beats on both (no
+/// larger error, less time) is left out: nobody would choose that setting, so a code is
+/// compared at its best.
+fn bracket(points: &[(f64, f64)], target: f64) -> Option<(f64, [usize; 2])> {
+    let mut v: Vec<(f64, f64, usize)> = points
         .iter()
-        .copied()
-        .filter(|&(e, s)| e > 0.0 && s > 0.0 && e.is_finite() && s.is_finite())
+        .enumerate()
+        .map(|(i, &(e, s))| (e, s, i))
+        .filter(|&(e, s, _)| e > 0.0 && s > 0.0 && e.is_finite() && s.is_finite())
         .collect();
     v.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
     let mut fastest = f64::INFINITY;
-    v.retain(|&(_, s)| {
+    v.retain(|&(_, s, _)| {
         let better = s < fastest;
         fastest = fastest.min(s);
         better
     });
     v.windows(2).find_map(|w| {
-        let ((e0, s0), (e1, s1)) = (w[0], w[1]);
+        let ((e0, s0, i0), (e1, s1, i1)) = (w[0], w[1]);
         if !(e0 <= target && target <= e1) {
             return None;
         }
         if e0 == e1 {
-            return Some(s0.min(s1));
+            return Some(if s0 <= s1 {
+                (s0, [i0, i0])
+            } else {
+                (s1, [i1, i1])
+            });
         }
         let f = (target.ln() - e0.ln()) / (e1.ln() - e0.ln());
-        Some((s0.ln() + f * (s1.ln() - s0.ln())).exp())
+        Some(((s0.ln() + f * (s1.ln() - s0.ln())).exp(), [i0, i1]))
     })
 }
 
-fn error_points(t: &ThetaAnalysis) -> Vec<(f64, f64)> {
-    t.points
-        .iter()
-        .filter_map(|p| Some((p.force_error?[0], p.median_s)))
-        .collect()
+/// One code's settings on one system at one worker count: every case of its series over θ,
+/// for ours all expansion orders together (a user picks the best of them), for an external
+/// program its θ sweep or the members of its family.
+struct Settings {
+    scenario: crate::scenario::ScenarioKind,
+    n: usize,
+    workers: usize,
+    code: String,
+    /// `(median error, seconds per step)` of each setting, and its label.
+    points: Vec<(f64, f64)>,
+    labels: Vec<String>,
+}
+
+impl Settings {
+    /// The settings of `series` grouped by code, system and workers, in first-seen order.
+    fn of<'a>(series: impl IntoIterator<Item = &'a ThetaAnalysis>) -> Vec<Settings> {
+        let mut out: Vec<Settings> = Vec::new();
+        for t in series {
+            let (scenario, n, w) = (t.series.scenario, t.series.n.unwrap_or(0), workers(t));
+            let code = t.series.kernel.name().to_string();
+            let at = match out.iter().position(|s| {
+                s.scenario == scenario && s.n == n && s.workers == w && s.code == code
+            }) {
+                Some(i) => i,
+                None => {
+                    out.push(Settings {
+                        scenario,
+                        n,
+                        workers: w,
+                        code: code.clone(),
+                        points: Vec::new(),
+                        labels: Vec::new(),
+                    });
+                    out.len() - 1
+                }
+            };
+            for p in &t.points {
+                if let Some([median, _]) = p.force_error {
+                    out[at].points.push((median, p.median_s));
+                    out[at].labels.push(setting(p, &code));
+                }
+            }
+        }
+        out
+    }
+
+    /// The time at `error` and the two settings it lies between.
+    fn at(&self, error: f64) -> Option<(f64, [String; 2])> {
+        let (s, [a, b]) = bracket(&self.points, error)?;
+        Some((s, [self.labels[a].clone(), self.labels[b].clone()]))
+    }
+
+    /// [`Settings::at`], or when no two settings bracket `error` but some are more accurate,
+    /// the fastest of those, named with its error: an upper bound on the time at `error`.
+    /// Used for our codes only, so that a comparison can understate our speed, never overstate
+    /// it.
+    fn at_most(&self, error: f64) -> Option<(f64, [String; 2])> {
+        self.at(error).or_else(|| {
+            let (i, &(e, s)) = self
+                .points
+                .iter()
+                .enumerate()
+                .filter(|(_, (e, s))| *e <= error && s.is_finite() && *s > 0.0)
+                .min_by(|a, b| a.1.1.total_cmp(&b.1.1))?;
+            let label = format!("{} at {e:.1e}", self.labels[i]);
+            Some((s, [label.clone(), label]))
+        })
+    }
+}
+
+/// A case's setting within its code: "θ=0.5 quadrupole", "θ=0.4 order 6", or a family
+/// member's name without the family's ("eps1e-2" of "fmm3d-eps1e-2").
+fn setting(p: &Point, code: &str) -> String {
+    let name = p.case.kernel.name();
+    if name != code {
+        let short = name
+            .strip_prefix(code)
+            .map(|s| s.trim_start_matches(['-', '_', '.']));
+        return short.filter(|s| !s.is_empty()).unwrap_or(name).to_string();
+    }
+    let mut parts = Vec::new();
+    if let Some(t) = p.theta {
+        parts.push(format!("θ={t}"));
+    }
+    if p.case.multipole != crate::kernels::Multipole::Monopole {
+        parts.push(p.case.multipole.name().to_string());
+    }
+    if let Some(order) = p.case.order {
+        parts.push(format!("order {order}"));
+    }
+    parts.join(" ")
 }
 
 fn error_range(points: &[(f64, f64)]) -> [f64; 2] {
@@ -206,61 +307,53 @@ fn error_range(points: &[(f64, f64)]) -> [f64; 2] {
         })
 }
 
-/// Our tree series next to each external one of the same scenario, n and workers, at
-/// [`EQUAL_ERROR`], and at each of [`TIGHTER_ERRORS`] that the external series reaches.
+fn workers(t: &ThetaAnalysis) -> usize {
+    t.series.threads.unwrap_or(1) * t.series.ranks.unwrap_or(1)
+}
+
+/// Each of our tree codes (at its best over θ and expansion orders) next to each external one
+/// of the same scenario, n and workers, at [`EQUAL_ERROR`], and at each of [`TIGHTER_ERRORS`]
+/// that the external code reaches. Ours may stand in with a more accurate setting
+/// ([`Settings::at_most`]); theirs must bracket the error.
 pub(crate) fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
     let (theirs, ours): (Vec<&ThetaAnalysis>, Vec<&ThetaAnalysis>) =
         theta.iter().partition(|t| t.series.kernel.is_external());
+    let (theirs, ours) = (Settings::of(theirs), Settings::of(ours));
     let mut out = Vec::new();
     let levels =
         std::iter::once((EQUAL_ERROR, true)).chain(TIGHTER_ERRORS.iter().map(|&e| (e, false)));
     for (error, always) in levels {
         for t in &theirs {
-            let tp = error_points(t);
-            let theirs_s = cost_at_error(&tp, error);
-            if theirs_s.is_none() && !always {
+            let at_theirs = t.at(error);
+            if at_theirs.is_none() && !always {
                 continue;
             }
-            for o in ours.iter().filter(|o| {
-                o.series.scenario == t.series.scenario
-                    && o.series.n == t.series.n
-                    && workers(o) == workers(t)
-            }) {
-                let op = error_points(o);
-                out.push(equal_error_row(o, t, error, &op, &tp, theirs_s));
+            let same =
+                |o: &&Settings| o.scenario == t.scenario && o.n == t.n && o.workers == t.workers;
+            for o in ours.iter().filter(same) {
+                let at_ours = o.at_most(error);
+                out.push(EqualErrorCost {
+                    scenario: o.scenario.name().into(),
+                    n: o.n,
+                    workers: o.workers,
+                    error,
+                    ours: o.code.clone(),
+                    theirs: t.code.clone(),
+                    ours_s: at_ours.as_ref().map(|a| a.0),
+                    theirs_s: at_theirs.as_ref().map(|a| a.0),
+                    speedup: at_ours
+                        .as_ref()
+                        .zip(at_theirs.as_ref())
+                        .map(|(o, t)| t.0 / o.0),
+                    ours_between: at_ours.map(|a| a.1),
+                    theirs_between: at_theirs.clone().map(|a| a.1),
+                    ours_errors: error_range(&o.points),
+                    theirs_errors: error_range(&t.points),
+                });
             }
         }
     }
     out
-}
-
-fn workers(t: &ThetaAnalysis) -> usize {
-    t.series.threads.unwrap_or(1) * t.series.ranks.unwrap_or(1)
-}
-
-/// Our series `o` against their series `t` at median error `error`.
-fn equal_error_row(
-    o: &ThetaAnalysis,
-    t: &ThetaAnalysis,
-    error: f64,
-    op: &[(f64, f64)],
-    tp: &[(f64, f64)],
-    theirs_s: Option<f64>,
-) -> EqualErrorCost {
-    let ours_s = cost_at_error(op, error);
-    EqualErrorCost {
-        scenario: o.series.scenario.name().into(),
-        n: o.series.n.unwrap_or(0),
-        workers: workers(o),
-        error,
-        ours: o.label.clone(),
-        theirs: t.label.clone(),
-        ours_s,
-        theirs_s,
-        speedup: ours_s.zip(theirs_s).map(|(o, t)| t / o),
-        ours_errors: error_range(op),
-        theirs_errors: error_range(tp),
-    }
 }
 
 #[cfg(test)]
@@ -411,6 +504,8 @@ mod tests {
                 .map(|&(error, s)| {
                     let mut p = point(ScenarioKind::Coulomb, code, 1000, 1, 1, s);
                     p.force_error = Some([error, 10.0 * error]);
+                    // A θ to name the setting by: its time.
+                    p.theta = Some(s);
                     p
                 })
                 .collect();
@@ -434,6 +529,8 @@ mod tests {
         };
         let theta = [
             series("fmm", &[(1e-5, 4.0), (1e-3, 1.0)]),
+            // Another order of ours: one code with the first, at its best of both.
+            series("fmm", &[(1e-4, 1.5)]),
             // Reaches 1e-4: compared there too.
             series("fast-multipole", &[(1e-6, 8.0), (1e-2, 2.0)]),
             // Does not: compared at 1e-3 only. Its setting at 2e-3 is slower than the one
@@ -450,11 +547,29 @@ mod tests {
                 (1e-4, "fast-multipole")
             ]
         );
-        // At 1e-4 theirs interpolates between 1e-6 (8 s) and 1e-2 (2 s): 4 s, ours between
-        // 1e-5 (4 s) and 1e-3 (1 s): 2 s.
+        // At 1e-4 theirs interpolates between 1e-6 (8 s) and 1e-2 (2 s): 4 s; ours has a
+        // setting there, 1.5 s (the other order would have given 2 s).
         let at = &rows[2];
         assert!((at.theirs_s.unwrap() - 4.0).abs() < 1e-12);
-        assert!((at.ours_s.unwrap() - 2.0).abs() < 1e-12);
-        assert!((at.speedup.unwrap() - 2.0).abs() < 1e-12);
+        assert!((at.ours_s.unwrap() - 1.5).abs() < 1e-12);
+        assert!((at.speedup.unwrap() - 4.0 / 1.5).abs() < 1e-12);
+        assert_eq!(at.theirs_between, Some(["θ=8".into(), "θ=2".into()]));
+        assert_eq!(at.ours_between.as_ref().unwrap()[1], "θ=1.5");
+        // Ours with every setting more accurate than the target: the fastest stands in.
+        let tight = [
+            series("fmm", &[(1e-6, 5.0), (2e-4, 3.0), (5e-4, 2.5)]),
+            series("tree", &[(5e-4, 6.0), (1e-2, 3.0)]),
+        ];
+        let rows_tight = equal_error(&tight);
+        assert_eq!(rows_tight[0].ours_s, Some(2.5));
+        assert_eq!(
+            rows_tight[0].ours_between,
+            Some(["θ=2.5 at 5.0e-4".into(), "θ=2.5 at 5.0e-4".into()])
+        );
+        // Theirs never does: every setting of "tree" here is less accurate than 1e-4.
+        assert!(rows_tight.iter().all(|r| r.error == EQUAL_ERROR));
+        // At 1e-3, ours between its two orders' settings.
+        assert_eq!(rows[0].ours_between, Some(["θ=1.5".into(), "θ=1".into()]));
+        assert!((rows[0].ours_s.unwrap() - 1.0).abs() < 1e-12);
     }
 }

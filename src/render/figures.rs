@@ -255,13 +255,9 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         .theta
         .iter()
         .map(|t| ThetaSweep {
-            // One series per code and expansion order; our octree's monopole keeps its
-            // earlier name.
+            // One series per code and expansion order.
             name: {
-                let mut name = match t.series.kernel.kernel() {
-                    Some(crate::kernels::KernelKind::Octree) => String::new(),
-                    _ => format!("{} ", t.series.kernel.name()),
-                };
+                let mut name = format!("{} ", t.series.kernel.name());
                 name.push_str(&format!(
                     "{} n={}",
                     t.series.scenario.name(),

@@ -473,15 +473,21 @@ pub(crate) fn peers_equal_error(a: &Analysis) -> String {
         Some(s) => Duration(s).to_string(),
         None => format!("outside the measured {:.1e}–{:.1e}", range[0], range[1]),
     };
+    // "fmm (θ=0.5 order 4 – θ=0.4 order 6)": the settings the time lies between.
+    let code = |name: &str, between: &Option<[String; 2]>| match between {
+        Some([a, b]) if a == b => format!("{name} ({a})"),
+        Some([a, b]) => format!("{name} ({a} – {b})"),
+        None => name.to_string(),
+    };
     for r in &a.peers_equal_error {
         table.row([
             r.scenario.to_string(),
             r.n.to_string(),
             r.workers.to_string(),
             format!("{:.0e}", r.error),
-            r.ours.to_string(),
+            code(&r.ours, &r.ours_between),
             cost(r.ours_s, r.ours_errors),
-            r.theirs.to_string(),
+            code(&r.theirs, &r.theirs_between),
             cost(r.theirs_s, r.theirs_errors),
             r.speedup.map_or(NONE.to_string(), |s| format!("{s:.2}")),
         ]);

@@ -315,7 +315,11 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
         if !equal.is_empty() {
             md.push_str(
                 "At equal accuracy: each code's time per step interpolated (log-log) to the same median \
-                 relative force error on its sweep over θ (or over the settings of its `family`).\n\n",
+                 relative force error over its settings (θ and expansion order for ours; θ, or the members \
+                 of its `family`, for theirs), each code at its best: a setting that another beats on both \
+                 error and time is left out. In brackets, the two settings the time lies between; where \
+                 all of our settings are more accurate than the error, our fastest stands in (\"at\" its \
+                 error: an upper bound on our time), while theirs must reach the error from both sides.\n\n",
             );
             md.push_str(&equal);
             md.push('\n');
