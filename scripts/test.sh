@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Runs every check of the project: formatting, lints, unit and integration tests, the benches
-# (once each), the force validation of every scenario, the performance gate and the MPI tests.
+# (once each), the force validation of every scenario, the performance gate, the MPI tests and
+# the Slurm path (against a one-node Slurm started here).
 # Works on a fresh machine with a Rust toolchain (Open MPI and libclang are installed with apt
 # when missing and this runs as root).
 #
@@ -30,6 +31,10 @@ export CARGO_PROFILE_RELEASE_DEBUG=false
 
 step "format"
 scripts/install-mpi.sh
+# Slurm and munge for the Slurm tests at the end, installed (apt) while the build runs.
+slurm_log=$(mktemp)
+scripts/slurm-local.sh --install >"$slurm_log" 2>&1 &
+slurm_install=$!
 cargo fmt --all -- --check
 
 step "the build, linted: tests, benches and binary, with the mpi feature"
@@ -56,6 +61,10 @@ export RUSTC_WORKSPACE_WRAPPER="$clippy_driver" RUSTFLAGS="-D warnings"
 features=(--features mpi,test-slowdown)
 cargo test --release --workspace --all-targets "${features[@]}" --no-run
 bin=target/release/nbody-bench
+if ! wait "$slurm_install"; then
+    cat "$slurm_log" >&2
+    exit 1
+fi
 
 step "validation and the performance gate"
 "$bin" validate --threads 2
@@ -82,6 +91,17 @@ cargo test --release "${features[@]}" --test suite -- --skip gate:: --skip dry_r
 cargo test --release "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
 cargo test --release "${features[@]}" --benches
 
-step "the MPI drivers under mpirun"
+step "the MPI drivers under mpirun, and the Slurm path beside them"
+# Sweeps through a one-node Slurm and the weak-scaling job script under sbatch
+# (scripts/slurm-tests.sh), run alongside: they check what comes back, not how fast, and one of
+# them waits out a job's time limit (over a minute).
+NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh "${features[@]}" >"$slurm_log" 2>&1 &
+slurm_tests=$!
 NBODY_BENCH_BIN="$bin" scripts/mpi-tests.sh
+if ! wait "$slurm_tests"; then
+    cat "$slurm_log" >&2
+    echo "the Slurm tests failed (scripts/slurm-tests.sh)" >&2
+    exit 1
+fi
+tail -n 3 "$slurm_log" >&2
 step "all checks passed"

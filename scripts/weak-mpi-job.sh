@@ -2,7 +2,8 @@
 # A weak-scaling job for a cluster: takes the rank count from the batch system's allocation,
 # runs the lj-box gas with the spatial decomposition at 1, 2, 4, ... ranks up to it (n grows
 # with the ranks) as one sweep under the launcher, then the communication benchmark at the
-# full allocation. Results: results/<name>/results.json and results/<name>/mpi-bench.json.
+# full allocation. Results: results/<name>/results.json and results/<name>/mpi-bench.json (or
+# under $OUT).
 #
 #   sbatch -n 64 --time=00:30:00 scripts/weak-mpi-job.sh       (Slurm: launches with srun)
 #   qsub -l nodes=4:ppn=16 scripts/weak-mpi-job.sh              (PBS/Torque: mpirun)
@@ -12,7 +13,9 @@
 #   cargo build --release --features mpi
 # Settings (environment): RANKS (overrides the allocation), BASE_N (particles per rank,
 # 100000), STEPS (200), WARMUP (20), DECOMP (domain; or "domain allgather"), LAUNCHER_ARGS
-# (extra launcher arguments, e.g. "--bind-to none" for several threads per rank), THREADS (1).
+# (extra launcher arguments, e.g. "--bind-to none" for several threads per rank), THREADS (1),
+# SRUN_MPI (srun's --mpi plugin, pmix; empty for the cluster's default), OUT (results).
+# scripts/test.sh runs it under the one-node Slurm of scripts/slurm-local.sh.
 #SBATCH --job-name=nbody-weak-mpi
 set -euo pipefail
 cd "${SLURM_SUBMIT_DIR:-${PBS_O_WORKDIR:-$(dirname "$0")/..}}"
@@ -26,12 +29,17 @@ if ! [[ "$ranks" =~ ^[1-9][0-9]*$ ]]; then
     exit 2
 fi
 
+read -r -a extra <<<"${LAUNCHER_ARGS:-}"
 if [ -n "${SLURM_JOB_ID:-}" ]; then
     launcher=srun
+    mpi_plugin=${SRUN_MPI-pmix}
+    if [ -n "$mpi_plugin" ]; then
+        extra=("--mpi=$mpi_plugin" ${extra[@]+"${extra[@]}"})
+    fi
 else
     launcher=mpirun
     if [ "$(id -u)" = 0 ]; then
-        LAUNCHER_ARGS="--allow-run-as-root ${LAUNCHER_ARGS:-}"
+        extra=(--allow-run-as-root ${extra[@]+"${extra[@]}"})
     fi
 fi
 bin=target/release/nbody-bench
@@ -46,12 +54,12 @@ for ((r = 1; r <= ranks; r *= 2)); do series+=("$r"); done
 [ "${series[-1]}" = "$ranks" ] || series+=("$ranks")
 
 quote() { printf '"%s", ' "$@" | sed 's/, $//'; }
-read -r -a extra <<<"${LAUNCHER_ARGS:-}"
 read -r -a decomps <<<"${DECOMP:-domain}"
 name="weak-mpi-${SLURM_JOB_ID:-${PBS_JOBID:-$(date +%Y%m%d-%H%M%S)}}"
 name=${name//[^A-Za-z0-9._-]/-}
-mkdir -p results
-config="results/$name.toml"
+out=${OUT:-results}
+mkdir -p "$out"
+config="$out/$name.toml"
 cat >"$config" <<EOF
 # Written by scripts/weak-mpi-job.sh for an allocation of $ranks ranks.
 name = "$name"
@@ -77,5 +85,5 @@ samples = 10
 rounds = 2
 EOF
 echo "weak scaling over ranks ${series[*]} with $launcher; config $config"
-"$bin" sweep --config "$config" --out results
-"$launcher" "${extra[@]}" -n "$ranks" "$bin" mpi-bench --out "results/$name/mpi-bench.json"
+"$bin" sweep --config "$config" --out "$out"
+"$launcher" ${extra[@]+"${extra[@]}"} -n "$ranks" "$bin" mpi-bench --out "$out/$name/mpi-bench.json"

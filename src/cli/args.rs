@@ -60,6 +60,16 @@ pub enum Command {
     /// every key of a sweep config.
     #[command(hide = true)]
     Reference(ReferenceArgs),
+    /// Inside a batch job submitted by a sweep with a `[scheduler]`: do the work the sweep wrote
+    /// into DIR (one case round, or a calibration) and write DIR/result.json.
+    #[command(hide = true)]
+    Job(JobArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct JobArgs {
+    /// The job's directory (under the sweep's results, `jobs/...`).
+    pub dir: std::path::PathBuf,
 }
 
 #[derive(Debug, Args)]

@@ -38,6 +38,11 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::MpiCheck(args) => mpi::check(args),
         Command::Export(args) => export::export(args),
         Command::Reference(args) => reference::reference(args),
+        Command::Job(args) => {
+            nbody_bench::experiment::slurm::job_main(&args.dir)
+                .map_err(|e| anyhow::anyhow!("job {}: {e}", args.dir.display()))?;
+            Ok(0)
+        }
     }
 }
 

@@ -111,6 +111,14 @@ decomp = ["domain"]
 steps = 50
 warmup_steps = 5
 
+[scheduler]
+kind = "slurm"
+partition = "short"
+account = "proj42"
+time_limit = "10:00"
+sbatch_args = ["--qos=short"]
+poll_s = 5
+
 [[external]]
 name = "other"
 command = ["other", "{n}", "{threads}"]
@@ -182,6 +190,15 @@ fn meaning(key: &str) -> Option<&'static str> {
         "mpi.decomp" => "decompositions; each kernel runs with those that support it",
         "mpi.steps" => "timed steps per launch, split into the round's samples",
         "mpi.warmup_steps" => "untimed steps before them",
+        "scheduler" => {
+            "run each case round, and the calibrations, as a batch job on a cluster (Slurm)"
+        }
+        "scheduler.kind" => "the batch system",
+        "scheduler.partition" => "`sbatch --partition` (when left out: the cluster's default)",
+        "scheduler.account" => "`sbatch --account` (when left out: the user's default)",
+        "scheduler.time_limit" => "`sbatch --time` of each job",
+        "scheduler.sbatch_args" => "more `sbatch` arguments, given to every job",
+        "scheduler.poll_s" => "seconds between two looks at the queue while a job waits or runs",
         "external.name" => "the kernel name of its cases (keys, tables, figures)",
         "external.command" => {
             "the program and its arguments, each token with placeholders; never a shell string"

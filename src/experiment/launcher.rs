@@ -167,6 +167,7 @@ pub(crate) fn round_from_json(
         reference_s: Vec::new(),
         initial_work: None,
         external: None,
+        job: None,
     })
 }
 

@@ -11,8 +11,8 @@ use crate::run::RunError;
 use crate::scenario::{Setup, SetupError};
 use crate::stepper::{Stepper, stepper};
 
-/// How one round of a case is measured.
-#[derive(Clone, Debug)]
+/// How one round of a case is measured (a batch job reads it from its task file).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct RoundSpec {
     pub samples: usize,
     pub warmup_s: f64,
@@ -25,6 +25,7 @@ pub(crate) struct RoundSpec {
     pub reference_s: f64,
     /// The test-only slowdown knob, if set (see `experiment::slowdown`).
     #[cfg(feature = "test-slowdown")]
+    #[serde(skip)]
     pub slowdown: Option<TestSlowdown>,
 }
 
@@ -132,5 +133,6 @@ fn measure<C: Clock>(
         initial_work: Some(initial_work),
         mpi: None,
         external: None,
+        job: None,
     })
 }

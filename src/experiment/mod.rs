@@ -1,8 +1,10 @@
 //! The experiment runner: the cases of a sweep config ([`crate::records`]) measured round by
-//! round (`runner`, `measure`, with the `reference` workload and `progress` lines) into its
-//! results file, held by one writer (`lock`); external programs run (`external`) and rounds
-//! under an MPI launcher (`launcher`); the length estimate of a sweep (`estimate`).
+//! round (`runner`; one round of any case in `case_round`, of a kernel in `measure`, with the
+//! `reference` workload and `progress` lines) into its results file, held by one writer
+//! (`lock`); external programs run (`external`) and rounds under an MPI launcher (`launcher`)
+//! or as batch jobs (`slurm`); the length estimate of a sweep (`estimate`).
 
+mod case_round;
 pub mod estimate;
 pub mod external;
 pub mod launcher;
@@ -13,3 +15,4 @@ pub mod reference;
 pub mod runner;
 #[cfg(feature = "test-slowdown")]
 pub mod slowdown;
+pub mod slurm;

@@ -1,16 +1,16 @@
 //! Runs a sweep: plans the cases, measures them in interleaved rounds, saves the results
 //! file after every round of every case, and resumes an interrupted sweep.
 
+use super::case_round::{case_setup, measure_case};
 use super::lock::WriterLock;
-use super::measure::{RoundSpec, measure_round};
+use super::measure::RoundSpec;
 #[cfg(feature = "test-slowdown")]
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
+use super::slurm;
 use crate::clock::Clock;
 use crate::records::config::SweepConfig;
-use crate::records::kernel_or_program::KernelOrProgram;
 use crate::records::plan::{Case, cases};
 use crate::records::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
-use crate::scenario::Setup;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -92,6 +92,8 @@ pub enum SweepError {
     Plan(String),
     #[error(transparent)]
     Lock(#[from] super::lock::LockError),
+    #[error(transparent)]
+    Slurm(#[from] super::slurm::SlurmError),
     #[error("cannot keep {path} as a backup: {source}")]
     Backup {
         path: PathBuf,
@@ -189,6 +191,9 @@ pub fn run_sweep<C: Clock>(
         let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
         super::external::check_programs(ext, launcher, &context)?;
     }
+    if config.scheduler.is_some() {
+        slurm::check_available()?;
+    }
     #[cfg(feature = "test-slowdown")]
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     if let Some(dir) = path.parent() {
@@ -235,9 +240,11 @@ pub fn run_sweep<C: Clock>(
     };
     if options.calibrate && results.calibration.start.is_none() {
         observer.message("calibrating the machine...");
-        let cal = crate::calibrate::calibrate(&thread_counts);
-        observer.message(&cal.summary());
-        results.calibration.start = Some(cal);
+        let cal = calibrate(config, &context, &path, "start", &thread_counts, observer)?;
+        if let Some(cal) = &cal {
+            observer.message(&cal.summary());
+        }
+        results.calibration.start = cal;
     }
     if results.metadata.externals.is_empty() && !config.external.is_empty() {
         results.metadata.externals = config
@@ -285,19 +292,31 @@ pub fn run_sweep<C: Clock>(
                 samples: samples_in_round(config.measure.samples, rounds, round),
                 warmup_s: config.measure.warmup_s,
                 min_sample_s: config.measure.min_sample_s,
-                steps_per_sample: (record.rounds_done > 0).then_some(record.steps_per_sample),
+                // A round no job measured chose nothing.
+                steps_per_sample: (record.rounds_done > 0 && record.steps_per_sample > 0)
+                    .then_some(record.steps_per_sample),
                 force_error_sample: config.measure.force_error_sample,
                 reference_s: config.measure.reference_s,
                 #[cfg(feature = "test-slowdown")]
                 slowdown,
             };
-            let outcome =
-                measure_case(&record.case, &spec, clock, config, &context).map_err(|source| {
-                    SweepError::Case {
+            let outcome = match &config.scheduler {
+                Some(scheduler) => {
+                    let job = JobRound {
+                        scheduler,
+                        results: &path,
+                        config,
+                        context: &context,
+                    };
+                    job.measure(&record.case, round, &spec, observer)?
+                }
+                None => measure_case(&record.case, &spec, clock, config, &context).map_err(
+                    |source| SweepError::Case {
                         key: record.key.clone(),
                         source,
-                    }
-                })?;
+                    },
+                )?,
+            };
             report_external(&record.key, &outcome, observer);
             let record = &mut results.cases[i];
             record.add_round(outcome, config.measure.max_energy_drift);
@@ -307,8 +326,8 @@ pub fn run_sweep<C: Clock>(
         }
     }
     if options.calibrate && !stopped {
-        let cal = crate::calibrate::calibrate(&thread_counts);
-        results.calibration.end = Some(cal);
+        results.calibration.end =
+            calibrate(config, &context, &path, "end", &thread_counts, observer)?;
         results.save(&path)?;
     }
     observer.finish();
@@ -325,40 +344,92 @@ pub(super) fn samples_in_round(samples: usize, rounds: usize, round: usize) -> u
     samples / rounds + usize::from(round < samples % rounds)
 }
 
-fn measure_case<C: Clock>(
-    case: &Case,
-    spec: &RoundSpec,
-    clock: &C,
+/// One round of a case as a batch job: where its job directory goes and what it needs.
+struct JobRound<'a> {
+    scheduler: &'a crate::records::scheduler::Scheduler,
+    results: &'a Path,
+    config: &'a SweepConfig,
+    context: &'a super::external::Context,
+}
+
+impl JobRound<'_> {
+    /// Submits (or picks up) the round's job, waits for it and reads its round; a job that
+    /// ended without one gives a round without samples that keeps the job's output.
+    fn measure(
+        &self,
+        case: &Case,
+        round: usize,
+        spec: &RoundSpec,
+        observer: &mut dyn Observer,
+    ) -> Result<crate::records::round::RoundOutcome, SweepError> {
+        let key = case.key();
+        let what = format!("{key} round {}", round + 1);
+        let dir = slurm::job_dir(self.results, &format!("round-{}-{key}", round + 1));
+        let work = slurm::Work::Round {
+            case: case.clone(),
+            spec: spec.clone(),
+        };
+        let task = slurm::Task::new(self.config, self.context, work);
+        let resources = slurm::Resources {
+            tasks: case.ranks,
+            cpus_per_task: case.threads,
+        };
+        let mut say = |m: &str| observer.message(m);
+        let ended = slurm::run(self.scheduler, &dir, &task, resources, &what, &mut say)?;
+        let measured = ended.result.and_then(|r| Some((r.round?, r.step_ns)));
+        Ok(match measured {
+            Some((mut outcome, step_ns)) => {
+                outcome.step_ns = step_ns;
+                outcome.job = Some(ended.record);
+                outcome
+            }
+            None => {
+                if let Some(e) = &ended.record.error {
+                    let last = e.output_tail.last().map(|l| format!("; last line: {l}"));
+                    observer.message(&format!(
+                        "error: {what}: {}{}",
+                        e.what,
+                        last.unwrap_or_default()
+                    ));
+                }
+                slurm::unmeasured_round(case, spec, ended.record)
+            }
+        })
+    }
+}
+
+/// Calibrates the machine, or with a `[scheduler]` the node of a job (`None` if that job
+/// ended without a result: the sweep goes on without this calibration).
+fn calibrate(
     config: &SweepConfig,
     context: &super::external::Context,
-) -> Result<crate::records::round::RoundOutcome, Box<dyn std::error::Error + Send + Sync>> {
-    let kernel = match &case.kernel {
-        KernelOrProgram::Kernel(k) => *k,
-        KernelOrProgram::External(name) => {
-            let ext = config
-                .external
-                .iter()
-                .find(|e| &e.name == name)
-                .ok_or_else(|| format!("the config has no [[external]] entry named `{name}`"))?;
-            return Ok(super::external::run::measure_round(
-                ext,
-                case,
-                spec,
-                config.mpi.as_ref(),
-                context,
-            )?);
-        }
+    results: &Path,
+    when: &str,
+    threads: &[usize],
+    observer: &mut dyn Observer,
+) -> Result<Option<crate::calibrate::Calibration>, SweepError> {
+    let Some(scheduler) = &config.scheduler else {
+        return Ok(Some(crate::calibrate::calibrate(threads)));
     };
-    if let Some(launch) = &config.mpi {
-        return Ok(super::launcher::measure_round(launch, case, spec)?);
+    let dir = slurm::job_dir(results, &format!("calibrate-{when}"));
+    let work = slurm::Work::Calibrate {
+        threads: threads.to_vec(),
+    };
+    let task = slurm::Task::new(config, context, work);
+    let resources = slurm::Resources {
+        tasks: 1,
+        cpus_per_task: threads.iter().copied().max().unwrap_or(1),
+    };
+    let what = format!("calibration ({when})");
+    let mut say = |m: &str| observer.message(m);
+    let ended = slurm::run(scheduler, &dir, &task, resources, &what, &mut say)?;
+    let calibration = ended.result.and_then(|r| r.calibration);
+    if calibration.is_none() {
+        observer.message(&format!(
+            "warning: {what}: the job ended without a result; the sweep goes on without it"
+        ));
     }
-    Ok(measure_round(
-        &case_setup(case),
-        case,
-        kernel,
-        spec,
-        clock,
-    )??)
+    Ok(calibration)
 }
 
 /// Where external programs find the sweep; their work directories go next to the results.
@@ -413,15 +484,6 @@ fn report_external(
     }
 }
 
-/// The system a case measures.
-fn case_setup(case: &Case) -> Setup {
-    let mut setup = Setup::new(case.scenario);
-    setup.n = Some(case.n);
-    setup.seed = case.seed;
-    setup.precision = case.precision;
-    setup
-}
-
 /// Opens the results file for this sweep: a new one, or an existing one to resume.
 fn open(
     config: &SweepConfig,
@@ -446,6 +508,15 @@ fn open(
             path: path.into(),
             source,
         })?;
+        // The jobs of the old results (a batch system's) go with them.
+        let jobs = path.with_file_name("jobs");
+        if jobs.exists() {
+            let kept = path.with_file_name(format!("jobs.{stamp}.bak"));
+            std::fs::rename(&jobs, &kept).map_err(|source| SweepError::Backup {
+                path: jobs.clone(),
+                source,
+            })?;
+        }
         return Ok(fresh());
     }
     if !options.resume {

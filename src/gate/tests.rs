@@ -120,6 +120,7 @@ fn results(run: Run) -> ResultsFile {
                 }),
                 mpi: None,
                 external: None,
+                job: None,
             };
             record.add_round(round, 0.05);
         }

@@ -192,6 +192,9 @@ pub struct SweepConfig {
     /// one runs it, so a config is code.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub external: Vec<super::external::External>,
+    /// Run every case round (and the calibrations) as a batch job (`[scheduler]`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scheduler: Option<super::scheduler::Scheduler>,
 }
 
 /// How a sweep starts MPI cases (the `[mpi]` table). Each round of a case is one launch; its
@@ -456,6 +459,9 @@ impl SweepConfig {
         }
         if let Some(mpi) = &self.mpi {
             self.validate_mpi(mpi, path)?;
+        }
+        if let Some(s) = &self.scheduler {
+            s.validate().map_err(|(key, problem)| bad(&key, problem))?;
         }
         let m = &self.measure;
         if m.samples == 0 || m.rounds == 0 || m.rounds > m.samples {

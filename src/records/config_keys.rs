@@ -107,6 +107,17 @@ pub fn allowed(key: &str) -> Option<&'static str> {
         "mpi.decomp" => "a list of decompositions, such as decomp = [\"allgather\", \"domain\"]",
         "mpi.steps" => "a whole number of timed steps per launch, such as steps = 100",
         "mpi.warmup_steps" => "a whole number of untimed steps, such as warmup_steps = 10",
+        "scheduler" => {
+            "a table [scheduler] with kind and optionally partition, account, time_limit, sbatch_args, poll_s"
+        }
+        "scheduler.kind" => "\"slurm\"",
+        "scheduler.partition" => "a partition name, such as partition = \"short\"",
+        "scheduler.account" => "an account name, such as account = \"proj42\"",
+        "scheduler.time_limit" => {
+            "a Slurm time limit per job: minutes, MM:SS, HH:MM:SS or D-HH[:MM[:SS]], such as time_limit = \"10:00\""
+        }
+        "scheduler.sbatch_args" => "a list of strings, such as sbatch_args = [\"--qos=short\"]",
+        "scheduler.poll_s" => "seconds above 0, at most 3600, such as poll_s = 5",
         _ => return None,
     })
 }

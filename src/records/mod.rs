@@ -1,9 +1,9 @@
 //! The files a sweep is defined by and leaves behind, and their versions: the sweep config
 //! (`config`, with `config_keys` for its messages and the external programs' entries in
 //! `external`), the cases it plans (`plan`, each measuring a `kernel_or_program`), the results
-//! file with every round (`results`, `round`, the outlier rules of `vet`) and the run
-//! directories (`locate`). The runner (`experiment`) writes them and `analysis` reads them;
-//! neither needs the other.
+//! file with every round (`results`, `round`, the outlier rules of `vet`), the batch system's
+//! table and job records (`scheduler`) and the run directories (`locate`). The runner
+//! (`experiment`) writes them and `analysis` reads them; neither needs the other.
 
 pub mod config;
 pub mod config_keys;
@@ -13,4 +13,5 @@ pub mod locate;
 pub mod plan;
 pub mod results;
 pub mod round;
+pub mod scheduler;
 pub mod vet;

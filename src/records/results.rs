@@ -328,10 +328,11 @@ impl CaseRecord {
             .flat_map(|r| r.samples_s.iter().copied())
             .collect();
         let med = median(&samples)?;
-        let rounds = self.rounds.len().max(1) as f64;
+        // Rounds that measured something (a batch job may end without measuring its round).
+        let measured = || self.rounds.iter().filter(|r| !r.samples_s.is_empty());
+        let rounds = measured().count().max(1) as f64;
         let steps: u64 = self.rounds.iter().map(|r| r.steps).sum();
-        let mean_of =
-            |f: &dyn Fn(&RoundOutcome) -> f64| self.rounds.iter().map(f).sum::<f64>() / rounds;
+        let mean_of = |f: &dyn Fn(&RoundOutcome) -> f64| measured().map(f).sum::<f64>() / rounds;
         let per_step = |f: &dyn Fn(&WorkCounters) -> u64| {
             self.rounds.iter().map(|r| f(&r.work) as f64).sum::<f64>() / steps.max(1) as f64
         };

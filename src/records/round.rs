@@ -45,4 +45,8 @@ pub struct RoundOutcome {
     /// Every run of an external program (`[[external]]`) with its times or its error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub external: Option<super::external::ExternalRound>,
+    /// The batch job that ran the round (`[scheduler]`), or that ended without measuring it:
+    /// then the round has no samples.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub job: Option<super::scheduler::JobRecord>,
 }

@@ -8,6 +8,7 @@
 use crate::{bin, text};
 use nbody_bench::records::external::SampleError;
 use nbody_bench::records::results::ResultsFile;
+use nbody_bench::records::scheduler::{JobError, JobRecord};
 use nbody_bench::records::vet::Rejected;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
@@ -187,8 +188,8 @@ fn committed_results() -> Vec<PathBuf> {
 #[test]
 fn the_results_reference_lists_exactly_the_fields_written() {
     // Each committed file read by this version and written again (older files gain the
-    // fields added since), plus the fields only some sweeps write: a rejected value and an
-    // external program's failures and wall-timing overhead.
+    // fields added since), plus the fields only some sweeps write: a rejected value, an
+    // external program's failures and wall-timing overhead, and a batch job's record.
     let mut found = BTreeSet::new();
     let files = committed_results();
     assert!(files.len() > 5, "{files:?}");
@@ -200,6 +201,15 @@ fn the_results_reference_lists_exactly_the_fields_written() {
                 what: "sample 0".into(),
                 value: "NaN".into(),
                 reason: "not a finite number".into(),
+            });
+            file.cases[0].rounds[0].job = Some(JobRecord {
+                id: "17".into(),
+                node: Some("node1".into()),
+                state: Some("TIMEOUT".into()),
+                error: Some(JobError {
+                    what: "job 17 ended TIMEOUT without a result".into(),
+                    output_tail: vec!["slurmstepd: error: *** JOB 17 CANCELLED".into()],
+                }),
             });
         }
         let external = file

@@ -29,6 +29,7 @@ mod parsers;
 mod peers;
 mod report;
 mod runs;
+mod slurm;
 mod supervision;
 mod sweep;
 mod verlet;

@@ -349,5 +349,6 @@ fn outcome(ext: &External, case: &Case, round: ExternalRound, steps: u64) -> Rou
         initial_work: None,
         mpi: None,
         external: Some(round),
+        job: None,
     }
 }

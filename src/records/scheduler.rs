@@ -1,0 +1,142 @@
+//! The `[scheduler]` table of a sweep config (run each case round as a batch job, today through
+//! Slurm) and what a round's results keep of its job.
+
+use serde::{Deserialize, Serialize};
+
+/// How a sweep submits its work to a batch system.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scheduler {
+    pub kind: SchedulerKind,
+    /// `sbatch --partition` [default: the cluster's default partition].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partition: Option<String>,
+    /// `sbatch --account` [default: the user's default account].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub account: Option<String>,
+    /// `sbatch --time` of each job, in Slurm's forms ("30", "10:00", "1:00:00", "1-0").
+    #[serde(default = "default_time_limit")]
+    pub time_limit: String,
+    /// More `sbatch` arguments, e.g. ["--qos=short", "--constraint=avx512"].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub sbatch_args: Vec<String>,
+    /// Seconds between two looks at the queue while a job waits or runs.
+    #[serde(default = "default_poll_s")]
+    pub poll_s: f64,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SchedulerKind {
+    Slurm,
+}
+
+fn default_time_limit() -> String {
+    "30:00".into()
+}
+
+fn default_poll_s() -> f64 {
+    2.0
+}
+
+impl Scheduler {
+    /// Checks what can be checked before a submission; `(key, problem)` on failure.
+    pub(crate) fn validate(&self) -> Result<(), (String, String)> {
+        if !valid_time_limit(&self.time_limit) {
+            return Err((
+                "scheduler.time_limit".into(),
+                format!(
+                    "is `{}`: give minutes, MM:SS, HH:MM:SS or D-HH[:MM[:SS]], such as \"10:00\"",
+                    self.time_limit
+                ),
+            ));
+        }
+        if !(self.poll_s.is_finite() && self.poll_s > 0.0 && self.poll_s <= 3600.0) {
+            return Err((
+                "scheduler.poll_s".into(),
+                format!("is {}: give seconds above 0, at most 3600", self.poll_s),
+            ));
+        }
+        for (key, value) in [("partition", &self.partition), ("account", &self.account)] {
+            if let Some(v) = value
+                && (v.is_empty() || v.chars().any(|c| c.is_whitespace() || c == '\0'))
+            {
+                return Err((
+                    format!("scheduler.{key}"),
+                    format!("is `{v}`: it must be one word"),
+                ));
+            }
+        }
+        if let Some(a) = self.sbatch_args.iter().find(|a| a.contains('\0')) {
+            return Err((
+                "scheduler.sbatch_args".into(),
+                format!("has a NUL byte in `{}`", a.escape_default()),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Slurm's time forms: "M", "M:S", "H:M:S", "D-H", "D-H:M", "D-H:M:S" (whole numbers).
+fn valid_time_limit(t: &str) -> bool {
+    let numbers = |s: &str, most: usize| {
+        let parts: Vec<&str> = s.split(':').collect();
+        parts.len() <= most
+            && parts
+                .iter()
+                .all(|p| !p.is_empty() && p.len() <= 9 && p.bytes().all(|b| b.is_ascii_digit()))
+    };
+    match t.split_once('-') {
+        Some((days, rest)) => numbers(days, 1) && numbers(rest, 3),
+        None => numbers(t, 3) && t != "0",
+    }
+}
+
+/// The batch job that measured a round (or failed to).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JobRecord {
+    /// The scheduler's job id.
+    pub id: String,
+    /// The node it ran on (its host name), when it started.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub node: Option<String>,
+    /// Its final state as the scheduler gave it (COMPLETED, FAILED, TIMEOUT, CANCELLED, ...),
+    /// when known.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub state: Option<String>,
+    /// Why the round has no samples: the job ended without a result.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub error: Option<JobError>,
+}
+
+/// A job that ended without a result, with the last lines of its output.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct JobError {
+    pub what: String,
+    pub output_tail: Vec<String>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slurm_time_forms_are_accepted_and_others_refused() {
+        for ok in ["30", "10:00", "1:00:00", "1-0", "2-12:30", "1-00:00:30"] {
+            assert!(valid_time_limit(ok), "{ok}");
+        }
+        for bad in [
+            "",
+            "0",
+            "1h",
+            "1:2:3:4",
+            "-1",
+            "1-",
+            "1-2:3:4:5",
+            "a:b",
+            "1.5",
+        ] {
+            assert!(!valid_time_limit(bad), "{bad}");
+        }
+    }
+}
