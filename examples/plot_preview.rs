@@ -224,7 +224,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         points: [0.2, 0.3, 0.5, 0.7, 1.0]
             .iter()
             .map(|&theta: &f64| ThetaPoint {
-                theta,
+                setting: format!("θ={theta}"),
                 seconds: scale * 0.02 / theta.powf(1.6),
                 error: 2e-3 * theta.powf(3.0),
             })
