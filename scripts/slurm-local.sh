@@ -23,20 +23,22 @@ die() {
     exit 2
 }
 
-# Stops the daemons started in $1 and removes it.
+# Stops the daemons started in $1, waits until they are gone (up to 10 s) and removes $1.
 cleanup() {
-    local dir=$1
-    [ -f "$dir/slurm.conf" ] && SLURM_CONF="$dir/slurm.conf" scontrol shutdown >/dev/null 2>&1 || true
+    local dir=$1 pids=() pid
     for pidfile in "$dir/slurmd.pid" "$dir/slurmctld.pid" "$dir/munged.pid"; do
         if [ -f "$pidfile" ]; then
-            kill "$(cat "$pidfile")" 2>/dev/null || true
+            pids+=("$(cat "$pidfile")")
         fi
     done
-    # The daemons take a moment to go; their sockets and pid files are in $dir.
-    for _ in $(seq 50); do
+    [ -f "$dir/slurm.conf" ] && SLURM_CONF="$dir/slurm.conf" scontrol shutdown >/dev/null 2>&1 || true
+    for pid in ${pids[@]+"${pids[@]}"}; do
+        kill "$pid" 2>/dev/null || true
+    done
+    for _ in $(seq 100); do
         local alive=0
-        for pidfile in "$dir"/*.pid; do
-            [ -f "$pidfile" ] && kill -0 "$(cat "$pidfile")" 2>/dev/null && alive=1
+        for pid in ${pids[@]+"${pids[@]}"}; do
+            kill -0 "$pid" 2>/dev/null && alive=1
         done
         [ "$alive" = 0 ] && break
         sleep 0.1
@@ -83,6 +85,7 @@ if pgrep -x slurmctld >/dev/null || pgrep -x slurmd >/dev/null; then
     die "a Slurm daemon is already running on this machine; stop it first (scripts/slurm-local.sh --stop DIR for one this script left running)"
 fi
 
+# The daemons talk over the loopback address, whether or not the host name resolves.
 dir=$(mktemp -d /tmp/slurm-local.XXXXXX)
 # Whatever fails from here on leaves nothing running and nothing behind.
 trap 'cleanup "$dir"' EXIT
@@ -108,7 +111,7 @@ ln -s "$dir/munge/munged.pid" "$dir/munged.pid"
 mkdir -p "$dir/state" "$dir/spool"
 cat >"$dir/slurm.conf" <<EOF
 ClusterName=local
-SlurmctldHost=$host
+SlurmctldHost=$host(127.0.0.1)
 SlurmUser=root
 AuthType=auth/munge
 AuthInfo=socket=$dir/munge-socket/munge.socket
@@ -130,7 +133,7 @@ ReturnToService=2
 MpiDefault=none
 MinJobAge=600
 SlurmdParameters=config_overrides
-NodeName=$host CPUs=$cpus State=UNKNOWN
+NodeName=$host NodeAddr=127.0.0.1 CPUs=$cpus State=UNKNOWN
 PartitionName=local Nodes=$host Default=YES MaxTime=INFINITE State=UP
 EOF
 export SLURM_CONF="$dir/slurm.conf"
