@@ -60,6 +60,22 @@ impl Point {
         self.threads * self.ranks
     }
 
+    /// For a member of the external family `series` (a series named after the family, not
+    /// after this case's program), its setting: the program's name without the family's
+    /// ("eps1e-2" of "fmm3d-eps1e-2"), or the whole name; `None` when the case is the series'
+    /// own code.
+    pub(crate) fn family_setting(&self, series: &str) -> Option<String> {
+        let name = self.case.kernel.name();
+        if name == series {
+            return None;
+        }
+        let short = name
+            .strip_prefix(series)
+            .map(|s| s.trim_start_matches(['-', '_', '.']))
+            .filter(|s| !s.is_empty());
+        Some(short.unwrap_or(name).to_string())
+    }
+
     /// Whether this case ran with `p` workers, `p` as a fit gives it back (a float).
     pub(crate) fn has_workers(&self, p: f64) -> bool {
         p.is_finite() && p >= 0.0 && self.p() == p.round() as usize

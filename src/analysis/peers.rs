@@ -279,12 +279,8 @@ impl Settings {
 /// A case's setting within its code: "θ=0.5 quadrupole", "θ=0.4 order 6", or a family
 /// member's name without the family's ("eps1e-2" of "fmm3d-eps1e-2").
 fn setting(p: &Point, code: &str) -> String {
-    let name = p.case.kernel.name();
-    if name != code {
-        let short = name
-            .strip_prefix(code)
-            .map(|s| s.trim_start_matches(['-', '_', '.']));
-        return short.filter(|s| !s.is_empty()).unwrap_or(name).to_string();
+    if let Some(member) = p.family_setting(code) {
+        return member;
     }
     let mut parts = Vec::new();
     if let Some(t) = p.theta {

@@ -90,9 +90,7 @@ impl WriterLock {
                 file,
                 "pid {} on {}, since {}",
                 std::process::id(),
-                fs::read_to_string("/etc/hostname")
-                    .map(|h| h.trim().to_string())
-                    .unwrap_or_else(|_| "this host".into()),
+                crate::records::results::host_name().unwrap_or_else(|| "this host".into()),
                 crate::records::results::utc_now()
             );
             return Ok(WriterLock { path, file });

@@ -28,8 +28,6 @@ use thiserror::Error;
 const CALL_LIMIT: Duration = Duration::from_secs(120);
 /// Failed looks at the queue in a row before the sweep gives up on it (it can be resumed).
 const QUEUE_FAILURES: usize = 5;
-/// Lines of a job's output kept with a round it did not measure.
-const TAIL_LINES: usize = 20;
 
 #[derive(Debug, Error)]
 pub enum SlurmError {
@@ -55,9 +53,7 @@ pub enum SlurmError {
 #[derive(Serialize, Deserialize)]
 pub(crate) struct Task {
     pub config: SweepConfig,
-    pub config_dir: PathBuf,
-    pub nbody_bench: PathBuf,
-    pub work_root: PathBuf,
+    pub context: Context,
     pub work: Work,
 }
 
@@ -97,18 +93,8 @@ impl Task {
     pub(crate) fn new(config: &SweepConfig, context: &Context, work: Work) -> Task {
         Task {
             config: config.clone(),
-            config_dir: context.config_dir.clone(),
-            nbody_bench: context.nbody_bench.clone(),
-            work_root: context.work_root.clone(),
+            context: context.clone(),
             work,
-        }
-    }
-
-    fn context(&self) -> Context {
-        Context {
-            config_dir: self.config_dir.clone(),
-            nbody_bench: self.nbody_bench.clone(),
-            work_root: self.work_root.clone(),
         }
     }
 }
@@ -165,7 +151,7 @@ pub(crate) fn run(
                 "job {id} ended {} without a result",
                 state.as_deref().unwrap_or("(state unknown)")
             ),
-            output_tail: tail(&dir.join("job.out")),
+            output_tail: super::external::process::last_lines_of(&dir.join("job.out")),
         }),
     };
     Ok(Ended {
@@ -200,7 +186,7 @@ fn submit(
     let script = format!(
         "#!/bin/sh\n# Written by nbody-bench: {what}. Submitted with sbatch; runs on the compute \
          node and writes result.json here.\nexec {} job {}\n",
-        shell_quote(&task.nbody_bench.display().to_string()),
+        shell_quote(&task.context.nbody_bench.display().to_string()),
         shell_quote(&dir.display().to_string())
     );
     write(&dir.join("job.sh"), script.as_bytes())?;
@@ -320,7 +306,7 @@ pub fn job_main(dir: &Path) -> Result<(), Box<dyn std::error::Error + Send + Syn
         Work::Round { case, spec } => {
             let clock = crate::clock::WallClock::new();
             let outcome =
-                super::case_round::measure_case(case, spec, &clock, &task.config, &task.context())?;
+                super::case_round::measure_case(case, spec, &clock, &task.config, &task.context)?;
             JobResult {
                 node,
                 step_ns: outcome.step_ns.clone(),
@@ -344,9 +330,8 @@ pub fn job_main(dir: &Path) -> Result<(), Box<dyn std::error::Error + Send + Syn
 fn node_name() -> Option<String> {
     std::env::var("SLURMD_NODENAME")
         .ok()
-        .or_else(|| std::fs::read_to_string("/proc/sys/kernel/hostname").ok())
-        .map(|s| s.trim().to_string())
-        .filter(|s| !s.is_empty())
+        .filter(|s| !s.trim().is_empty())
+        .or_else(crate::records::results::host_name)
 }
 
 /// A round that no job measured: no samples, the job's record.
@@ -396,14 +381,6 @@ fn write(path: &Path, bytes: &[u8]) -> Result<(), SlurmError> {
         path: path.into(),
         detail: e.to_string(),
     })
-}
-
-fn tail(path: &Path) -> Vec<String> {
-    let text = std::fs::read(path)
-        .map(|b| String::from_utf8_lossy(&b).into_owned())
-        .unwrap_or_else(|e| format!("(no output: {e})"));
-    let lines: Vec<String> = text.lines().map(str::to_string).collect();
-    lines[lines.len().saturating_sub(TAIL_LINES)..].to_vec()
 }
 
 fn last_line(bytes: &[u8]) -> Option<String> {

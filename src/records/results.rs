@@ -8,7 +8,7 @@ use super::vet::Rejected;
 use crate::calibrate::Calibration;
 use crate::engine::PhaseTimes;
 use crate::kernels::WorkCounters;
-pub use crate::output::provenance::{git_state, utc_now};
+pub use crate::output::provenance::{git_state, host_name, utc_now};
 use crate::stats::{
     BOOTSTRAP_RESAMPLES, StepHistogram, StepPercentiles, bootstrap_median_ci, mad, median,
 };
@@ -407,9 +407,7 @@ impl Metadata {
                 "release"
             }
             .to_string(),
-            host: std::fs::read_to_string("/etc/hostname")
-                .map(|h| h.trim().to_string())
-                .unwrap_or_else(|_| "unknown".into()),
+            host: host_name().unwrap_or_else(|| "unknown".into()),
             os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
             started: utc_now(),
             externals: Vec::new(),

@@ -298,15 +298,8 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
 /// family (the series named after the family) its program's name without the family's
 /// prefix ("eps1e-2" of "fmm3d-eps1e-2"); `None` for a θ series point without a θ.
 fn setting_label(p: &Point, series: &KernelOrProgram) -> Option<String> {
-    if p.case.kernel != *series {
-        let name = p.case.kernel.name();
-        let short = name
-            .strip_prefix(series.name())
-            .map(|s| s.trim_start_matches(['-', '_', '.']))
-            .filter(|s| !s.is_empty());
-        return Some(short.unwrap_or(name).to_string());
-    }
-    Some(format!("θ={}", p.theta?))
+    p.family_setting(series.name())
+        .or_else(|| Some(format!("θ={}", p.theta?)))
 }
 
 /// "octree θ=0.5 p=2 n=16384" — short enough for a category axis: the case key (whose form

@@ -46,8 +46,9 @@ pub enum ExternalError {
     },
 }
 
-/// Where externals find the sweep: the config's directory and this program.
-#[derive(Clone, Debug)]
+/// Where externals find the sweep: the config's directory and this program (a batch job
+/// reads it from its task file).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Context {
     pub config_dir: PathBuf,
     pub nbody_bench: PathBuf,

@@ -206,6 +206,12 @@ pub fn resolve(program: &str, path: Option<&str>) -> Result<PathBuf, String> {
         })
 }
 
+/// The last [`TAIL_LINES`] lines of the output written to `path` (none if it cannot be read),
+/// read as a run's output is: at most [`MAX_OUTPUT_BYTES`] from the start, and its end.
+pub(crate) fn last_lines_of(path: &Path) -> Vec<String> {
+    Output::read(path).last_lines()
+}
+
 /// One output stream of a finished run: its text up to [`MAX_OUTPUT_BYTES`], and its size.
 #[derive(Debug, Default)]
 pub struct Output {

@@ -32,6 +32,15 @@ pub fn git_state() -> (String, bool) {
     }
 }
 
+/// This machine's host name (`/etc/hostname`), as results, the writer lock and batch jobs name
+/// it; `None` when it cannot be read.
+pub fn host_name() -> Option<String> {
+    std::fs::read_to_string("/etc/hostname")
+        .ok()
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+}
+
 /// The current UTC time as `YYYY-MM-DDTHH:MM:SSZ`.
 pub fn utc_now() -> String {
     let secs = std::time::SystemTime::now()
