@@ -7,6 +7,7 @@ use crate::decomp::Decomposition;
 use crate::engine::PhaseTimes;
 use crate::kernels::{KernelKind, Multipole};
 use crate::records::config::Study;
+use crate::records::external::{External, PhaseKind};
 use crate::records::kernel_or_program::KernelOrProgram;
 use crate::records::results::{CaseRecord, ResultsFile};
 use crate::scenario::{Precision, ScenarioKind};
@@ -30,7 +31,7 @@ pub struct Point {
     /// MPI decomposition of a case run under a launcher.
     pub decomp: Option<Decomposition>,
     /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases).
-    pub(crate) comm_s_per_step: Option<f64>,
+    pub comm_s_per_step: Option<f64>,
     pub(crate) bytes_per_step: Option<f64>,
     /// Of `comm_s_per_step`, the part left after the estimated wait for slower ranks: moving
     /// data and MPI overhead (MPI cases).
@@ -48,6 +49,9 @@ pub struct Point {
     pub ns_per_particle_step: f64,
     pub pair_evals_per_s: f64,
     pub phases: PhaseTimes,
+    /// The phases an external program timed itself (`phases`), in the config's order.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub named_phases: Vec<NamedPhase>,
     pub step_ns: StepPercentiles,
     pub force_error: Option<[f64; 2]>,
     pub max_energy_drift: f64,
@@ -80,6 +84,42 @@ impl Point {
     pub(crate) fn has_workers(&self, p: f64) -> bool {
         p.is_finite() && p >= 0.0 && self.p() == p.round() as usize
     }
+}
+
+/// A phase an external program timed: seconds per step, the mean over its successful runs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct NamedPhase {
+    pub name: String,
+    pub kind: PhaseKind,
+    pub s_per_step: f64,
+}
+
+/// The phases of an external case, per step, from every successful run of every round.
+fn named_phases(r: &CaseRecord, ext: Option<&External>) -> Vec<NamedPhase> {
+    let Some(ext) = ext else {
+        return Vec::new();
+    };
+    ext.phases
+        .iter()
+        .filter_map(|(name, source)| {
+            let per_step: Vec<f64> = r
+                .rounds
+                .iter()
+                .filter_map(|round| Some((round.external.as_ref()?, round.steps_per_sample)))
+                .flat_map(|(e, steps)| {
+                    e.runs
+                        .iter()
+                        .filter(|run| run.error.is_none())
+                        .filter_map(move |run| Some(run.phases.get(name)? / steps.max(1) as f64))
+                })
+                .collect();
+            (!per_step.is_empty()).then(|| NamedPhase {
+                name: name.clone(),
+                kind: source.kind,
+                s_per_step: per_step.iter().sum::<f64>() / per_step.len() as f64,
+            })
+        })
+        .collect()
 }
 
 /// What a series holds fixed. `None` fields vary along the series or do not apply.
@@ -177,6 +217,14 @@ pub struct Groups {
 
 /// Reads the complete cases of `results` into series.
 pub fn group(results: &ResultsFile) -> Groups {
+    let point = |r: &CaseRecord| {
+        let ext = results
+            .config
+            .external
+            .iter()
+            .find(|e| r.case.kernel.kernel().is_none() && e.name == r.case.kernel.name());
+        point(r, ext)
+    };
     let cases: Vec<Point> = results.cases.iter().filter_map(point).collect();
     let weak = results.config.study == Study::Weak;
     let base = |c: &Point, r: &CaseRecord| SeriesKey {
@@ -288,12 +336,20 @@ fn precision_of(r: &CaseRecord) -> Precision {
         .unwrap_or(r.case.scenario.defaults().precision)
 }
 
-/// The analysis view of a complete case; `None` for a case still being measured.
-fn point(r: &CaseRecord) -> Option<Point> {
+/// The analysis view of a complete case (`ext`: its program's entry, for an external one);
+/// `None` for a case still being measured.
+fn point(r: &CaseRecord, ext: Option<&External>) -> Option<Point> {
     let s = r.summary.as_ref()?;
     if !r.is_complete() || s.samples == 0 {
         return None;
     }
+    let named_phases = named_phases(r, ext);
+    // A program's own communication phases stand where an MPI driver's counted time does.
+    let own_comm = named_phases
+        .iter()
+        .filter(|p| p.kind == PhaseKind::Comm)
+        .map(|p| p.s_per_step)
+        .reduce(|a, b| a + b);
     Some(Point {
         case: r.case.clone(),
         key: r.key.clone(),
@@ -303,7 +359,7 @@ fn point(r: &CaseRecord) -> Option<Point> {
         time_factor: r.case.time_factor,
         theta: r.case.theta,
         decomp: r.case.decomp,
-        comm_s_per_step: mpi_mean(r, &|m| m.reduced.comm_s.mean),
+        comm_s_per_step: mpi_mean(r, &|m| m.reduced.comm_s.mean).or(own_comm),
         bytes_per_step: mpi_mean(r, &|m| m.reduced.bytes_sent.mean),
         transfer_s_per_step: mpi_mean(r, &|m| m.reduced.transfer_s.mean),
         compute_imbalance: {
@@ -325,6 +381,7 @@ fn point(r: &CaseRecord) -> Option<Point> {
         ns_per_particle_step: s.ns_per_particle_step,
         pair_evals_per_s: s.pair_evals_per_s,
         phases: s.phases,
+        named_phases,
         step_ns: s.step_ns,
         force_error: s.force_error,
         max_energy_drift: s.max_energy_drift,

@@ -17,6 +17,7 @@ use crate::fit::{
 };
 use crate::kernels::KernelKind;
 use crate::records::config::{Study, WeakRule};
+use crate::records::external::PhaseKind;
 use crate::records::kernel_or_program::KernelOrProgram;
 use crate::records::results::{Metadata, ResultsFile};
 use groups::{Groups, Point, Series, SeriesKey};
@@ -82,7 +83,7 @@ pub struct StrongAnalysis {
     pub fit: Fitted<StrongFit>,
     /// The serial fraction from the one-worker case's phase timers (the Barnes-Hut report's method),
     /// and how it compares with the fitted one.
-    pub(crate) timed_serial: Option<TimedSerialFraction>,
+    pub timed_serial: Option<TimedSerialFraction>,
     pub(crate) serial_comparison: Option<SerialFractionComparison>,
 }
 
@@ -303,6 +304,59 @@ fn parallel_interaction(kernel: KernelKind) -> bool {
     !matches!(kernel, KernelKind::Symmetric)
 }
 
+fn kernel_of(s: &Series) -> Option<KernelKind> {
+    s.key.kernel.kernel()
+}
+
+/// The serial fraction of a built-in kernel's one-worker case from its phase timers.
+fn engine_serial_fraction(
+    one: &Point,
+    kernel: KernelKind,
+    dim: usize,
+) -> Option<fit::TimedSerialFraction> {
+    let ph = &one.phases;
+    // Which phases ran on the pool's threads: the per-particle passes (kick, drift, walls)
+    // and the cell and Verlet lists' binning fork from a size on; the interactions of
+    // every kernel but `symmetric` do.
+    let passes_fork = one.n * dim >= crate::par::MIN_FORK_ELEMENTS;
+    let build_forks = passes_fork && kernel.parallel_build();
+    let (mut serial, mut parallel) = (vec![ph.output], vec![]);
+    let mut put = |t: f64, forks: bool| {
+        if forks {
+            parallel.push(t)
+        } else {
+            serial.push(t)
+        }
+    };
+    put(ph.force_interact, parallel_interaction(kernel));
+    put(ph.force_build, build_forks);
+    put(ph.integrate, passes_fork);
+    put(ph.boundary, passes_fork);
+    fit::timed_serial_fraction(&serial, &parallel).ok()
+}
+
+/// The serial fraction of an external program's one-worker case from the phases it timed:
+/// its `serial` phases against the rest (communication counts as parallel work); a program
+/// that times only its serial phases has the rest of its step time as the parallel part.
+fn external_serial_fraction(one: &Point) -> Option<fit::TimedSerialFraction> {
+    let of = |keep: &dyn Fn(PhaseKind) -> bool| -> Vec<f64> {
+        one.named_phases
+            .iter()
+            .filter(|p| keep(p.kind))
+            .map(|p| p.s_per_step)
+            .collect()
+    };
+    let serial = of(&|k| k == PhaseKind::Serial);
+    if serial.is_empty() {
+        return None;
+    }
+    let mut parallel = of(&|k| k != PhaseKind::Serial);
+    if parallel.is_empty() {
+        parallel.push((one.median_s - serial.iter().sum::<f64>()).max(0.0));
+    }
+    fit::timed_serial_fraction(&serial, &parallel).ok()
+}
+
 fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
     let real: Vec<Point> = s
         .points
@@ -340,33 +394,11 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
             .map(|f| f.points.clone())
             .unwrap_or_default(),
     };
-    // An external program has no phase timers: no timed serial fraction.
-    let kernel = s.key.kernel.kernel();
-    let one = s
-        .points
-        .iter()
-        .find(|p| p.p() == 1)
-        .filter(|_| kernel.is_some());
-    let timed_serial = one.and_then(|one| {
-        let ph = &one.phases;
-        // Which phases ran on the pool's threads: the per-particle passes (kick, drift, walls)
-        // and the cell and Verlet lists' binning fork from a size on; the interactions of
-        // every kernel but `symmetric` do.
-        let passes_fork = one.n * s.key.scenario.dim() >= crate::par::MIN_FORK_ELEMENTS;
-        let build_forks = passes_fork && kernel.is_some_and(KernelKind::parallel_build);
-        let (mut serial, mut parallel) = (vec![ph.output], vec![]);
-        let mut put = |t: f64, forks: bool| {
-            if forks {
-                parallel.push(t)
-            } else {
-                serial.push(t)
-            }
-        };
-        put(ph.force_interact, kernel.is_some_and(parallel_interaction));
-        put(ph.force_build, build_forks);
-        put(ph.integrate, passes_fork);
-        put(ph.boundary, passes_fork);
-        fit::timed_serial_fraction(&serial, &parallel).ok()
+    let one = s.points.iter().find(|p| p.p() == 1);
+    let timed_serial = one.and_then(|one| match kernel_of(s) {
+        Some(kernel) => engine_serial_fraction(one, kernel, s.key.scenario.dim()),
+        // An external program's serial fraction comes from the phases it timed, if any.
+        None => external_serial_fraction(one),
     });
     let serial_comparison = match (&timed_serial, &fit.fit) {
         (Some(t), Some(f)) => Some(fit::compare_serial_fractions(t, &f.serial_fraction)),

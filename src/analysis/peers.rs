@@ -403,6 +403,7 @@ mod tests {
             ns_per_particle_step: median_s * 1e9 / n as f64,
             pair_evals_per_s: 0.0,
             phases: Default::default(),
+            named_phases: Vec::new(),
             step_ns: Default::default(),
             force_error: None,
             max_energy_drift: 0.0,

@@ -128,6 +128,7 @@ time = { regex = 'took ([0-9.]+)', unit = "ms" }
 check = 'done'
 force_error = 'error ([^ ]+) ([^ ]+)'
 family = "other"
+phases = { comm = { regex = 'phase comm ([0-9.eE+-]+)', unit = "s", kind = "comm" } }
 env = { OMP_NUM_THREADS = "{threads}" }
 version = ["other", "--version"]
 empty = ["other", "--empty"]
@@ -221,6 +222,9 @@ fn meaning(key: &str) -> Option<&'static str> {
         "external.family" => {
             "entries of one family are one code at several accuracy settings: their cases form one series of force error against cost, like a θ sweep"
         }
+        "external.phases" => {
+            "phases the program times itself, each the first group of the last match in its output (its total over the run): a phase table and figure, the Amdahl serial fraction from its serial phases, its communication share; a run whose output lacks one is an error"
+        }
         "external.env" => "environment variables set for the program (values with placeholders)",
         "external.version" => {
             "a command whose first line of output names the program's version (results metadata)"
@@ -257,6 +261,9 @@ fn external_forms(key: &str) -> Option<&'static str> {
         }
         "external.family" => {
             "a plain name shared by the entries, such as family = \"fmm3d\"; needs force_error"
+        }
+        "external.phases" => {
+            "a table of phases by name, each { regex, unit = \"s\" | \"ms\" | \"us\" | \"ns\", kind = \"parallel\" (default) | \"serial\" | \"comm\" }, such as phases = { comm = { regex = 'phase comm ([0-9.]+)', unit = \"s\", kind = \"comm\" } }"
         }
         "external.env" => "a table of strings, such as env = { OMP_NUM_THREADS = \"{threads}\" }",
         "external.timeout_s" => "seconds above 0, at most 7 days, such as timeout_s = 600",

@@ -34,9 +34,8 @@ pub(crate) use power::crossover;
 pub use power::{ComplexityClass, PowerFit, fit_power};
 pub(crate) use strong::StrongPoint;
 pub use strong::{StrongFit, fit_strong};
-pub(crate) use timed::{
-    SerialFractionComparison, TimedSerialFraction, compare_serial_fractions, timed_serial_fraction,
-};
+pub use timed::TimedSerialFraction;
+pub(crate) use timed::{SerialFractionComparison, compare_serial_fractions, timed_serial_fraction};
 pub(crate) use weak::{EfficiencyPoint, WeakSamples};
 pub use weak::{WeakFit, fit_weak, fit_weak_with_n};
 

@@ -9,7 +9,7 @@ use serde::Serialize;
 
 /// `f_timed = Σ serial / (Σ serial + Σ parallelisable)` of a one-worker run.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
-pub(crate) struct TimedSerialFraction {
+pub struct TimedSerialFraction {
     pub(crate) serial_s: f64,
     pub(crate) parallel_s: f64,
     pub total_s: f64,

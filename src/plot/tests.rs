@@ -305,11 +305,13 @@ fn bar_figures_render_for_every_input() {
     let dir = tempfile::tempdir().unwrap();
     let phase = |case: &str, v: f64| PhaseTimes {
         case: case.into(),
-        build: v,
-        interact: 10.0 * v,
-        integrate: v,
-        boundary: f64::NAN,
-        communication: -v,
+        phases: vec![
+            ("force: build".into(), v),
+            ("force: interact".into(), 10.0 * v),
+            ("integrate".into(), v),
+            ("boundary".into(), f64::NAN),
+            ("communication".into(), -v),
+        ],
     };
     let long = "lj-box/cell-list/n=100000/p=2/with/a/very/long/name/indeed";
     let bar_cases = [

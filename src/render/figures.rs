@@ -226,11 +226,7 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
             .iter()
             .map(|c| PhaseTimes {
                 case: case_label(c),
-                build: c.phases.force_build,
-                interact: c.phases.force_interact,
-                integrate: c.phases.integrate,
-                boundary: c.phases.boundary,
-                communication: c.comm_s_per_step.unwrap_or(0.0),
+                phases: phase_list(c),
             })
             .collect();
         let mut bars = fig::phase_breakdown(&phases, &cap);
@@ -378,4 +374,27 @@ fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
     let mut series = KernelSeries::new(s.label.clone(), measured);
     series.fit = Some(curve);
     series
+}
+
+/// A case's phases for the bars: an external program's own, else the engine's timers and the
+/// MPI drivers' communication.
+fn phase_list(c: &Point) -> Vec<(String, f64)> {
+    if !c.named_phases.is_empty() {
+        return c
+            .named_phases
+            .iter()
+            .map(|p| (p.name.clone(), p.s_per_step))
+            .collect();
+    }
+    let ph = &c.phases;
+    [
+        ("force: build", ph.force_build),
+        ("force: interact", ph.force_interact),
+        ("integrate", ph.integrate),
+        ("boundary", ph.boundary),
+        ("communication", c.comm_s_per_step.unwrap_or(0.0)),
+    ]
+    .into_iter()
+    .map(|(name, s)| (name.to_string(), s))
+    .collect()
 }

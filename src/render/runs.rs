@@ -2,9 +2,12 @@
 //! sweep's config (as the results file keeps it) and the cases it measured, never from what a
 //! config is expected to hold: a comparison names exactly what it compares against.
 
+use super::tables;
 use crate::analysis::Analysis;
+use crate::analysis::groups::Point;
 use crate::records::external::config::TimeUnit;
 use crate::records::external::{External, TimeSource};
+use crate::units::{Duration, Percent};
 use std::fmt::Write;
 
 /// A Markdown list with one item per external program of the sweep: its version, command line
@@ -115,6 +118,78 @@ fn code(text: &str) -> String {
     } else {
         format!("`{text}`")
     }
+}
+
+/// The phases external programs timed themselves, case by case: each phase per step with its
+/// share of the step, then the serial and the communication shares. Empty when no case has any.
+pub fn external_phases(a: &Analysis) -> String {
+    use crate::records::external::PhaseKind;
+    let cases: Vec<&Point> = a
+        .cases
+        .iter()
+        .filter(|c| !c.named_phases.is_empty())
+        .collect();
+    if cases.is_empty() {
+        return String::new();
+    }
+    let mut t = tables::Table::new([
+        "scenario",
+        "case",
+        "time per step",
+        "phases per step (share of the step)",
+        "serial share",
+        "communication share",
+    ])
+    .aligned([
+        tables::Align::Default,
+        tables::Align::Default,
+        tables::Align::Right,
+        tables::Align::Default,
+        tables::Align::Right,
+        tables::Align::Right,
+    ]);
+    for c in cases {
+        let step = c.median_s.max(f64::MIN_POSITIVE);
+        let share_of = |kind: PhaseKind| -> Option<f64> {
+            let of: Vec<f64> = c
+                .named_phases
+                .iter()
+                .filter(|p| p.kind == kind)
+                .map(|p| p.s_per_step)
+                .collect();
+            (!of.is_empty()).then(|| of.iter().sum::<f64>() / step)
+        };
+        let phases: Vec<String> = c
+            .named_phases
+            .iter()
+            .map(|p| {
+                let kind = match p.kind {
+                    PhaseKind::Parallel => String::new(),
+                    k => format!(" ({})", k.name()),
+                };
+                format!(
+                    "{}{kind}: {} ({})",
+                    p.name,
+                    Duration(p.s_per_step),
+                    Percent(p.s_per_step / step)
+                )
+            })
+            .collect();
+        let share = |s: Option<f64>| s.map_or(tables::NONE.to_string(), |s| Percent(s).to_string());
+        t.row([
+            c.case.scenario.name().to_string(),
+            format!(
+                "{}{}",
+                crate::render::figures::case_label(c),
+                tables::over(c.oversubscribed)
+            ),
+            Duration(c.median_s).to_string(),
+            phases.join("<br>"),
+            share(share_of(PhaseKind::Serial)),
+            share(share_of(PhaseKind::Comm)),
+        ]);
+    }
+    t.markdown()
 }
 
 #[cfg(test)]

@@ -53,6 +53,15 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             tables::weak(a)
         );
     }
+    let phases = super::runs::external_phases(a);
+    if !phases.is_empty() {
+        let _ = writeln!(
+            md,
+            "## Phases the programs timed\n\nEach program's own phase times (`phases` in its \
+             [[external]] entry), per step; shares are of the median step time. \
+             * = oversubscribed.\n\n{phases}"
+        );
+    }
     if !a.theta.is_empty() {
         let _ = writeln!(md, "## Octree accuracy vs cost\n\n{}", tables::theta(a));
     }

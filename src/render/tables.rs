@@ -95,7 +95,7 @@ fn line(cells: &[String]) -> String {
 }
 
 /// What a cell shows when there is no value.
-const NONE: &str = "–";
+pub(crate) const NONE: &str = "–";
 
 /// The marker of a case that ran more workers (threads or ranks) than logical CPUs.
 pub fn over(oversubscribed: bool) -> &'static str {

@@ -29,7 +29,7 @@ esac
 "#;
 
 /// A temporary directory holding the program (`{config_dir}/prog`).
-fn program_dir() -> tempfile::TempDir {
+pub(crate) fn program_dir() -> tempfile::TempDir {
     use std::os::unix::fs::PermissionsExt;
     let dir = tempfile::tempdir().unwrap();
     let prog = dir.path().join("prog");
@@ -38,7 +38,7 @@ fn program_dir() -> tempfile::TempDir {
     dir
 }
 
-fn options(dir: &Path) -> SweepOptions {
+pub(crate) fn options(dir: &Path) -> SweepOptions {
     SweepOptions {
         out: Some(dir.join("out")),
         config_dir: Some(dir.to_path_buf()),
@@ -47,14 +47,14 @@ fn options(dir: &Path) -> SweepOptions {
     }
 }
 
-fn sweep(text: &str, dir: &Path) -> ResultsFile {
+pub(crate) fn sweep(text: &str, dir: &Path) -> ResultsFile {
     let config = SweepConfig::parse(text, Path::new("ext.toml")).unwrap();
     let clock = MockClock::new(Duration::from_millis(1));
     let report = run_sweep(&config, text, &options(dir), &clock, &mut Silent).unwrap();
     ResultsFile::load(&report.path).unwrap()
 }
 
-const HEAD: &str = r#"
+pub(crate) const HEAD: &str = r#"
 name = "ext"
 study = "cartesian"
 scenarios = ["lj-box"]
@@ -62,7 +62,7 @@ n = [50]
 "#;
 
 /// The `[measure]` table, after the `[[external]]` entries.
-const MEASURE: &str = r#"
+pub(crate) const MEASURE: &str = r#"
 [measure]
 warmup_s = 0.002
 samples = 3
@@ -70,7 +70,10 @@ rounds = 2
 min_sample_s = 0.002
 "#;
 
-fn record<'a>(r: &'a ResultsFile, key: &str) -> &'a nbody_bench::records::results::CaseRecord {
+pub(crate) fn record<'a>(
+    r: &'a ResultsFile,
+    key: &str,
+) -> &'a nbody_bench::records::results::CaseRecord {
     r.cases.iter().find(|c| c.key == key).unwrap_or_else(|| {
         panic!(
             "no case {key} in {:?}",
@@ -474,6 +477,18 @@ fn bad_external_configs_are_refused_before_anything_runs() {
             "at least 1",
         ),
         (format!("{base}command = [\"p\"]\nfamily = \"f\""), "give `force_error` too"),
+        (
+            format!("{base}command = [\"p\"]\nphases = {{ comm = {{ regex = 'comm', unit = \"s\" }} }}"),
+            "`external.x.phases.comm.regex` needs a group",
+        ),
+        (
+            format!("{base}command = [\"p\"]\nphases = {{ c = {{ regex = 'c (.+)', unit = \"s\", kind = \"io\" }} }}"),
+            "unknown variant `io`",
+        ),
+        (
+            format!("{base}command = [\"p\"]\nphases = {{ \"a b\" = {{ regex = 'c (.+)', unit = \"s\" }} }}"),
+            "phase named `a b`",
+        ),
         (
             format!("{base}command = [\"p\"]\nforce_error = 'e (.+)'\nfamily = \"a b\""),
             "it must be letters",

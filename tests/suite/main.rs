@@ -16,6 +16,7 @@ mod docs;
 mod dry_run;
 mod export;
 mod external;
+mod external_phases;
 mod fit_cli;
 mod gate;
 mod gate_refusals;

@@ -13,6 +13,7 @@ use crate::records::plan::Case;
 use crate::records::round::RoundOutcome;
 use crate::stats::median;
 use regex::Regex;
+use std::collections::BTreeMap;
 use std::path::Path;
 
 /// Empty runs whose median is the launch overhead.
@@ -142,16 +143,22 @@ pub(crate) fn measure_round(
         TimeSource::Wall(_) => None,
     };
     let error = ext.force_error.as_deref().map(compile).transpose()?;
-    let reads_output = check.is_some() || time.is_some() || error.is_some();
+    let phases = ext
+        .phases
+        .iter()
+        .map(|(name, p)| Ok((name.as_str(), compile(&p.regex)?, p.unit.seconds())))
+        .collect::<Result<Vec<_>, ExternalError>>()?;
+    let reads_output = check.is_some() || time.is_some() || error.is_some() || !phases.is_empty();
     for _ in 0..spec.samples {
         let run = match checked_run(&main, &dir, ext.timeout_s, check.as_ref(), reads_output) {
             Err(e) => ExternalRun {
                 wall_s: e.wall_s,
                 reported_s: None,
                 force_error: None,
+                phases: BTreeMap::new(),
                 error: Some(e.error),
             },
-            Ok(done) => sample(&main, &done, time.as_ref(), error.as_ref()),
+            Ok(done) => sample(&main, &done, time.as_ref(), error.as_ref(), &phases),
         };
         round.runs.push(run);
     }
@@ -227,18 +234,20 @@ fn checked_run(
     }
 }
 
-/// The sample of a successful run: its time (wall, or the last match of the time regex) and
-/// the force error it printed.
+/// The sample of a successful run: its time (wall, or the last match of the time regex), the
+/// force error and the phase times it printed.
 fn sample(
     launch: &Launch,
     done: &Finished,
     time: Option<&(Regex, f64)>,
     error: Option<&Regex>,
+    phases: &[(&str, Regex, f64)],
 ) -> ExternalRun {
     let fail = |what: String| ExternalRun {
         wall_s: done.wall_s,
         reported_s: None,
         force_error: None,
+        phases: BTreeMap::new(),
         error: Some(SampleError {
             what,
             command: launch.display(),
@@ -301,10 +310,36 @@ fn sample(
             }
         },
     };
+    let mut phase_s = BTreeMap::new();
+    for (name, re, unit) in phases {
+        let t = match last_number(re, done) {
+            // A phase the run did not enter (no output written, say) takes no time.
+            Some(Ok(t)) if t.is_finite() && t >= 0.0 => t * unit,
+            Some(Ok(t)) => {
+                return fail(format!(
+                    "it printed the phase `{name}` as {t}, not a duration"
+                ));
+            }
+            Some(Err(text)) => {
+                return fail(format!(
+                    "the phase `{name}` regex `{}` matched `{text}`, which is not a number",
+                    re.as_str()
+                ));
+            }
+            None => {
+                return fail(format!(
+                    "its output does not match the phase `{name}` regex `{}`",
+                    re.as_str()
+                ));
+            }
+        };
+        phase_s.insert(name.to_string(), t);
+    }
     ExternalRun {
         wall_s: done.wall_s,
         reported_s,
         force_error,
+        phases: phase_s,
         error: None,
     }
 }

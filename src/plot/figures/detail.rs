@@ -6,34 +6,40 @@ use crate::plot::spec::{
     Axis, Band, Chart, Point, Region, Scale, Series, SeriesStyle, StackedBars, Unit,
 };
 
-/// Seconds per step spent in each phase of one case.
+/// Seconds per step spent in each phase of one case, phases named.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PhaseTimes {
     pub case: String,
-    pub build: f64,
-    pub interact: f64,
-    pub integrate: f64,
-    pub boundary: f64,
-    pub communication: f64,
+    pub phases: Vec<(String, f64)>,
 }
 
-/// One horizontal bar per case, split into phases; phases that are zero everywhere are left
-/// out of the legend.
+/// One horizontal bar per case, split into phases: every phase name any case has, in order of
+/// first appearance (a case without it has none of that time).
 pub fn phase_breakdown(cases: &[PhaseTimes], caption: &str) -> StackedBars {
-    let column = |f: fn(&PhaseTimes) -> f64| cases.iter().map(f).collect::<Vec<f64>>();
+    let mut names: Vec<&str> = Vec::new();
+    for (name, _) in cases.iter().flat_map(|c| &c.phases) {
+        if !names.contains(&name.as_str()) {
+            names.push(name);
+        }
+    }
+    let column = |name: &str| -> Vec<f64> {
+        cases
+            .iter()
+            .map(|c| {
+                c.phases
+                    .iter()
+                    .find(|(n, _)| n == name)
+                    .map_or(0.0, |(_, v)| *v)
+            })
+            .collect()
+    };
     StackedBars {
         title: "Where a step's time goes".into(),
         caption: caption.into(),
         value_label: "time per step".into(),
         value_unit: Unit::Seconds,
         categories: cases.iter().map(|c| c.case.clone()).collect(),
-        segments: vec![
-            ("force: build".into(), column(|c| c.build)),
-            ("force: interact".into(), column(|c| c.interact)),
-            ("integrate".into(), column(|c| c.integrate)),
-            ("boundary".into(), column(|c| c.boundary)),
-            ("communication".into(), column(|c| c.communication)),
-        ],
+        segments: names.iter().map(|n| (n.to_string(), column(n))).collect(),
     }
 }
 
@@ -237,15 +243,25 @@ mod tests {
     fn phases_keep_case_order() {
         let case = |name: &str, interact| PhaseTimes {
             case: name.into(),
-            build: 0.0,
-            interact,
-            integrate: 1e-5,
-            boundary: 0.0,
-            communication: 0.0,
+            phases: vec![
+                ("build".into(), 0.0),
+                ("interact".into(), interact),
+                ("integrate".into(), 1e-5),
+            ],
         };
         let bars = phase_breakdown(&[case("a", 1e-3), case("b", 2e-3)], "");
         assert_eq!(bars.categories, ["a", "b"]);
         assert_eq!(bars.segments[1].1, [1e-3, 2e-3]);
+        // A program's own phases join the legend after the others; cases without them get none.
+        let own = PhaseTimes {
+            case: "c".into(),
+            phases: vec![("comm".into(), 3e-3), ("interact".into(), 1e-3)],
+        };
+        let bars = phase_breakdown(&[case("a", 1e-3), own], "");
+        let names: Vec<&str> = bars.segments.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["build", "interact", "integrate", "comm"]);
+        assert_eq!(bars.segments[3].1, [0.0, 3e-3]);
+        assert_eq!(bars.segments[1].1, [1e-3, 1e-3]);
         let shares = phase_shares(&[case("a", 1e-3), case("b", 0.0)], "");
         let a: f64 = shares.segments.iter().map(|(_, v)| v[0]).sum();
         assert!((a - 1.0).abs() < 1e-12);

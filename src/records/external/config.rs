@@ -21,6 +21,12 @@ pub struct External {
     pub steps: u64,
     /// How a run is timed: `"wall"` or `{ regex, unit }` on its output.
     pub time: TimeSource,
+    /// Phases the program times itself, each found in its output like `time` (its total over
+    /// the run): `{ name = { regex, unit, kind } }`, names free. The kind says how the analysis
+    /// reads a phase: `parallel` (the default), `serial` (the Amdahl serial part) or `comm`
+    /// (communication, against the rest as computation). A run whose output lacks one is an error.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub phases: BTreeMap<String, PhaseSource>,
     /// A regular expression the output must match, else the sample is an error.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub check: Option<String>,
@@ -111,6 +117,51 @@ impl TimeUnit {
             TimeUnit::Us => 1e-6,
             TimeUnit::Ns => 1e-9,
         }
+    }
+}
+
+/// One phase an external program times and prints.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhaseSource {
+    /// Its first group is the phase's time over the whole run.
+    pub regex: String,
+    pub unit: TimeUnit,
+    #[serde(default)]
+    pub kind: PhaseKind,
+}
+
+/// How the analysis reads a phase of an external program.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PhaseKind {
+    /// Work the program spreads over its workers.
+    #[default]
+    Parallel,
+    /// Work done by one worker whatever the count: the timed Amdahl serial part.
+    Serial,
+    /// Communication between ranks; the other phases are computation.
+    Comm,
+}
+
+impl PhaseKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            PhaseKind::Parallel => "parallel",
+            PhaseKind::Serial => "serial",
+            PhaseKind::Comm => "comm",
+        }
+    }
+}
+
+/// A regex that is valid and has a group around the number; the problem otherwise.
+fn number_regex(re: &str, example: &str) -> Result<(), String> {
+    match regex::Regex::new(re) {
+        Err(e) => Err(format!("is not a regular expression: {e}")),
+        Ok(r) if r.captures_len() < 2 => {
+            Err(format!("needs a group around the number, e.g. '{example}'"))
+        }
+        Ok(_) => Ok(()),
     }
 }
 
@@ -233,16 +284,20 @@ impl External {
                 ),
             );
         }
-        if let TimeSource::Regex(t) = &self.time {
-            match regex::Regex::new(&t.regex) {
-                Err(e) => return bad("time.regex", format!("is not a regular expression: {e}")),
-                Ok(r) if r.captures_len() < 2 => {
-                    return bad(
-                        "time.regex",
-                        "needs a group around the number, e.g. 'Loop time of ([0-9.eE+-]+)'".into(),
-                    );
-                }
-                Ok(_) => {}
+        if let TimeSource::Regex(t) = &self.time
+            && let Err(e) = number_regex(&t.regex, "Loop time of ([0-9.eE+-]+)")
+        {
+            return bad("time.regex", e);
+        }
+        for (name, phase) in &self.phases {
+            if !plain_name(name) {
+                return bad(
+                    "phases",
+                    format!("has a phase named `{name}`: use letters, digits, '-', '_' and '.'"),
+                );
+            }
+            if let Err(e) = number_regex(&phase.regex, "phase comm ([0-9.eE+-]+)") {
+                return bad(&format!("phases.{name}.regex"), e);
             }
         }
         if let Some(c) = &self.check

@@ -6,9 +6,11 @@ pub mod config;
 pub mod placeholders;
 
 pub use config::External;
+pub use config::PhaseKind;
 pub(crate) use config::TimeSource;
 
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 
 /// The longest timeout a config may give a program: a week.
 pub(crate) const MAX_TIMEOUT_S: f64 = 7.0 * 24.0 * 3600.0;
@@ -42,6 +44,9 @@ pub struct ExternalRun {
     /// The median (and largest) relative force error it printed.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub force_error: Option<[f64; 2]>,
+    /// The phases it printed (`phases`): each its time over the whole run, seconds.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub phases: BTreeMap<String, f64>,
     /// Why the run is not a sample.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<SampleError>,
