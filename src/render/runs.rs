@@ -135,7 +135,7 @@ pub fn external_phases(a: &Analysis) -> String {
     let mut t = tables::Table::new([
         "scenario",
         "case",
-        "time per step",
+        "time per step (mean)",
         "phases per step (share of the step)",
         "serial share",
         "communication share",
@@ -149,7 +149,10 @@ pub fn external_phases(a: &Analysis) -> String {
         tables::Align::Right,
     ]);
     for c in cases {
-        let step = c.median_s.max(f64::MIN_POSITIVE);
+        // The phases are means over the case's runs: their shares are of the mean step time
+        // of the same runs (of the median, a noisy case's phases could add up to over 100%).
+        let mean = c.samples.iter().sum::<f64>() / c.samples.len().max(1) as f64;
+        let step = mean.max(f64::MIN_POSITIVE);
         let share_of = |kind: PhaseKind| -> Option<f64> {
             let of: Vec<f64> = c
                 .named_phases
@@ -183,7 +186,7 @@ pub fn external_phases(a: &Analysis) -> String {
                 crate::render::figures::case_label(c),
                 tables::over(c.oversubscribed)
             ),
-            Duration(c.median_s).to_string(),
+            Duration(mean).to_string(),
             phases.join("<br>"),
             share(share_of(PhaseKind::Serial)),
             share(share_of(PhaseKind::Comm)),

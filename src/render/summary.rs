@@ -58,7 +58,8 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
         let _ = writeln!(
             md,
             "## Phases the programs timed\n\nEach program's own phase times (`phases` in its \
-             [[external]] entry), per step; shares are of the median step time. \
+             [[external]] entry), per step: means over the successful runs, shares of their mean step \
+             time. \
              * = oversubscribed.\n\n{phases}"
         );
     }

@@ -12,6 +12,7 @@ mod bad_sizes;
 mod cli;
 mod config_corpus;
 mod conservation;
+mod course_codes;
 mod docs;
 mod dry_run;
 mod export;
