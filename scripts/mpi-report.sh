@@ -6,7 +6,9 @@
 #   mpi-bench on 2 and 4 ranks;
 # - configs/weak-mpi-tree.toml (the galaxy: allgather, octants, tree) with mpi-bench on 2 ranks;
 # - configs/weak-mpi-tree-tcp.toml, the same over TCP on loopback, with mpi-bench on 2 ranks
-#   under `--mca btl tcp,self`.
+#   under `--mca btl tcp,self`;
+# - configs/seeds-mpi-strong.toml, the Barnes-Hut report's strong scaling over MPI processes at
+#   2000 bodies.
 #
 # About 25 minutes on a 2-vCPU machine. Installs Open MPI when missing (scripts/install-mpi.sh).
 set -euo pipefail
@@ -46,3 +48,4 @@ bench weak-mpi-tree 2 mpi-bench-2.json
 sweep weak-mpi-tree
 bench weak-mpi-tree-tcp 2 mpi-bench-tcp-2.json --mca btl tcp,self
 sweep weak-mpi-tree-tcp
+sweep seeds-mpi-strong

@@ -16,13 +16,16 @@ cd "$(dirname "$0")/.."
 source scripts/lib/sweep.sh
 
 CONFIGS=(complexity complexity-large strong strong-long-range weak weak-time octree-accuracy
-    vs-lammps vs-lammps-liquid vs-pytreegrav vs-fmm3d)
+    vs-lammps vs-lammps-liquid vs-pytreegrav vs-fmm3d
+    seeds seeds-weak seeds-weak-time course-codes)
 mode="${1:-}"
 cargo build --release --quiet
 bin=target/release/nbody-bench
 if [[ "$mode" != "--report" ]]; then
-    # The vs-*.toml sweeps run LAMMPS and pytreegrav next to our kernels.
+    # The vs-*.toml sweeps run LAMMPS and pytreegrav next to our kernels; course-codes compiles
+    # the course's C codes with mpicc.
     scripts/install-peers.sh
+    scripts/install-mpi.sh
 fi
 
 if [[ "$mode" != "--report" ]]; then

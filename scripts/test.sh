@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Runs every check of the project: formatting, lints, unit and integration tests, the benches
-# (once each), the force validation of every scenario, the performance gate, the MPI tests and
-# the Slurm path (against a one-node Slurm started here).
+# (once each), the force validation of every scenario, the performance gate, the MPI tests, the
+# course's C codes and the Slurm path (against a one-node Slurm started here).
 # Works on a fresh machine with a Rust toolchain (Open MPI and libclang are installed with apt
 # when missing and this runs as root).
 #
@@ -98,6 +98,9 @@ step "the MPI drivers under mpirun, and the Slurm path beside them"
 NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh "${features[@]}" >"$slurm_log" 2>&1 &
 slurm_tests=$!
 NBODY_BENCH_BIN="$bin" scripts/mpi-tests.sh
+# The course's C codes: warning-free builds, their energy conservation and agreement with each
+# other over threads and ranks (their runs under the harness are in the suite).
+bash examples/course-codes/check.sh
 if ! wait "$slurm_tests"; then
     cat "$slurm_log" >&2
     echo "the Slurm tests failed (scripts/slurm-tests.sh)" >&2

@@ -9,6 +9,7 @@
 mod comm_section;
 pub mod keep;
 mod sections;
+mod sources_section;
 mod tree_section;
 
 use crate::analysis::{self, Analysis};

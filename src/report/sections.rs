@@ -40,9 +40,16 @@ pub fn document(
     octree(&mut md, sweeps);
     peers(&mut md, sweeps);
     sanity(&mut md, sweeps);
-    md.push_str("\n## Comparison with the source documents\n\n");
-    md.push_str(&region("sources", NO_NOTES));
+    super::sources_section::section(&mut md, sweeps, NO_NOTES);
     md
+}
+
+/// The sweeps of a section: not those that redo a source document's study (the comparison with
+/// the source documents shows them).
+fn own(sweeps: &[Sweep]) -> impl Iterator<Item = &Sweep> {
+    sweeps
+        .iter()
+        .filter(|s| !super::sources_section::redoes_a_source_study(&s.analysis))
 }
 
 fn figure_links(md: &mut String, sweep: &Sweep, prefix: &str) {
@@ -207,8 +214,7 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
 
 fn strong(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Strong scaling: what limits the speedup\n\n");
-    let with: Vec<&Sweep> = sweeps
-        .iter()
+    let with: Vec<&Sweep> = own(sweeps)
         .filter(|s| s.analysis.study == Study::Strong && !s.analysis.strong.is_empty())
         .collect();
     if with.is_empty() {
@@ -236,8 +242,7 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
 
 fn weak(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Weak scaling\n\n");
-    let with: Vec<&Sweep> = sweeps
-        .iter()
+    let with: Vec<&Sweep> = own(sweeps)
         .filter(|s| !s.analysis.weak.is_empty())
         .collect();
     if with.is_empty() {
@@ -284,8 +289,7 @@ fn octree(md: &mut String, sweeps: &[Sweep]) {
 
 fn peers(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Against established codes\n\n");
-    let with: Vec<&Sweep> = sweeps
-        .iter()
+    let with: Vec<&Sweep> = own(sweeps)
         .filter(|s| !s.analysis.peers.is_empty())
         .collect();
     if with.is_empty() {
