@@ -56,6 +56,9 @@ pub enum Command {
     /// Write a scenario's initial state for another code: a LAMMPS data file (reduced units),
     /// or a text / .npy table of positions, velocities, masses and strengths.
     Export(ExportArgs),
+    /// Write a commented sweep config for your own program, every key explained (NAME.toml):
+    /// edit it, then `nbody-bench sweep --config NAME.toml`.
+    Init(InitArgs),
     /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
     /// every key of a sweep config.
     #[command(hide = true)]
@@ -64,6 +67,17 @@ pub enum Command {
     /// into DIR (one case round, or a calibration) and write DIR/result.json.
     #[command(hide = true)]
     Job(JobArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct InitArgs {
+    /// Your program's name: the name of its cases and of the config file.
+    #[arg(long, value_name = "NAME")]
+    pub external: String,
+    /// Write the config here [default: NAME.toml in the current directory]; an existing file
+    /// is never replaced.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<std::path::PathBuf>,
 }
 
 #[derive(Debug, Args)]

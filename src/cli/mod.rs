@@ -10,6 +10,7 @@ mod export;
 mod fit;
 mod fit_tables;
 mod gate;
+mod init;
 mod list;
 mod mpi;
 mod reference;
@@ -37,6 +38,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::MpiBench(args) => mpi::bench(args),
         Command::MpiCheck(args) => mpi::check(args),
         Command::Export(args) => export::export(args),
+        Command::Init(args) => init::init(args),
         Command::Reference(args) => reference::reference(args),
         Command::Job(args) => {
             nbody_bench::experiment::slurm::job_main(&args.dir)

@@ -21,6 +21,7 @@ mod external_phases;
 mod fit_cli;
 mod gate;
 mod gate_refusals;
+mod init;
 mod integrity;
 mod invariants;
 mod kernel_parts;

@@ -66,7 +66,7 @@ pub struct External {
 }
 
 /// Letters, digits, '-', '_' and '.', not empty: what names a case or a family.
-fn plain_name(name: &str) -> bool {
+pub fn plain_name(name: &str) -> bool {
     !name.is_empty()
         && name
             .chars()
