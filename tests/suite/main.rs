@@ -19,6 +19,7 @@ mod external;
 mod fit_cli;
 mod gate;
 mod gate_refusals;
+mod initial;
 mod integrity;
 mod invariants;
 mod kernel_parts;
