@@ -131,11 +131,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let phase = |case: &str, build, interact, integrate, boundary, communication| PhaseTimes {
         case: case.into(),
-        build,
-        interact,
-        integrate,
-        boundary,
-        communication,
+        phases: [
+            ("force: build", build),
+            ("force: interact", interact),
+            ("integrate", integrate),
+            ("boundary", boundary),
+            ("communication", communication),
+        ]
+        .into_iter()
+        .map(|(name, s): (&str, f64)| (name.to_string(), s))
+        .collect(),
     };
     let phases = [
         phase(

@@ -5,7 +5,7 @@ use nbody_bench::decomp::Decomposition;
 use nbody_bench::export::ExportFormat;
 use nbody_bench::kernels::{KernelKind, Multipole};
 use nbody_bench::output::nbview::NbviewFormat;
-use nbody_bench::scenario::{Precision, ScenarioKind};
+use nbody_bench::scenario::{Precision, ScenarioKind, lj};
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -146,6 +146,64 @@ pub struct SystemArgs {
     pub allow_fewer: bool,
 }
 
+/// Where a run starts: bodies from a file, and the Lennard-Jones parameters.
+#[derive(Debug, Args, Clone)]
+pub struct StartArgs {
+    /// Start from the bodies in FILE instead of the scenario's placement (the file sets n; the
+    /// law, box and field stay the scenario's): `nbody-bench export --format text` output, or a
+    /// Barnes-Hut body file, one body per line `m x y z vx vy vz` with `#` comments (3-D
+    /// scenarios but coulomb, which needs charges).
+    #[arg(long, value_name = "FILE")]
+    pub initial: Option<PathBuf>,
+    #[command(flatten)]
+    pub lj: LjArgs,
+}
+
+const LJ_HEADING: &str = "Lennard-Jones (lj-box, lj-liquid)";
+
+/// The Lennard-Jones parameters; their help shows the scenario's own constants.
+#[derive(Debug, Args, Clone)]
+pub struct LjArgs {
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true, help_heading = LJ_HEADING, help = lj_help(
+        "Well depth epsilon",
+        format!("{}", lj::LJ_EPSILON),
+    ))]
+    pub epsilon: Option<f64>,
+    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true, help_heading = LJ_HEADING, help = lj_help(
+        "Particle size sigma: the cutoff is 2.5 sigma, generated particles are at least sigma \
+         apart, and lj-liquid's default density follows it (reduced density 0.8)",
+        format!("{}", lj::LJ_SIGMA),
+    ))]
+    pub sigma: Option<f64>,
+    #[arg(long = "g", value_parser = parse_float, allow_hyphen_values = true, help_heading = LJ_HEADING, help = lj_help(
+        "Downward acceleration of the external field (negative: upward)",
+        format!("{} for lj-box, 0 for lj-liquid", lj::LJ_GRAVITY),
+    ))]
+    pub g: Option<f64>,
+    #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true, help_heading = LJ_HEADING, help = lj_help(
+        "Initial temperature: velocity components are drawn from N(0, sqrt(T0)); not with \
+         --initial, whose bodies carry their velocities",
+        format!("{}", lj::LJ_T0),
+    ))]
+    pub t0: Option<f64>,
+}
+
+/// The help of a Lennard-Jones option, with the default the scenario uses.
+fn lj_help(what: &str, default: String) -> String {
+    format!("{what} [default: {default}]")
+}
+
+impl LjArgs {
+    pub fn overrides(&self) -> nbody_bench::scenario::LjOverrides {
+        nbody_bench::scenario::LjOverrides {
+            epsilon: self.epsilon,
+            sigma: self.sigma,
+            g: self.g,
+            t0: self.t0,
+        }
+    }
+}
+
 /// Kernel tuning options.
 #[derive(Debug, Args, Clone)]
 pub struct KernelArgs {
@@ -189,6 +247,8 @@ pub struct RunArgs {
     pub steps: usize,
     #[command(flatten)]
     pub system: SystemArgs,
+    #[command(flatten)]
+    pub start: StartArgs,
     #[command(flatten)]
     pub kernel_args: KernelArgs,
     /// Write a machine-readable result (schema nbody-bench/run/v1) to this file.
@@ -600,6 +660,8 @@ pub struct ExportArgs {
     pub scenario: ScenarioKind,
     #[command(flatten)]
     pub system: SystemArgs,
+    #[command(flatten)]
+    pub start: StartArgs,
     /// lammps-data: a LAMMPS data file in LJ reduced units (atom style atomic, the walls as the
     /// box; Lennard-Jones scenarios only); text: positions, velocities, mass and strength per
     /// particle with the law's parameters in the header; npy: the same columns as float64.

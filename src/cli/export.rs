@@ -5,8 +5,7 @@ use nbody_bench::export::export_setup;
 
 pub fn export(args: ExportArgs) -> anyhow::Result<i32> {
     nbody_bench::output::check_outputs(&[("--out", args.out.as_path())], &[])?;
-    let setup = super::setup(args.scenario, &args.system);
-    setup.validate()?;
+    let setup = super::start_setup(args.scenario, &args.system, &args.start)?;
     let bytes = export_setup(&setup, args.format)??;
     nbody_bench::output::write_atomic(&args.out, &bytes)?;
     eprintln!(

@@ -20,7 +20,7 @@ mod summary;
 mod sweep;
 mod validate;
 
-use crate::cli::args::{Cli, Command, KernelArgs, SystemArgs};
+use crate::cli::args::{Cli, Command, KernelArgs, StartArgs, SystemArgs};
 use nbody_bench::kernels::{KernelKind, KernelParams};
 use nbody_bench::scenario::{ScenarioKind, Setup};
 
@@ -75,7 +75,38 @@ fn setup(scenario: ScenarioKind, args: &SystemArgs) -> Setup {
         density: args.density,
         precision: args.precision,
         allow_fewer: args.allow_fewer,
+        initial: None,
+        lj: Default::default(),
     }
+}
+
+/// The set-up of `run` and `export`: the system options, the Lennard-Jones parameters and the
+/// bodies of `--initial`, read and checked against the scenario here, before anything runs.
+fn start_setup(
+    scenario: ScenarioKind,
+    system: &SystemArgs,
+    start: &StartArgs,
+) -> anyhow::Result<Setup> {
+    let mut setup = setup(scenario, system);
+    setup.lj = start.lj.overrides();
+    if let Some(path) = &start.initial {
+        let bodies = nbody_bench::scenario::initial::read(path)?;
+        if let Some(from) = bodies
+            .exported_from
+            .as_deref()
+            .filter(|&f| f != scenario.name())
+        {
+            eprintln!(
+                "note: {} was exported from scenario {from}; it starts {} here, with that \
+                 scenario's law, box and field",
+                path.display(),
+                scenario.name()
+            );
+        }
+        setup.initial = Some(std::sync::Arc::new(bodies));
+    }
+    setup.validate()?;
+    Ok(setup)
 }
 
 /// The kernel parameters given, over the defaults; `--theta`, `--multipole`, `--order`,

@@ -47,7 +47,7 @@ mod with_mpi {
     use super::*;
     use crate::cli::args::{KernelArgs, MpiOptions};
     use crate::cli::summary::print_summary;
-    use crate::cli::{kernel_params, setup};
+    use crate::cli::{error_chain, kernel_params, setup, start_setup};
     use anyhow::Context;
     use nbody_bench::decomp::stats::MpiReport;
     use nbody_bench::kernels::KernelKind;
@@ -140,17 +140,12 @@ mod with_mpi {
         // Rank 0 alone estimates the run, before MPI starts (a probe's timing differs between
         // ranks, and a refusal must not leave ranks waiting in a collective): its exit with
         // code 2 ends the job under the launcher.
-        if !args.yes && launcher_rank().unwrap_or(0) == 0 {
-            let setup = setup(args.scenario, &args.system);
-            if setup.validate().is_ok() {
-                let steps = (args.steps + args.mpi.warmup_steps) as u64;
-                crate::cli::dry_run::refuse_long_run(
-                    &setup,
-                    args.kernel,
-                    &args.kernel_args,
-                    steps,
-                )?;
-            }
+        if !args.yes
+            && launcher_rank().unwrap_or(0) == 0
+            && let Ok(setup) = start_setup(args.scenario, &args.system, &args.start)
+        {
+            let steps = (args.steps + args.mpi.warmup_steps) as u64;
+            crate::cli::dry_run::refuse_long_run(&setup, args.kernel, &args.kernel_args, steps)?;
         }
         let mut mpi = match start(&job("run", &args)) {
             Ok(mpi) => mpi,
@@ -164,7 +159,10 @@ mod with_mpi {
             );
             return Ok(fail(rank, err));
         }
-        let setup = setup(args.scenario, &args.system);
+        let setup = match start_setup(args.scenario, &args.system, &args.start) {
+            Ok(setup) => setup,
+            Err(e) => return Ok(fail(rank, MpiError::Usage(error_chain(&e)))),
+        };
         if let Err(err) = fits(&setup, args.kernel, decomp, &args.kernel_args, mpi.size()) {
             return Ok(fail(rank, err));
         }

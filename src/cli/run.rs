@@ -1,6 +1,6 @@
 use super::dry_run::refuse_long_run;
 use super::summary::print_summary;
-use super::{kernel_params, setup};
+use super::{kernel_params, start_setup};
 use crate::cli::args::RunArgs;
 use anyhow::Context;
 use nbody_bench::run::{RunSpec, TrajectorySpec, logical_cpus, run_setup};
@@ -19,8 +19,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     if let Some(decomp) = args.decomp {
         return super::mpi::run(args, decomp);
     }
-    let setup = setup(args.scenario, &args.system);
-    setup.validate()?;
+    let setup = start_setup(args.scenario, &args.system, &args.start)?;
     let params = kernel_params(&args.kernel_args, Some(args.kernel))?;
     nbody_bench::run::check_memory(&setup, args.kernel, &params, args.kernel_args.threads, 1)?;
     if !args.yes {

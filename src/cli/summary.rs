@@ -6,7 +6,7 @@ use nbody_bench::units::Duration;
 pub fn print_summary(r: &RunOutcome) {
     let t = &r.timing;
     outln!(
-        "{} / {}: n = {}, {} steps, {} thread{}{}, {}-D {}, seed {}, simd {}",
+        "{} / {}: n = {}, {} steps, {} thread{}{}, {}-D {}, {}, simd {}",
         r.scenario,
         r.kernel,
         r.n,
@@ -20,7 +20,10 @@ pub fn print_summary(r: &RunOutcome) {
         },
         r.dim,
         r.precision,
-        r.seed,
+        match &r.initial {
+            Some(path) => format!("bodies from {path}"),
+            None => format!("seed {}", r.seed),
+        },
         r.simd
     );
     if r.n < r.n_requested {

@@ -124,6 +124,7 @@ fn two_body_circular_orbit_stays_circular() {
         precision: Precision::F64,
         density: None,
         box_side: None,
+        initial: None,
     };
     for kernel in [
         KernelKind::Naive,

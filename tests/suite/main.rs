@@ -22,6 +22,7 @@ mod fit_cli;
 mod gate;
 mod gate_refusals;
 mod init;
+mod initial;
 mod integrity;
 mod invariants;
 mod kernel_parts;

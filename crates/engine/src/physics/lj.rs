@@ -5,7 +5,7 @@ use crate::real::{Real, select};
 
 /// σ of the LJ scenarios (the LJ-box assignment's length unit), and the scale of the kernels'
 /// distance defaults (the Verlet skin).
-pub(crate) const LJ_SIGMA: f64 = 0.01;
+pub const LJ_SIGMA: f64 = 0.01;
 
 /// Lennard-Jones with a cutoff. The force is truncated (not shifted); the energy used for
 /// monitoring is shifted by `V(rc)` so that it stays continuous when pairs cross the cutoff.

@@ -12,7 +12,7 @@ mod lj;
 
 pub use coulomb::Coulomb;
 pub use gravity::Gravity;
-pub(crate) use lj::LJ_SIGMA;
+pub use lj::LJ_SIGMA;
 pub use lj::LennardJones;
 
 use crate::real::Real;

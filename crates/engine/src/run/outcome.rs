@@ -32,6 +32,9 @@ pub struct RunOutcome {
     pub dt: f64,
     pub density: Option<f64>,
     pub box_side: Option<f64>,
+    /// The initial-state file the bodies came from (`run --initial`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub initial: Option<String>,
     pub kernel_params: KernelParams,
     /// Instruction set the pair loops ran with.
     pub simd: &'static str,
@@ -158,6 +161,7 @@ impl RunOutcome {
             dt: m.info.dt,
             density: m.info.density,
             box_side: m.info.box_side,
+            initial: m.info.initial.clone(),
             kernel_params: m.params,
             simd: simd::level().name(),
             timing: Timing {

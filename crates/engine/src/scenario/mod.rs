@@ -6,19 +6,24 @@
 //! it a [`SystemJob`] and receives the job's result.
 
 pub mod galaxy;
+pub mod initial;
+pub mod lj;
 mod placement;
 
 use crate::boundary::Boundary;
 use crate::kernels::CompiledKernels;
-use crate::physics::{Coulomb, Gravity, LawKind, LennardJones};
+use crate::physics::{Coulomb, Gravity, LawKind};
 use crate::real::Real;
 use crate::state::State;
 use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 use rand_pcg::Pcg64Mcg;
 use serde::Serialize;
+use std::sync::Arc;
 use thiserror::Error;
 
+pub use initial::{InitialBodies, InitialError};
+pub use lj::{LJ_CUTOFF, LJ_GAS_DENSITY, LjOverrides};
+use lj::{LJ_LIQUID_DENSITY, LJ_LIQUID_REDUCED_DENSITY};
 pub use placement::PlacementError;
 
 /// The scenarios a user can pick.
@@ -118,19 +123,6 @@ impl ScenarioKind {
 /// and 2^29 particles already need tens of GB.
 pub(crate) const MAX_PARTICLES: usize = 1 << 29;
 
-/// Lennard-Jones parameters shared by the LJ scenarios (the LJ-box assignment's units); σ is
-/// the physics layer's, where the kernels' defaults also read it.
-pub(crate) const LJ_EPSILON: f64 = 1.0;
-pub(crate) use crate::physics::LJ_SIGMA;
-pub const LJ_CUTOFF: f64 = 2.5 * LJ_SIGMA;
-/// The source's 500 particles in the unit square (≈1 neighbour inside rc: a dilute gas).
-pub const LJ_GAS_DENSITY: f64 = 500.0;
-/// Reduced density ρσ² = 0.8.
-pub(crate) const LJ_LIQUID_DENSITY: f64 = 0.8 / (LJ_SIGMA * LJ_SIGMA);
-/// Initial temperature: velocity components are N(0, √T0) for unit mass (k_B = 1).
-pub(crate) const LJ_T0: f64 = 1.0;
-/// Downward acceleration of the lj-box field.
-pub(crate) const LJ_GRAVITY: f64 = 1.0;
 /// Coulomb force quench distance (the source leaves it unset).
 pub(crate) const COULOMB_QUENCH: f64 = 1e-3;
 
@@ -180,6 +172,11 @@ pub struct Setup {
     pub precision: Option<Precision>,
     /// Accept fewer particles than asked when the box cannot hold `n` at minimum spacing.
     pub allow_fewer: bool,
+    /// Start from these bodies instead of the scenario's placement (`run --initial`); they
+    /// set n. Shared: a set-up is cloned per case and per probe.
+    pub initial: Option<Arc<InitialBodies>>,
+    /// Lennard-Jones parameters changed from the scenario's.
+    pub lj: LjOverrides,
 }
 
 #[derive(Debug, Error)]
@@ -208,6 +205,33 @@ pub enum SetupError {
     },
     #[error(transparent)]
     Placement(#[from] PlacementError),
+    #[error(
+        "{flag} applies to the Lennard-Jones scenarios (lj-box, lj-liquid) only; scenario `{1}` \
+         has no such parameter: drop it", flag = .0
+    )]
+    NotLj(&'static str, &'static str),
+    #[error("{flag} must be {want} (got {got})")]
+    BadLj {
+        flag: &'static str,
+        want: &'static str,
+        got: f64,
+    },
+    #[error(
+        "n = {n} was asked but the initial state {} holds {bodies} bodies: drop -n (the file \
+         sets n) or give -n {bodies}", path.display()
+    )]
+    InitialCount {
+        path: std::path::PathBuf,
+        n: usize,
+        bodies: usize,
+    },
+    #[error(
+        "--t0 sets the velocities of generated particles; the bodies of the initial state {} \
+         carry their own: drop --t0", .0.display()
+    )]
+    T0WithInitial(std::path::PathBuf),
+    #[error(transparent)]
+    Initial(#[from] InitialError),
 }
 
 impl Setup {
@@ -220,11 +244,17 @@ impl Setup {
             density: None,
             precision: None,
             allow_fewer: false,
+            initial: None,
+            lj: LjOverrides::default(),
         }
     }
 
+    /// The bodies of the initial state, else `-n`, else the scenario's default.
     pub fn n(&self) -> usize {
-        self.n.unwrap_or(self.scenario.defaults().n)
+        match &self.initial {
+            Some(bodies) => bodies.len(),
+            None => self.n.unwrap_or(self.scenario.defaults().n),
+        }
     }
 
     pub fn dt(&self) -> f64 {
@@ -235,12 +265,33 @@ impl Setup {
         self.precision.unwrap_or(self.scenario.defaults().precision)
     }
 
+    /// The density given, else the scenario's: the liquid's follows σ (reduced density 0.8).
     pub fn density(&self) -> Option<f64> {
-        self.density.or(self.scenario.defaults().density)
+        match (self.density, self.scenario) {
+            (Some(rho), _) => Some(rho),
+            (None, ScenarioKind::LjLiquid) if self.lj.sigma.is_some() => {
+                let sigma = self.lj.sigma();
+                Some(LJ_LIQUID_REDUCED_DENSITY / (sigma * sigma))
+            }
+            (None, _) => self.scenario.defaults().density,
+        }
     }
 
     /// Checks the overrides before anything is built.
     pub fn validate(&self) -> Result<(), SetupError> {
+        self.lj.validate(self.scenario)?;
+        if let Some(bodies) = &self.initial {
+            if let Some(n) = self.n.filter(|&n| n != bodies.len()) {
+                return Err(SetupError::InitialCount {
+                    path: bodies.path.clone(),
+                    n,
+                    bodies: bodies.len(),
+                });
+            }
+            if self.lj.t0.is_some() {
+                return Err(SetupError::T0WithInitial(bodies.path.clone()));
+            }
+        }
         if self.n() == 0 {
             return Err(SetupError::ZeroParticles);
         }
@@ -267,15 +318,20 @@ impl Setup {
                 Precision::F32 => f32::EPSILON as f64,
                 Precision::F64 => f64::EPSILON,
             };
-            if !side.is_finite() || side * epsilon * 16.0 > LJ_SIGMA {
+            let sigma = self.lj.sigma();
+            if !side.is_finite() || side * epsilon * 16.0 > sigma {
                 return Err(SetupError::BoxTooLarge {
                     side,
                     n: self.n(),
                     density,
                     precision: self.precision().name(),
-                    sigma: LJ_SIGMA,
+                    sigma,
                 });
             }
+        }
+        if let Some(bodies) = &self.initial {
+            let side = self.density().map(|rho| (self.n() as f64 / rho).sqrt());
+            bodies.check(self.scenario, side)?;
         }
         Ok(())
     }
@@ -285,10 +341,10 @@ impl Setup {
         self.validate()?;
         Ok(match (self.scenario, self.precision()) {
             (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F32) => {
-                job.run(self.lj::<f32>()?)
+                job.run(lj::build::<f32>(self)?)
             }
             (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F64) => {
-                job.run(self.lj::<f64>()?)
+                job.run(lj::build::<f64>(self)?)
             }
             (ScenarioKind::Coulomb, Precision::F32) => job.run(self.coulomb::<f32>()),
             (ScenarioKind::Coulomb, Precision::F64) => job.run(self.coulomb::<f64>()),
@@ -297,55 +353,22 @@ impl Setup {
         })
     }
 
-    fn lj<T: Real>(&self) -> Result<System<T, LennardJones<T>, 2>, SetupError> {
-        let density = self.density().expect("LJ scenarios have a density");
-        let side = (self.n() as f64 / density).sqrt();
-        let mut rng = Pcg64Mcg::seed_from_u64(self.seed);
-        let positions = match self.scenario {
-            // Random sequential placement jams near packing fraction 0.55; the liquid
-            // (0.63) starts from a jittered lattice instead.
-            ScenarioKind::LjLiquid => {
-                placement::jittered_lattice(self.n(), side, LJ_SIGMA, &mut rng)
-            }
-            _ => placement::spaced_uniform(self.n(), side, LJ_SIGMA, self.allow_fewer, &mut rng)?,
-        };
-        let n = positions.len();
-        let mut state = State::<T, 2>::new(n);
-        let normal = Normal::new(0.0, LJ_T0.sqrt()).expect("valid normal");
-        for (i, p) in positions.iter().enumerate() {
-            for d in 0..2 {
-                state.pos[d][i] = T::of(p[d]);
-                state.vel[d][i] = T::of(normal.sample(&mut rng));
-            }
-        }
-        let g = if self.scenario == ScenarioKind::LjBox {
-            LJ_GRAVITY
-        } else {
-            0.0
-        };
-        Ok(System {
-            state,
-            law: LennardJones::new(LJ_EPSILON, LJ_SIGMA, LJ_CUTOFF),
-            boundary: Boundary::Reflecting {
-                lo: [T::zero(); 2],
-                hi: [T::of(side); 2],
-            },
-            external: [T::zero(), T::of(-g)],
-            dt: T::of(self.dt()),
-            info: self.info(n, Some(side)),
-        })
-    }
-
     fn coulomb<T: Real>(&self) -> System<T, Coulomb<T>, 3> {
-        let mut rng = Pcg64Mcg::seed_from_u64(self.seed);
         let n = self.n();
-        let mut state = State::<T, 3>::new(n);
-        for i in 0..n {
-            for d in 0..3 {
-                state.pos[d][i] = T::of(rand::Rng::random::<f64>(&mut rng));
+        let state = match &self.initial {
+            Some(bodies) => bodies.state(),
+            None => {
+                let mut rng = Pcg64Mcg::seed_from_u64(self.seed);
+                let mut state = State::<T, 3>::new(n);
+                for i in 0..n {
+                    for d in 0..3 {
+                        state.pos[d][i] = T::of(rand::Rng::random::<f64>(&mut rng));
+                    }
+                    state.source[i] = if i % 2 == 0 { T::one() } else { -T::one() };
+                }
+                state
             }
-            state.source[i] = if i % 2 == 0 { T::one() } else { -T::one() };
-        }
+        };
         System {
             state,
             law: Coulomb::new(COULOMB_QUENCH),
@@ -358,7 +381,10 @@ impl Setup {
 
     fn galaxy<T: Real>(&self) -> System<T, Gravity<T>, 3> {
         let n = self.n();
-        let state = galaxy::galaxy::<T>(n, self.seed);
+        let state = match &self.initial {
+            Some(bodies) => bodies.state(),
+            None => galaxy::galaxy::<T>(n, self.seed),
+        };
         System {
             state,
             law: Gravity::new(galaxy::G, galaxy::SOFTENING),
@@ -379,6 +405,7 @@ impl Setup {
             precision: self.precision(),
             density: self.density(),
             box_side: side,
+            initial: self.initial.as_ref().map(|b| b.path.display().to_string()),
         }
     }
 }
@@ -395,6 +422,8 @@ pub struct SystemInfo {
     pub precision: Precision,
     pub density: Option<f64>,
     pub box_side: Option<f64>,
+    /// The file the bodies came from (`run --initial`), else none: the seed placed them.
+    pub initial: Option<String>,
 }
 
 /// A ready-to-run system in concrete types.
