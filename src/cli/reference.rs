@@ -86,6 +86,7 @@ theta = [0.7]
 multipole = ["monopole"]
 order = [6]
 precision = "f64"
+initial = "bodies.txt"
 out = "elsewhere"
 
 [measure]
@@ -160,6 +161,9 @@ fn meaning(key: &str) -> Option<&'static str> {
         "order" => "expansion orders of the fmm's cells, fmm cases only",
         "precision" => "overrides each scenario's precision (when left out: each scenario's own)",
         "out" => "the results directory",
+        "initial" => {
+            "every case starts from the bodies in this file (relative to the config's directory) instead of the seeded placement: the built-in kernels, in this process or under [mpi]"
+        }
         "measure" => "how each case is measured",
         "weak" => "weak studies only: how n grows with the workers",
         "mpi" => {

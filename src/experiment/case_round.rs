@@ -8,6 +8,8 @@ use crate::records::config::SweepConfig;
 use crate::records::kernel_or_program::KernelOrProgram;
 use crate::records::plan::Case;
 use crate::scenario::Setup;
+use crate::scenario::initial::InitialBodies;
+use std::sync::Arc;
 
 /// Measures one round of `case`.
 pub(super) fn measure_case<C: Clock>(
@@ -35,10 +37,21 @@ pub(super) fn measure_case<C: Clock>(
         }
     };
     if let Some(launch) = &config.mpi {
-        return Ok(super::launcher::measure_round(launch, case, spec)?);
+        return Ok(super::launcher::measure_round(
+            launch,
+            case,
+            spec,
+            context.initial.as_deref(),
+        )?);
     }
+    let bodies = context
+        .initial
+        .as_deref()
+        .map(crate::scenario::initial::read)
+        .transpose()?
+        .map(Arc::new);
     Ok(measure_round(
-        &case_setup(case),
+        &case_setup(case, bodies),
         case,
         kernel,
         spec,
@@ -46,11 +59,12 @@ pub(super) fn measure_case<C: Clock>(
     )??)
 }
 
-/// The system a case measures.
-pub(super) fn case_setup(case: &Case) -> Setup {
+/// The system a case measures: the seeded placement, or the config's file of bodies.
+pub(super) fn case_setup(case: &Case, bodies: Option<Arc<InitialBodies>>) -> Setup {
     let mut setup = Setup::new(case.scenario);
     setup.n = Some(case.n);
     setup.seed = case.seed;
     setup.precision = case.precision;
+    setup.initial = bodies;
     setup
 }

@@ -192,11 +192,15 @@ pub(crate) fn measure_round(
     launch: &MpiLaunch,
     case: &Case,
     spec: &RoundSpec,
+    initial: Option<&Path>,
 ) -> Result<RoundOutcome, LaunchError> {
     let exe = std::env::current_exe().map_err(LaunchError::Exe)?;
     let dir = private_dir()?;
     let json = dir.path().join("round.json");
-    let args = launch_args(launch, case, &exe, &json);
+    let mut args = launch_args(launch, case, &exe, &json);
+    if let Some(file) = initial {
+        args.extend(["--initial".to_string(), file.display().to_string()]);
+    }
     let command = format!("{} {}", launch.launcher, args.join(" "));
     // In a process group of its own: the launcher and its ranks are stopped together when
     // the sweep is interrupted.

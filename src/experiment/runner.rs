@@ -10,8 +10,12 @@ use super::slurm;
 use crate::clock::Clock;
 use crate::records::config::SweepConfig;
 use crate::records::plan::{Case, cases};
-use crate::records::results::{CaseRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile};
+use crate::records::results::{
+    CaseRecord, InitialRecord, Metadata, RESULTS_SCHEMA, ResultsError, ResultsFile,
+};
+use crate::scenario::initial::InitialBodies;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 use thiserror::Error;
 
 /// How a sweep starts.
@@ -90,6 +94,10 @@ pub enum SweepError {
     Exe(std::io::Error),
     #[error("{0}")]
     Plan(String),
+    #[error("config key `initial`: {source}")]
+    Initial {
+        source: crate::scenario::initial::InitialError,
+    },
     #[error(transparent)]
     Lock(#[from] super::lock::LockError),
     #[error(transparent)]
@@ -159,8 +167,9 @@ pub fn run_sweep<C: Clock>(
     // otherwise fail only when its turn comes, after the cases before it ran, and again at
     // every --resume.
     let planned = crate::records::plan::unique_cases(config).map_err(SweepError::Plan)?;
+    let initial = initial_bodies(config, options)?;
     for case in planned {
-        let setup = case_setup(&case);
+        let setup = case_setup(&case, initial.as_ref().map(|(_, b)| b.clone()));
         let copies = match case.decomp {
             // Every rank holds all the particles.
             Some(crate::decomp::Decomposition::Allgather) => case.ranks,
@@ -186,7 +195,10 @@ pub fn run_sweep<C: Clock>(
         Some(dir) => dir.join("results.json"),
         None => results_path(config, options.out.as_deref()),
     };
-    let context = external_context(options, &path)?;
+    let mut context = external_context(options, &path)?;
+    context.initial = initial
+        .as_ref()
+        .map(|(record, _)| PathBuf::from(&record.path));
     for ext in &config.external {
         let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
         super::external::check_programs(ext, launcher, &context)?;
@@ -245,6 +257,9 @@ pub fn run_sweep<C: Clock>(
             observer.message(&cal.summary());
         }
         results.calibration.start = cal;
+    }
+    if let Some((record, _)) = initial {
+        results.metadata.initial = Some(record);
     }
     if results.metadata.externals.is_empty() && !config.external.is_empty() {
         results.metadata.externals = config
@@ -432,6 +447,35 @@ fn calibrate(
     Ok(calibration)
 }
 
+/// The config's file of bodies (`initial`), read once before anything runs, and its record for
+/// the results metadata (the path made absolute, so that MPI ranks and later rounds find it).
+fn initial_bodies(
+    config: &SweepConfig,
+    options: &SweepOptions,
+) -> Result<Option<(InitialRecord, Arc<InitialBodies>)>, SweepError> {
+    let Some(file) = &config.initial else {
+        return Ok(None);
+    };
+    let dir = options.config_dir.as_deref().unwrap_or(Path::new("."));
+    let path = dir.join(file);
+    let path = std::path::absolute(&path).unwrap_or(path);
+    let bytes = crate::input::read_text(&path).map_err(|source| SweepError::Initial {
+        source: crate::scenario::initial::InitialError::Read {
+            path: path.clone(),
+            source,
+        },
+    })?;
+    let bodies = crate::scenario::initial::parse(&path, &bytes)
+        .map_err(|source| SweepError::Initial { source })?;
+    let record = InitialRecord {
+        path: path.display().to_string(),
+        format: bodies.format.name().to_string(),
+        bodies: bodies.len(),
+        fnv1a: format!("{:016x}", crate::records::results::fnv1a(bytes.as_bytes())),
+    };
+    Ok(Some((record, Arc::new(bodies))))
+}
+
 /// Where external programs find the sweep; their work directories go next to the results.
 fn external_context(
     options: &SweepOptions,
@@ -451,6 +495,7 @@ fn external_context(
         config_dir: absolute(config_dir),
         nbody_bench: absolute(nbody_bench),
         work_root: absolute(path.parent().unwrap_or(Path::new(".")).join("work")),
+        initial: None,
     })
 }
 

@@ -93,7 +93,8 @@ fn compare_case(
     let (b_raw, c_raw) = (samples(base), samples(cur));
     let (bm, cm) = (median_of(&b_raw), median_of(&c_raw));
     let ratio = median_of(&c) / median_of(&b);
-    let seed = options.seed ^ fnv1a(&base.key);
+    // A seed per case that does not depend on the case's position.
+    let seed = options.seed ^ crate::records::results::fnv1a(base.key.as_bytes());
     // A side without a positive sample has no interval, and no change is claimed.
     let ci95 = bootstrap_ratio_ci(&b, &c, options.resamples, seed).unwrap_or([f64::NAN; 2]);
     let t = options.threshold;
@@ -265,11 +266,4 @@ fn compare_work(base: &CaseRecord, cur: &CaseRecord) -> (Vec<WorkChange>, bool, 
         }
     }
     (changes, compared, notes)
-}
-
-/// FNV-1a of the case key: a seed per case that does not depend on the case's position.
-fn fnv1a(text: &str) -> u64 {
-    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
-        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
-    })
 }

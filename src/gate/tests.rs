@@ -81,6 +81,7 @@ fn metadata() -> Metadata {
         os: "linux x86_64".into(),
         started: "2026-11-22T00:00:00Z".into(),
         externals: Vec::new(),
+        initial: None,
     }
 }
 

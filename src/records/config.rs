@@ -178,6 +178,11 @@ pub struct SweepConfig {
     pub order: Vec<usize>,
     #[serde(default)]
     pub precision: Option<Precision>,
+    /// Every case starts from the bodies in this file (`export --format text`, or a body file
+    /// `m x y z vx vy vz`; a relative path is from the config's directory) instead of the
+    /// seeded placement. Built-in kernels only, in this process or under `[mpi]`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<PathBuf>,
     /// Output directory [default: results].
     #[serde(default = "default_out")]
     pub out: PathBuf,
@@ -336,6 +341,9 @@ impl SweepConfig {
             ));
         }
         self.validate_external(path)?;
+        if self.initial.is_some() {
+            self.validate_initial(path)?;
+        }
         for &s in &self.scenarios {
             let external = self
                 .external
@@ -536,6 +544,38 @@ impl SweepConfig {
 }
 
 impl SweepConfig {
+    /// What a file of bodies can start: the built-in kernels' cases, at the file's one n.
+    fn validate_initial(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = |problem: &str| ConfigError::Invalid {
+            path: path.into(),
+            key: "initial".into(),
+            problem: problem.into(),
+        };
+        if !self.external.is_empty() {
+            return Err(bad(
+                "starts the built-in kernels only: an [[external]] program reads a file of bodies                  through its own `setup` (e.g. `{nbody_bench} export --initial FILE --format \
+                 lammps-data --out {workdir}/state.data`); drop one of the two",
+            ));
+        }
+        if self.scheduler.is_some() {
+            return Err(bad(
+                "is not taken to batch jobs yet: drop it or the [scheduler] table",
+            ));
+        }
+        if self.study == Study::Weak {
+            return Err(bad(
+                "holds one n, while a weak study grows n with the workers: use a cartesian or \
+                 strong study",
+            ));
+        }
+        if self.n.is_none() {
+            return Err(bad(
+                "needs `n` too: the file's number of bodies, written out (n = [N])",
+            ));
+        }
+        Ok(())
+    }
+
     fn validate_external(&self, path: &Path) -> Result<(), ConfigError> {
         let around = super::external::config::Around {
             threads: &self.threads,

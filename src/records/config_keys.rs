@@ -79,6 +79,9 @@ pub fn allowed(key: &str) -> Option<&'static str> {
         "order" => "a list of fmm expansion orders from 1 to 8, such as order = [3, 4, 6]",
         "precision" => "\"f32\" or \"f64\"",
         "out" => "a directory, as a string, such as out = \"results\"",
+        "initial" => {
+            "a file, as a string, such as initial = \"bodies.txt\": `nbody-bench export --format text` output, or one body a line `m x y z vx vy vz` (3-D, # comments); not with [[external]], [scheduler] or a weak study, and `n` must be the file's"
+        }
         "measure" => {
             "a table [measure] with warmup_s, samples, min_sample_s, rounds, budget_s, max_energy_drift, force_error_sample, reference_s"
         }

@@ -71,6 +71,9 @@ pub struct Metadata {
     pub os: String,
     /// UTC, ISO 8601, when the sweep started (the first run, not a resume).
     pub started: String,
+    /// The file of bodies every case started from (`initial`), as it was read.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub initial: Option<InitialRecord>,
     /// The version line of each external program of the config (`[[external]]`).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub externals: Vec<super::external::ExternalVersion>,
@@ -411,8 +414,27 @@ impl Metadata {
             os: format!("{} {}", std::env::consts::OS, std::env::consts::ARCH),
             started: utc_now(),
             externals: Vec::new(),
+            initial: None,
         }
     }
+}
+
+/// The file of bodies a sweep's cases started from: where, what, and a fingerprint of its
+/// content (a file changed between two sweeps shows here).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct InitialRecord {
+    pub path: String,
+    pub format: String,
+    pub bodies: usize,
+    /// FNV-1a of the file's bytes, 16 hex digits.
+    pub fnv1a: String,
+}
+
+/// FNV-1a, 64 bits: a fingerprint of `bytes` (not a cryptographic hash).
+pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ b as u64).wrapping_mul(0x0100_0000_01b3)
+    })
 }
 
 fn compiled_features() -> Vec<String> {

@@ -7,7 +7,7 @@
 
 use crate::{bin, text};
 use nbody_bench::records::external::SampleError;
-use nbody_bench::records::results::ResultsFile;
+use nbody_bench::records::results::{InitialRecord, ResultsFile};
 use nbody_bench::records::scheduler::{JobError, JobRecord};
 use nbody_bench::records::vet::Rejected;
 use std::collections::BTreeSet;
@@ -196,6 +196,12 @@ fn the_results_reference_lists_exactly_the_fields_written() {
     for (i, path) in files.iter().enumerate() {
         let mut file = ResultsFile::load(path).unwrap();
         if i == 0 {
+            file.metadata.initial = Some(InitialRecord {
+                path: "/data/bodies.txt".into(),
+                format: "barnes-hut".into(),
+                bodies: 2000,
+                fnv1a: "0123456789abcdef".into(),
+            });
             file.cases[0].rejected.push(Rejected {
                 round: 0,
                 what: "sample 0".into(),

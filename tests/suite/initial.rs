@@ -376,3 +376,65 @@ fn the_lennard_jones_options_change_the_law_and_the_field() {
     ]);
     refused(&o, "must be 0 or greater");
 }
+
+/// A sweep of `config_text` written into `dir` (its `initial` relative to `dir`): the results, or the
+/// command's exit code and error output.
+fn sweep_config(dir: &Path, config_text: &str) -> Result<String, (Option<i32>, String)> {
+    let config = dir.join("from-file.toml");
+    std::fs::write(&config, config_text).unwrap();
+    let out = nbody(&[
+        "sweep",
+        "--config",
+        config.to_str().unwrap(),
+        "--out",
+        dir.join("out").to_str().unwrap(),
+        "--no-calibration",
+        "--yes",
+    ]);
+    if out.status.success() {
+        Ok(std::fs::read_to_string(dir.join("out/from-file/results.json")).unwrap())
+    } else {
+        Err((out.status.code(), text(&out.stderr)))
+    }
+}
+
+#[test]
+fn a_sweep_starts_every_case_from_the_configs_file_of_bodies() {
+    let dir = tempfile::tempdir().unwrap();
+    export(
+        dir.path(),
+        "galaxy.txt",
+        &["--scenario", "galaxy", "-n", "64", "--seed", "9"],
+    );
+    let config = |n: usize, extra: &str| {
+        format!(
+            "name = \"from-file\"\nstudy = \"cartesian\"\nscenarios = [\"galaxy\"]\n\
+             kernels = [\"naive\", \"octree\"]\nn = [{n}]\nthreads = [1]\n\
+             initial = \"galaxy.txt\"\n{extra}\n[measure]\nwarmup_s = 0.001\nsamples = 2\n\
+             rounds = 1\nmin_sample_s = 0.001\n"
+        )
+    };
+    let results = sweep_config(dir.path(), &config(64, "")).unwrap();
+    let file: nbody_bench::records::results::ResultsFile = serde_json::from_str(&results).unwrap();
+    let record = file.metadata.initial.expect("the file recorded");
+    assert!(record.path.ends_with("galaxy.txt") && Path::new(&record.path).is_absolute());
+    assert_eq!((record.format.as_str(), record.bodies), ("export", 64));
+    assert_eq!(record.fnv1a.len(), 16);
+    assert!(file.cases.iter().all(|c| c.summary.is_some()));
+    // The file's n is the only n; a bad file is refused at its line; neither runs anything.
+    let (code, err) = sweep_config(dir.path(), &config(50, "")).unwrap_err();
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("64"), "{err}");
+    std::fs::write(
+        dir.path().join("galaxy.txt"),
+        "1 0 0 0 0 0 0\n1 0 0 x 0 0 0\n",
+    )
+    .unwrap();
+    let (code, err) = sweep_config(dir.path(), &config(2, "")).unwrap_err();
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("line 2"), "{err}");
+    let weak = config(2, "[weak]\nrule = \"linear\"\nbase_n = 2").replace("cartesian", "weak");
+    let (code, err) = sweep_config(dir.path(), &weak).unwrap_err();
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("initial"), "{err}");
+}

@@ -54,6 +54,9 @@ pub struct Context {
     pub nbody_bench: PathBuf,
     /// Case work directories are made under this one.
     pub(crate) work_root: PathBuf,
+    /// The config's `initial` file of bodies, resolved: the built-in kernels' cases start from it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) initial: Option<PathBuf>,
 }
 
 impl Context {

@@ -163,7 +163,7 @@ d=$(dirname "$json"); stat -c %a "$d" > '{log}'; echo "$d" >> '{log}'; echo junk
         #[cfg(feature = "test-slowdown")]
         slowdown: None,
     };
-    let err = measure_round(&launch, &case, &spec).unwrap_err();
+    let err = measure_round(&launch, &case, &spec, None).unwrap_err();
     std::fs::remove_file(&planted).unwrap();
     assert!(matches!(err, LaunchError::Result { .. }), "{err}");
     assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
