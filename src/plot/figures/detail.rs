@@ -13,8 +13,8 @@ pub struct PhaseTimes {
     pub phases: Vec<(String, f64)>,
 }
 
-/// One horizontal bar per case, split into phases: every phase name any case has, in order of
-/// first appearance (a case without it has none of that time).
+/// One horizontal bar per case, split into phases: every phase name any case spent time in, in
+/// order of first appearance (a case without it has none of that time).
 pub fn phase_breakdown(cases: &[PhaseTimes], caption: &str) -> StackedBars {
     let mut names: Vec<&str> = Vec::new();
     for (name, _) in cases.iter().flat_map(|c| &c.phases) {
@@ -39,7 +39,12 @@ pub fn phase_breakdown(cases: &[PhaseTimes], caption: &str) -> StackedBars {
         value_label: "time per step".into(),
         value_unit: Unit::Seconds,
         categories: cases.iter().map(|c| c.case.clone()).collect(),
-        segments: names.iter().map(|n| (n.to_string(), column(n))).collect(),
+        // A phase no case spent time in takes no colour: the others keep distinct ones.
+        segments: names
+            .iter()
+            .map(|n| (n.to_string(), column(n)))
+            .filter(|(_, values)| values.iter().any(|v| v.is_finite() && *v > 0.0))
+            .collect(),
     }
 }
 
@@ -251,7 +256,9 @@ mod tests {
         };
         let bars = phase_breakdown(&[case("a", 1e-3), case("b", 2e-3)], "");
         assert_eq!(bars.categories, ["a", "b"]);
-        assert_eq!(bars.segments[1].1, [1e-3, 2e-3]);
+        // `build` is zero in every case: left out.
+        assert_eq!(bars.segments[0].0, "interact");
+        assert_eq!(bars.segments[0].1, [1e-3, 2e-3]);
         // A program's own phases join the legend after the others; cases without them get none.
         let own = PhaseTimes {
             case: "c".into(),
@@ -259,9 +266,9 @@ mod tests {
         };
         let bars = phase_breakdown(&[case("a", 1e-3), own], "");
         let names: Vec<&str> = bars.segments.iter().map(|(n, _)| n.as_str()).collect();
-        assert_eq!(names, ["build", "interact", "integrate", "comm"]);
-        assert_eq!(bars.segments[3].1, [0.0, 3e-3]);
-        assert_eq!(bars.segments[1].1, [1e-3, 1e-3]);
+        assert_eq!(names, ["interact", "integrate", "comm"]);
+        assert_eq!(bars.segments[2].1, [0.0, 3e-3]);
+        assert_eq!(bars.segments[0].1, [1e-3, 1e-3]);
         let shares = phase_shares(&[case("a", 1e-3), case("b", 0.0)], "");
         let a: f64 = shares.segments.iter().map(|(_, v)| v[0]).sum();
         assert!((a - 1.0).abs() < 1e-12);
