@@ -52,7 +52,7 @@ fn own(sweeps: &[Sweep]) -> impl Iterator<Item = &Sweep> {
         .filter(|s| !super::sources_section::redoes_a_source_study(&s.analysis))
 }
 
-fn figure_links(md: &mut String, sweep: &Sweep, prefix: &str) {
+pub(super) fn figure_links(md: &mut String, sweep: &Sweep, prefix: &str) {
     for f in sweep.figures.iter().filter(|f| f.stem.starts_with(prefix)) {
         let _ = writeln!(md, "![{}]({}/{}.svg)\n", f.title, sweep.figures_dir, f.stem);
     }

@@ -7,6 +7,7 @@
 
 use super::Sweep;
 use super::keep::region;
+use super::sections::figure_links;
 use crate::analysis::Analysis;
 use crate::records::external::PhaseKind;
 use crate::render::tables;
@@ -20,12 +21,6 @@ pub(crate) fn redoes_a_source_study(a: &Analysis) -> bool {
 
 fn named<'a>(sweeps: &'a [Sweep], name: &str) -> Option<&'a Sweep> {
     sweeps.iter().find(|s| s.analysis.name == name)
-}
-
-fn figure_links(md: &mut String, sweep: &Sweep, prefix: &str) {
-    for f in sweep.figures.iter().filter(|f| f.stem.starts_with(prefix)) {
-        let _ = writeln!(md, "![{}]({}/{}.svg)\n", f.title, sweep.figures_dir, f.stem);
-    }
 }
 
 pub(crate) fn section(md: &mut String, sweeps: &[Sweep], no_notes: &str) {
