@@ -30,7 +30,8 @@ pub struct Point {
     pub theta: Option<f64>,
     /// MPI decomposition of a case run under a launcher.
     pub decomp: Option<Decomposition>,
-    /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases).
+    /// Mean over ranks of the time inside MPI calls and of the bytes sent, per step (MPI cases);
+    /// for an external program, its `comm` phases as it reports them.
     pub comm_s_per_step: Option<f64>,
     pub(crate) bytes_per_step: Option<f64>,
     /// Of `comm_s_per_step`, the part left after the estimated wait for slower ranks: moving
@@ -49,7 +50,7 @@ pub struct Point {
     pub ns_per_particle_step: f64,
     pub pair_evals_per_s: f64,
     pub phases: PhaseTimes,
-    /// The phases an external program timed itself (`phases`), in the config's order.
+    /// The phases an external program timed itself (`phases`), by name.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub named_phases: Vec<NamedPhase>,
     pub step_ns: StepPercentiles,
@@ -78,6 +79,12 @@ impl Point {
             .map(|s| s.trim_start_matches(['-', '_', '.']))
             .filter(|s| !s.is_empty());
         Some(short.unwrap_or(name).to_string())
+    }
+
+    /// The mean of the samples: the step time the means over runs (an external program's phases)
+    /// are shares of.
+    pub(crate) fn mean_step_s(&self) -> f64 {
+        self.samples.iter().sum::<f64>() / self.samples.len().max(1) as f64
     }
 
     /// Whether this case ran with `p` workers, `p` as a fit gives it back (a float).

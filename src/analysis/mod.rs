@@ -335,26 +335,21 @@ fn engine_serial_fraction(
     fit::timed_serial_fraction(&serial, &parallel).ok()
 }
 
-/// The serial fraction of an external program's one-worker case from the phases it timed:
-/// its `serial` phases against the rest (communication counts as parallel work); a program
-/// that times only its serial phases has the rest of its step time as the parallel part.
+/// The serial fraction of an external program's one-worker case from the phases it timed: its
+/// `serial` phases against its whole step (the mean step time of the runs the phases are means
+/// of), so that time no phase covers counts as the parallel part it most likely is.
 fn external_serial_fraction(one: &Point) -> Option<fit::TimedSerialFraction> {
-    let of = |keep: &dyn Fn(PhaseKind) -> bool| -> Vec<f64> {
-        one.named_phases
-            .iter()
-            .filter(|p| keep(p.kind))
-            .map(|p| p.s_per_step)
-            .collect()
-    };
-    let serial = of(&|k| k == PhaseKind::Serial);
+    let serial: Vec<f64> = one
+        .named_phases
+        .iter()
+        .filter(|p| p.kind == PhaseKind::Serial)
+        .map(|p| p.s_per_step)
+        .collect();
     if serial.is_empty() {
         return None;
     }
-    let mut parallel = of(&|k| k != PhaseKind::Serial);
-    if parallel.is_empty() {
-        parallel.push((one.median_s - serial.iter().sum::<f64>()).max(0.0));
-    }
-    fit::timed_serial_fraction(&serial, &parallel).ok()
+    let rest = (one.mean_step_s() - serial.iter().sum::<f64>()).max(0.0);
+    fit::timed_serial_fraction(&serial, &[rest]).ok()
 }
 
 fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {

@@ -44,14 +44,8 @@ pub(super) fn measure_case<C: Clock>(
             context.initial.as_deref(),
         )?);
     }
-    let bodies = context
-        .initial
-        .as_deref()
-        .map(crate::scenario::initial::read)
-        .transpose()?
-        .map(Arc::new);
     Ok(measure_round(
-        &case_setup(case, bodies),
+        &case_setup(case, context.bodies.clone()),
         case,
         kernel,
         spec,

@@ -199,6 +199,7 @@ pub fn run_sweep<C: Clock>(
     context.initial = initial
         .as_ref()
         .map(|(record, _)| PathBuf::from(&record.path));
+    context.bodies = initial.as_ref().map(|(_, bodies)| bodies.clone());
     for ext in &config.external {
         let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
         super::external::check_programs(ext, launcher, &context)?;
@@ -259,6 +260,20 @@ pub fn run_sweep<C: Clock>(
         results.calibration.start = cal;
     }
     if let Some((record, _)) = initial {
+        // A resumed sweep goes on from the same bodies, or not at all.
+        if let Some(before) = results.metadata.initial.as_ref()
+            && before.fnv1a != record.fnv1a
+            && !options.force
+        {
+            return Err(SweepError::Mismatch {
+                path: path.clone(),
+                what: "file of bodies",
+                detail: format!(
+                    "{} had fingerprint {}, now {}",
+                    record.path, before.fnv1a, record.fnv1a
+                ),
+            });
+        }
         results.metadata.initial = Some(record);
     }
     if results.metadata.externals.is_empty() && !config.external.is_empty() {
@@ -496,6 +511,7 @@ fn external_context(
         nbody_bench: absolute(nbody_bench),
         work_root: absolute(path.parent().unwrap_or(Path::new(".")).join("work")),
         initial: None,
+        bodies: None,
     })
 }
 

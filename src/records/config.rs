@@ -553,7 +553,8 @@ impl SweepConfig {
         };
         if !self.external.is_empty() {
             return Err(bad(
-                "starts the built-in kernels only: an [[external]] program reads a file of bodies                  through its own `setup` (e.g. `{nbody_bench} export --initial FILE --format \
+                "starts the built-in kernels only: an [[external]] program reads a file of bodies \
+                 through its own `setup` (e.g. `{nbody_bench} export --initial FILE --format \
                  lammps-data --out {workdir}/state.data`); drop one of the two",
             ));
         }

@@ -150,8 +150,8 @@ pub fn external_phases(a: &Analysis) -> String {
     ]);
     for c in cases {
         // The phases are means over the case's runs: their shares are of the mean step time
-        // of the same runs (of the median, a noisy case's phases could add up to over 100%).
-        let mean = c.samples.iter().sum::<f64>() / c.samples.len().max(1) as f64;
+        // of the same runs, not of the median.
+        let mean = c.mean_step_s();
         let step = mean.max(f64::MIN_POSITIVE);
         let share_of = |kind: PhaseKind| -> Option<f64> {
             let of: Vec<f64> = c

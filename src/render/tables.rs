@@ -151,7 +151,12 @@ pub fn complexity(a: &Analysis) -> String {
             format!("{}–{}", first.n, last.n),
             Duration(last.median_s).to_string(),
             format!("{:.1}", last.ns_per_particle_step),
-            format!("{:.2e}", last.pair_evals_per_s),
+            // An external program counts no pairs: none, rather than a rate of zero.
+            if last.pair_evals_per_s > 0.0 {
+                format!("{:.2e}", last.pair_evals_per_s)
+            } else {
+                NONE.to_string()
+            },
             peak,
             k,
             class,

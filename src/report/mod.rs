@@ -59,6 +59,16 @@ pub struct Sweep {
     pub figures: Vec<crate::render::figures::Figure>,
 }
 
+impl Sweep {
+    /// Links to this sweep's figures whose names start with `prefix`.
+    pub(crate) fn figure_links(&self, md: &mut String, prefix: &str) {
+        use std::fmt::Write;
+        for f in self.figures.iter().filter(|f| f.stem.starts_with(prefix)) {
+            let _ = writeln!(md, "![{}]({}/{}.svg)\n", f.title, self.figures_dir, f.stem);
+        }
+    }
+}
+
 /// What `generate` wrote.
 pub struct Generated {
     pub path: PathBuf,

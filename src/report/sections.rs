@@ -52,12 +52,6 @@ fn own(sweeps: &[Sweep]) -> impl Iterator<Item = &Sweep> {
         .filter(|s| !super::sources_section::redoes_a_source_study(&s.analysis))
 }
 
-pub(super) fn figure_links(md: &mut String, sweep: &Sweep, prefix: &str) {
-    for f in sweep.figures.iter().filter(|f| f.stem.starts_with(prefix)) {
-        let _ = writeln!(md, "![{}]({}/{}.svg)\n", f.title, sweep.figures_dir, f.stem);
-    }
-}
-
 fn machine(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## The machine and the sweeps\n\n");
     // The calibration that measured the most thread counts (a one-thread sweep does not
@@ -207,7 +201,7 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
             md.push_str(&tables::crossovers(a));
         }
         md.push('\n');
-        figure_links(md, s, "time-vs-n-");
+        s.figure_links(md, "time-vs-n-");
     }
     md.push_str(&region("complexity", NO_NOTES));
 }
@@ -233,9 +227,9 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
         md.push_str("\nTimed vs fitted serial fraction (the Barnes-Hut report's method next to the fit):\n\n");
         md.push_str(&tables::serial_comparisons(a));
         md.push('\n');
-        figure_links(md, s, "speedup-");
-        figure_links(md, s, "karp-flatt-");
-        figure_links(md, s, "phases-");
+        s.figure_links(md, "speedup-");
+        s.figure_links(md, "karp-flatt-");
+        s.figure_links(md, "phases-");
     }
     md.push_str(&region("strong", NO_NOTES));
 }
@@ -259,7 +253,7 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
         );
         md.push_str(&tables::weak(a));
         md.push('\n');
-        figure_links(md, s, "weak-efficiency-");
+        s.figure_links(md, "weak-efficiency-");
     }
     md.push_str(&region("weak", NO_NOTES));
 }
@@ -282,7 +276,7 @@ fn octree(md: &mut String, sweeps: &[Sweep]) {
         );
         md.push_str(&tables::theta(&s.analysis));
         md.push('\n');
-        figure_links(md, s, "octree-accuracy");
+        s.figure_links(md, "octree-accuracy");
     }
     md.push_str(&region("octree", NO_NOTES));
 }
@@ -333,7 +327,7 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
             md.push_str(&tables::strong(a));
             md.push('\n');
         }
-        figure_links(md, s, "octree-accuracy");
+        s.figure_links(md, "octree-accuracy");
     }
     md.push_str(&region("peers", NO_NOTES));
 }

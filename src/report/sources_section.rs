@@ -7,16 +7,23 @@
 
 use super::Sweep;
 use super::keep::region;
-use super::sections::figure_links;
 use crate::analysis::Analysis;
 use crate::records::external::PhaseKind;
 use crate::render::tables;
 use crate::units::Percent;
 use std::fmt::Write;
 
-/// The sweeps that redo the source documents' studies; the other sections leave them to this one.
+/// The sweeps this section shows; the other sections leave them to it.
+const SOURCE_STUDIES: [&str; 5] = [
+    "course-codes",
+    "seeds",
+    "seeds-weak",
+    "seeds-weak-time",
+    "seeds-mpi-strong",
+];
+
 pub(crate) fn redoes_a_source_study(a: &Analysis) -> bool {
-    a.name == "course-codes" || a.name == "seeds" || a.name.starts_with("seeds-")
+    SOURCE_STUDIES.contains(&a.name.as_str())
 }
 
 fn named<'a>(sweeps: &'a [Sweep], name: &str) -> Option<&'a Sweep> {
@@ -65,7 +72,7 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
             md.push('\n');
             md.push_str(&tables::serial_comparisons(a));
             md.push('\n');
-            figure_links(md, s, "speedup-");
+            s.figure_links(md, "speedup-");
         }
     }
     for (name, what) in [
@@ -118,7 +125,7 @@ fn lj_box(md: &mut String, sweeps: &[Sweep]) {
     md.push_str(&tables::peers(a));
     md.push('\n');
     if !a.strong.is_empty() {
-        md.push_str("From 1 to 2 workers, every code (÷ the calibrated ceiling):\n\n");
+        md.push_str("Every code over its workers (÷ the calibrated ceiling for threads):\n\n");
         md.push_str(&tables::strong(a));
         md.push('\n');
     }
@@ -127,7 +134,7 @@ fn lj_box(md: &mut String, sweeps: &[Sweep]) {
         md.push_str(&tables::complexity(a));
         md.push('\n');
     }
-    figure_links(md, s, "phases-");
+    s.figure_links(md, "phases-");
     if named(sweeps, "seeds").is_some_and(|s| !s.analysis.complexity.is_empty()) {
         md.push_str(
             "`results/seeds` measures our kernels alone over the same range on all three systems \
@@ -150,26 +157,23 @@ fn coulomb(md: &mut String, sweeps: &[Sweep]) {
         .collect();
     cases.sort_by_key(|c| (c.ranks, c.n));
     for c in cases {
-        let of = |kind: PhaseKind| -> f64 {
-            c.named_phases
-                .iter()
-                .filter(|p| p.kind == kind)
-                .map(|p| p.s_per_step)
-                .sum()
-        };
-        let comm = of(PhaseKind::Comm);
-        let compute = of(PhaseKind::Parallel) + of(PhaseKind::Serial);
-        if comm + compute <= 0.0 {
+        let comm: f64 = c
+            .named_phases
+            .iter()
+            .filter(|p| p.kind == PhaseKind::Comm)
+            .map(|p| p.s_per_step)
+            .sum();
+        let step = c.mean_step_s();
+        if step <= 0.0 {
             continue;
         }
         lines.push(format!(
-            "- n = {}, {} ranks{}: communication {} of the timed phases (the slowest rank's \
-             Allgatherv, its wait for the others included), computation {}",
+            "- n = {}, {} ranks{}: communication {} of the step (the Allgatherv, the wait for \
+             slower ranks included, as the mean over ranks), computation the rest",
             c.n,
             c.ranks,
             tables::over(c.oversubscribed),
-            Percent(comm / (comm + compute)),
-            Percent(compute / (comm + compute)),
+            Percent(comm / step),
         ));
     }
     if lines.is_empty() {

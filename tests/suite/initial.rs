@@ -421,6 +421,28 @@ fn a_sweep_starts_every_case_from_the_configs_file_of_bodies() {
     assert_eq!((record.format.as_str(), record.bodies), ("export", 64));
     assert_eq!(record.fnv1a.len(), 16);
     assert!(file.cases.iter().all(|c| c.summary.is_some()));
+    // Other bodies in the same file do not resume the sweep that started from the old ones.
+    std::fs::remove_file(dir.path().join("galaxy.txt")).unwrap();
+    export(
+        dir.path(),
+        "galaxy.txt",
+        &["--scenario", "galaxy", "-n", "64", "--seed", "10"],
+    );
+    let resumed = nbody(&[
+        "sweep",
+        "--config",
+        dir.path().join("from-file.toml").to_str().unwrap(),
+        "--out",
+        dir.path().join("out").to_str().unwrap(),
+        "--resume",
+        "--no-calibration",
+    ]);
+    assert_eq!(resumed.status.code(), Some(2));
+    assert!(
+        text(&resumed.stderr).contains("fingerprint"),
+        "{}",
+        text(&resumed.stderr)
+    );
     // The file's n is the only n; a bad file is refused at its line; neither runs anything.
     let (code, err) = sweep_config(dir.path(), &config(50, "")).unwrap_err();
     assert_eq!(code, Some(2), "{err}");

@@ -57,6 +57,10 @@ pub struct Context {
     /// The config's `initial` file of bodies, resolved: the built-in kernels' cases start from it.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub(crate) initial: Option<PathBuf>,
+    /// Its bodies as read before the sweep started (the ones its fingerprint describes), for the
+    /// cases measured in this process.
+    #[serde(skip)]
+    pub(crate) bodies: Option<std::sync::Arc<crate::scenario::initial::InitialBodies>>,
 }
 
 impl Context {

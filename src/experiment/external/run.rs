@@ -1,7 +1,7 @@
 //! One round of an external case: the set-up command, untimed warm-up runs, the launch
 //! overhead of the empty run (wall timing), then one run per sample. A run that fails (exit
-//! status, timeout, no match of `check` or of the time regex) is kept as an error with the
-//! program's last lines of output, and the round goes on.
+//! status, timeout, no match of `check`, of the time regex, of a phase or of `force_error`) is
+//! kept as an error with the program's last lines of output, and the round goes on.
 
 use super::process::{self, Finished, Launch};
 use super::{Context, ExternalError, OVERHEAD_WARN};
@@ -313,7 +313,7 @@ fn sample(
     let mut phase_s = BTreeMap::new();
     for (name, re, unit) in phases {
         let t = match last_number(re, done) {
-            // A phase the run did not enter (no output written, say) takes no time.
+            // Zero is a duration: a phase the run did not enter (no frame written, say).
             Some(Ok(t)) if t.is_finite() && t >= 0.0 => t * unit,
             Some(Ok(t)) => {
                 return fail(format!(
