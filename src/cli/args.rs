@@ -46,6 +46,10 @@ pub enum Command {
     /// Compare a sweep's results with a baseline, case by case; exit 1 if a case got slower
     /// beyond the threshold (with its whole confidence interval), 2 for bad input.
     Gate(GateArgs),
+    /// Measure the gate's false-alarm rate and power on this machine: many gate decisions on
+    /// unchanged code and with one kernel slowed by 5, 10 and 25% (needs the `test-slowdown`
+    /// feature); writes results/gate-study/<machine class>.json.
+    GateStudy(GateStudyArgs),
     /// Measure MPI ping-pong and Allgatherv times over message sizes, for the latency-bandwidth
     /// model (needs the `mpi` feature; run under `mpirun -n 2` or more).
     MpiBench(MpiBenchArgs),
@@ -644,6 +648,11 @@ pub struct GateArgs {
     /// case, the sweep's calibration, or nothing; auto takes the best both files have.
     #[arg(long, value_enum, default_value = "auto")]
     pub normalize: nbody_bench::gate::NormalizationChoice,
+    /// Which ratio a case is judged on: the normalised one, the raw one, or both (a change is
+    /// claimed only when both show it, the rule the gate's noise study chose; see
+    /// docs/explanation/gate.md).
+    #[arg(long, value_enum, default_value = "both")]
+    pub judge: nbody_bench::gate::Judged,
     /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
     #[arg(long)]
     pub force: bool,
@@ -651,6 +660,40 @@ pub struct GateArgs {
     /// cannot be compared (a file without them) is then an error (exit 2), not a pass.
     #[arg(long)]
     pub fail_on_work_change: bool,
+}
+
+#[derive(Debug, Args)]
+#[command(
+    long_about = "Measure the gate's false-alarm rate and power on this machine.\n\n        One long interleaved run is cut into disjoint blocks. Each block measures every case         of the gate's config (this machine class's baseline's) as two sides of the same code, A         and B, and the slowed kernel's cases at 5, 10 and 25% slower (the test-only knob),         each for the rounds and samples one gate decision takes. Every block gives an A/B         decision (A against B) and a fast-path decision (B against the committed baseline), on         unchanged code and at each slowdown, judged under each rule and candidate threshold.         The summary goes to results/gate-study/<machine class>.json (a run of the same load and         mode replaces the earlier one), the raw measurements to         results/runs/gate-study/<UTC time>/raw.json. Run it on a quiet machine, under the lock         the gate uses (flock /tmp/nbody-bench.lock).",
+    after_help = "Examples:\n  cargo build --release --features test-slowdown\n      flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --blocks 120\n      flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --load spin --blocks 60\n      flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --duet --blocks 30\n      nbody-bench gate-study --docs     # docs/explanation/gate.md's tables from the study files"
+)]
+pub struct GateStudyArgs {
+    /// Blocks to measure: one decision per mode and slowdown each.
+    #[arg(long, default_value_t = 120, value_parser = clap::value_parser!(u64).range(1..=10_000))]
+    pub blocks: u64,
+    /// What else runs meanwhile: nothing, or a process spinning on one CPU.
+    #[arg(long, value_enum, default_value = "quiet")]
+    pub load: nbody_bench::gate::study::Load,
+    /// Measure the two sides at the same moment, one per CPU (A/A only).
+    #[arg(long, conflicts_with = "load")]
+    pub duet: bool,
+    /// The kernel made slower for the power decisions.
+    #[arg(long, value_enum, default_value = "octree")]
+    pub slow: nbody_bench::kernels::KernelKind,
+    /// The folder of baselines: this machine class's file gives the config and the fast
+    /// path's reference.
+    #[arg(long, value_name = "DIR", default_value = "results/baseline")]
+    pub baseline: PathBuf,
+    /// Study this config instead (A/B decisions only, unless it is the baseline's).
+    #[arg(long, value_name = "FILE|NAME")]
+    pub config: Option<PathBuf>,
+    /// Folder of the study files.
+    #[arg(long, value_name = "DIR", default_value = "results/gate-study")]
+    pub out: PathBuf,
+    /// Measure nothing: rewrite the generated tables of docs/explanation/gate.md from the
+    /// study files of --out.
+    #[arg(long, conflicts_with_all = ["duet", "config"])]
+    pub docs: bool,
 }
 
 #[derive(Debug, Args)]

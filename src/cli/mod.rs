@@ -10,6 +10,7 @@ mod export;
 mod fit;
 mod fit_tables;
 mod gate;
+mod gate_study;
 mod init;
 mod list;
 mod mpi;
@@ -35,6 +36,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Report(args) => report::report(args),
         Command::Fit(args) => fit::fit(args),
         Command::Gate(args) => gate::gate(args),
+        Command::GateStudy(args) => gate_study::gate_study(args),
         Command::MpiBench(args) => mpi::bench(args),
         Command::MpiCheck(args) => mpi::check(args),
         Command::Export(args) => export::export(args),

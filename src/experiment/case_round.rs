@@ -54,7 +54,7 @@ pub(super) fn measure_case<C: Clock>(
 }
 
 /// The system a case measures: the seeded placement, or the config's file of bodies.
-pub(super) fn case_setup(case: &Case, bodies: Option<Arc<InitialBodies>>) -> Setup {
+pub(crate) fn case_setup(case: &Case, bodies: Option<Arc<InitialBodies>>) -> Setup {
     let mut setup = Setup::new(case.scenario);
     setup.n = Some(case.n);
     setup.seed = case.seed;

@@ -16,3 +16,5 @@ pub mod runner;
 #[cfg(feature = "test-slowdown")]
 pub mod slowdown;
 pub mod slurm;
+
+pub(crate) use case_round::case_setup;

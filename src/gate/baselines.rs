@@ -2,9 +2,18 @@
 //! the class it runs on (the fast path); a machine class with no file of its own gets A/B
 //! against the newest file's commit. Each class CI has run on thus keeps its fast path, and a
 //! new class costs one A/B run until its baseline is committed next to the others.
+//!
+//! A baseline is swept again from the config it stores, resolved when it was measured (every
+//! key written out, defaults included, by the build its metadata names), never from its TOML
+//! text read under today's defaults: a default that changes later does not change what the
+//! gate measures. A baseline this build cannot reproduce (a key, kernel or schema it no
+//! longer has, or cases it would plan differently) is [`Fitness::Stale`]: the gate then says
+//! why and measures A/B against the baseline's commit; `tests/suite/gate_baselines.rs` keeps
+//! every committed baseline reproducible.
 
 use super::RunInfo;
-use crate::records::results::{ResultsError, ResultsFile};
+use crate::records::config::SweepConfig;
+use crate::records::results::{RESULTS_SCHEMA, ResultsError, ResultsFile};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -12,7 +21,149 @@ use thiserror::Error;
 #[derive(Debug)]
 pub struct Chosen {
     pub path: PathBuf,
+    /// Where it comes from (read even from a file this build can no longer load).
+    pub info: RunInfo,
+    pub fitness: Fitness,
+}
+
+/// Whether this build can sweep a baseline's config again and get the baseline's cases.
+#[derive(Debug)]
+pub enum Fitness {
+    Reproducible(Box<Reproducible>),
+    /// Why not, in one line.
+    Stale(String),
+}
+
+/// A baseline this build reproduces.
+#[derive(Debug)]
+pub struct Reproducible {
     pub file: ResultsFile,
+    /// Its stored config, as this build parsed it.
+    pub config: SweepConfig,
+    /// The stored config as TOML text: what the gate sweeps and what an A/B run gives both
+    /// builds (the base build resolved it itself, so it knows every key).
+    pub text: String,
+}
+
+impl Fitness {
+    /// The reproducible baseline, if it is one.
+    pub fn reproducible(&self) -> Option<&Reproducible> {
+        match self {
+            Fitness::Reproducible(r) => Some(r),
+            Fitness::Stale(_) => None,
+        }
+    }
+}
+
+/// Reads one baseline and judges whether this build reproduces it. Only a file that is not a
+/// results file at all (unreadable, not JSON, no commit or machine recorded) is an error: that
+/// needs the user, while a stale one only needs the A/B route.
+pub fn examine(path: &Path) -> Result<Chosen, BaselinesError> {
+    let text = crate::input::read_text(path).map_err(|source| ResultsError::Read {
+        path: path.into(),
+        source,
+    })?;
+    let value: serde_json::Value =
+        serde_json::from_str(&text).map_err(|e| ResultsError::Corrupt {
+            path: path.into(),
+            detail: e.to_string(),
+        })?;
+    let info = RunInfo::from_json(&value).ok_or_else(|| ResultsError::Corrupt {
+        path: path.into(),
+        detail: "no metadata.git_commit or machine calibration: not a baseline".into(),
+    })?;
+    let fitness = match ResultsFile::load(path) {
+        Err(ResultsError::Schema { found, .. }) => Fitness::Stale(format!(
+            "its schema `{found}` is not this build's `{RESULTS_SCHEMA}`"
+        )),
+        Err(e) => Fitness::Stale(format!("this build cannot read it ({e})")),
+        Ok(file) => match reproduce(path, &value, file) {
+            Ok(r) => Fitness::Reproducible(Box::new(r)),
+            Err(why) => Fitness::Stale(why),
+        },
+    };
+    Ok(Chosen {
+        path: path.to_path_buf(),
+        info,
+        fitness,
+    })
+}
+
+/// The baseline's stored config (the raw JSON `value["config"]`, as the build that measured it
+/// resolved it) parsed and planned by this build: the cases must be the baseline's, key for key.
+fn reproduce(
+    path: &Path,
+    value: &serde_json::Value,
+    file: ResultsFile,
+) -> Result<Reproducible, String> {
+    let text = resolved_text(&value["config"])
+        .map_err(|e| format!("its stored config has no TOML form ({e})"))?;
+    let config = SweepConfig::parse(&text, path)
+        .map_err(|e| format!("this build refuses its stored config: {e}"))?;
+    let planned: Vec<String> = crate::records::plan::cases(&config)
+        .iter()
+        .map(|c| c.key())
+        .collect();
+    let stored: Vec<String> = file.cases.iter().map(|c| c.key.clone()).collect();
+    if planned != stored {
+        let only = |a: &[String], b: &[String]| {
+            a.iter()
+                .filter(|k| !b.contains(k))
+                .cloned()
+                .collect::<Vec<_>>()
+        };
+        let (new, gone) = (only(&planned, &stored), only(&stored, &planned));
+        return Err(format!(
+            "this build plans other cases from its stored config (would measure [{}], which it              does not have; has [{}], which this build would not measure)",
+            new.join(", "),
+            gone.join(", ")
+        ));
+    }
+    Ok(Reproducible { file, config, text })
+}
+
+/// A stored config (JSON) as TOML text, nulls left out (TOML has none: an absent key is the
+/// same `None`).
+pub fn resolved_text(config: &serde_json::Value) -> Result<String, String> {
+    fn strip(v: &serde_json::Value) -> serde_json::Value {
+        match v {
+            serde_json::Value::Object(map) => map
+                .iter()
+                .filter(|(_, v)| !v.is_null())
+                .map(|(k, v)| (k.clone(), strip(v)))
+                .collect(),
+            serde_json::Value::Array(items) => items.iter().map(strip).collect(),
+            other => other.clone(),
+        }
+    }
+    if !config.is_object() {
+        return Err("not a table".into());
+    }
+    let table = toml::Value::try_from(strip(config)).map_err(|e| e.to_string())?;
+    let body = toml::to_string(&table).map_err(|e| e.to_string())?;
+    Ok(format!(
+        "# The sweep's config as it was resolved when measured: every key written out.\n{body}"
+    ))
+}
+
+/// Every `.json` file of `dir`, sorted, each examined ([`examine`]): what the compatibility
+/// test walks.
+pub fn examine_all(dir: &Path) -> Result<Vec<Chosen>, BaselinesError> {
+    json_files(dir)?.iter().map(|p| examine(p)).collect()
+}
+
+fn json_files(dir: &Path) -> Result<Vec<PathBuf>, BaselinesError> {
+    let read_err = |source| BaselinesError::Read {
+        path: dir.to_path_buf(),
+        source,
+    };
+    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map_err(read_err)?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    paths.sort();
+    Ok(paths)
 }
 
 #[derive(Debug, Error)]
@@ -33,38 +184,21 @@ pub enum BaselinesError {
 
 /// The file of `dir` measured on `here`'s machine class (the newest, if several are), else the
 /// newest file of all, marked as of another class. Every `.json` file in `dir` must be a
-/// results file: a corrupt one is an error, not skipped, so that a broken baseline is seen.
+/// results file: a corrupt one is an error, not skipped, so that a broken baseline is seen; a
+/// stale one is chosen as any other and marked so.
 pub fn choose(dir: &Path, here: &RunInfo) -> Result<Chosen, BaselinesError> {
-    let read_err = |source| BaselinesError::Read {
-        path: dir.to_path_buf(),
-        source,
-    };
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(dir)
-        .map_err(read_err)?
-        .filter_map(|entry| entry.ok().map(|e| e.path()))
-        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    paths.sort();
-    let mut files = Vec::with_capacity(paths.len());
-    for path in paths {
-        let file = ResultsFile::load(&path)?;
-        files.push((path, file));
-    }
-    let newest = |candidates: Vec<(PathBuf, ResultsFile)>| {
+    let files = examine_all(dir)?;
+    let newest = |candidates: Vec<Chosen>| {
         candidates
             .into_iter()
-            .max_by(|a, b| a.1.metadata.started.cmp(&b.1.metadata.started))
+            .max_by(|a, b| a.info.started.cmp(&b.info.started))
     };
     let (same, other): (Vec<_>, Vec<_>) = files
         .into_iter()
-        .partition(|(_, f)| RunInfo::of(f).machine_class_differs(here).is_none());
-    if let Some((path, file)) = newest(same) {
-        return Ok(Chosen { path, file });
-    }
-    match newest(other) {
-        Some((path, file)) => Ok(Chosen { path, file }),
-        None => Err(BaselinesError::Empty(dir.to_path_buf())),
-    }
+        .partition(|c| c.info.machine_class_differs(here).is_none());
+    newest(same)
+        .or_else(|| newest(other))
+        .ok_or_else(|| BaselinesError::Empty(dir.to_path_buf()))
 }
 
 /// A file name for a baseline of `info`'s machine class: `ci-<vendor>-<family>-<model>-

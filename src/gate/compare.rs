@@ -2,13 +2,14 @@
 //! verdict, and the exact comparison of the work counters.
 
 use super::checks::{calibrated_rate, check_comparable};
+use super::family::{FAMILY_ALPHA, Tails, holm};
 use super::{
-    CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, MAX_THRESHOLD, MIN_CI_SAMPLES,
-    MissingCase, Normalization, NormalizationChoice, RunInfo, Verdict, WorkChange,
+    CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, Judged, MAX_THRESHOLD,
+    MIN_CI_SAMPLES, MissingCase, Normalization, NormalizationChoice, RunInfo, Verdict, WorkChange,
 };
 use crate::kernels::WorkCounters;
 use crate::records::results::{CaseRecord, ResultsFile};
-use crate::stats::{bootstrap_ratio_ci, median};
+use crate::stats::{bootstrap_medians, interval95, median};
 
 /// Compares `current` against `baseline`; see the module documentation for the rules.
 pub fn compare(
@@ -28,6 +29,8 @@ pub fn compare(
         missing: Vec::new(),
         extra: Vec::new(),
         warnings,
+        judged_on: options.judge,
+        family_alpha: FAMILY_ALPHA,
     };
     for base in &baseline.cases {
         let missing = |reason: &str| MissingCase {
@@ -62,6 +65,7 @@ pub fn compare(
             report.cases.push(case);
         }
     }
+    apply_family_rule(&mut report.cases);
     report.extra = current
         .cases
         .iter()
@@ -95,15 +99,14 @@ fn compare_case(
     let ratio = median_of(&c) / median_of(&b);
     // A seed per case that does not depend on the case's position.
     let seed = options.seed ^ crate::records::results::fnv1a(base.key.as_bytes());
-    // A side without a positive sample has no interval, and no change is claimed.
-    let ci95 = bootstrap_ratio_ci(&b, &c, options.resamples, seed).unwrap_or([f64::NAN; 2]);
     let t = options.threshold;
-    let verdict = if ci95[0] > 1.0 + t {
-        Verdict::Regressed
-    } else if ci95[1] < 1.0 - t {
-        Verdict::Improved
-    } else {
-        Verdict::Unchanged
+    // A side without a positive sample has no interval, and no change is claimed.
+    let (ci95, tails) = ratio_interval(&b, &c, options.resamples, seed, t);
+    let (raw_ci95, raw_tails) = ratio_interval(&b_raw, &c_raw, options.resamples, seed, t);
+    let p = match options.judge {
+        Judged::Normalized => tails,
+        Judged::Raw => raw_tails,
+        Judged::Both => tails.both(raw_tails),
     };
     let (work_changes, work_compared, mut notes) = compare_work(base, cur);
     for (record, which) in [(base, "baseline"), (cur, "current")] {
@@ -122,18 +125,62 @@ fn compare_case(
     }
     Ok(CaseComparison {
         key: base.key.clone(),
-        verdict,
         normalization,
         baseline_median_s: bm,
         current_median_s: cm,
         raw_ratio: cm / bm,
         ratio,
         ci95,
+        raw_ci95,
+        p,
+        p_normalized: tails,
+        p_raw: raw_tails,
+        // Set across cases by the family-wise rule, once every case has its p-values.
+        verdict: Verdict::Unchanged,
         samples: [b_raw.len(), c_raw.len()],
         work_changes,
         work_compared,
         notes,
     })
+}
+
+/// The bootstrap 95% interval of median(current) / median(baseline) and its one-sided
+/// p-values against the threshold's margins (NaN and no claim when a side is empty).
+pub(super) fn ratio_interval(
+    baseline: &[f64],
+    current: &[f64],
+    resamples: usize,
+    seed: u64,
+    threshold: f64,
+) -> ([f64; 2], Tails) {
+    if baseline.is_empty() || current.is_empty() {
+        return ([f64::NAN; 2], Tails::NONE);
+    }
+    let replicates =
+        bootstrap_medians(&[baseline, current], resamples, seed, |m| Some(m[1] / m[0]));
+    let ci = interval95(replicates.iter().copied()).unwrap_or([f64::NAN; 2]);
+    (ci, Tails::of(&replicates, threshold))
+}
+
+/// Holm's step-down over the judged cases, for regressions and improvements separately, at
+/// [`FAMILY_ALPHA`] each: the gate run as a whole flags an unchanged case with at most that
+/// probability however many cases it judges.
+pub(super) fn apply_family_rule(cases: &mut [CaseComparison]) {
+    let regressed: Vec<f64> = cases.iter().map(|c| c.p.regressed).collect();
+    let improved: Vec<f64> = cases.iter().map(|c| c.p.improved).collect();
+    let (up, down) = (
+        holm(&regressed, FAMILY_ALPHA),
+        holm(&improved, FAMILY_ALPHA),
+    );
+    for (i, case) in cases.iter_mut().enumerate() {
+        case.verdict = if up[i] {
+            Verdict::Regressed
+        } else if down[i] {
+            Verdict::Improved
+        } else {
+            Verdict::Unchanged
+        };
+    }
 }
 
 /// Every raw sample of a case (seconds per step), in round order.

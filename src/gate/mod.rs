@@ -21,7 +21,12 @@ pub mod base_build;
 pub mod baselines;
 mod checks;
 mod compare;
+pub mod drive;
+pub mod family;
 mod render;
+pub mod route;
+pub mod save;
+pub mod study;
 #[cfg(test)]
 mod tests;
 
@@ -29,6 +34,7 @@ pub use checks::{
     BUSY_BASELINE_CPUS, RATE_TOLERANCE, background_cpus, calibrated_rate, prefix, rates_differ,
 };
 pub use compare::{check_threshold, compare};
+pub use family::Tails;
 pub use render::{Format, render};
 
 use crate::records::results::ResultsFile;
@@ -68,6 +74,8 @@ pub struct GateOptions {
     pub normalization: NormalizationChoice,
     /// A change of the work counters makes the gate fail too (exit 1).
     pub fail_on_work_change: bool,
+    /// Which ratio a case is judged on.
+    pub judge: Judged,
     /// Bootstrap resamples per case, and the seed they start from (with the case key mixed in).
     pub resamples: usize,
     pub seed: u64,
@@ -80,6 +88,7 @@ impl Default for GateOptions {
             force: false,
             normalization: NormalizationChoice::Auto,
             fail_on_work_change: false,
+            judge: Judged::Both,
             resamples: 4000,
             seed: 0x9a7e,
         }
@@ -95,6 +104,20 @@ pub enum NormalizationChoice {
     Reference,
     Calibration,
     None,
+}
+
+/// The ratio a case is judged on. The normalised ratio cancels the machine's speed and
+/// load, but the reference workload can speed up more than the kernels (a run on a quieter
+/// machine than its baseline's then reads slower); the raw ratio is fair only between runs
+/// measured side by side. `Both` claims a change only when both ratios show it (an
+/// intersection-union test, at the same level): the rule the gate's noise study chose
+/// (docs/explanation/gate.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Judged {
+    Normalized,
+    Raw,
+    Both,
 }
 
 /// What the case's times were divided by before comparing.
@@ -125,9 +148,10 @@ impl Normalization {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
-    /// The whole CI of the ratio lies above 1 + threshold.
+    /// Slower by more than the threshold, with the family-wise error of [`family`]: the
+    /// case's p-value for "at most 1 + threshold" passed Holm's step-down over the cases.
     Regressed,
-    /// The whole CI lies below 1 − threshold.
+    /// Faster by more than the threshold, by the same rule below 1 − threshold.
     Improved,
     Unchanged,
 }
@@ -155,8 +179,15 @@ pub struct CaseComparison {
     pub(crate) raw_ratio: f64,
     /// Ratio current / baseline of the normalised medians: the statistic.
     pub ratio: f64,
-    /// Bootstrap 95% confidence interval of `ratio`.
+    /// Bootstrap 95% confidence interval of `ratio` (of the case alone).
     pub ci95: [f64; 2],
+    /// Bootstrap 95% confidence interval of `raw_ratio`.
+    pub raw_ci95: [f64; 2],
+    /// One-sided p-values the verdict comes from (of the ratio the gate judges on).
+    pub p: family::Tails,
+    /// Those of the normalised ratio and of the raw ratio alone.
+    pub p_normalized: family::Tails,
+    pub p_raw: family::Tails,
     /// Samples in each run.
     pub samples: [usize; 2],
     /// Deterministic work counters that differ between the runs.
@@ -226,6 +257,28 @@ impl RunInfo {
         None
     }
 
+    /// From a results file's JSON, read field by field so that a file this build can no
+    /// longer load still says where it comes from; `None` without a commit.
+    pub fn from_json(value: &serde_json::Value) -> Option<RunInfo> {
+        let text = |v: &serde_json::Value| v.as_str().map(str::to_string);
+        let meta = &value["metadata"];
+        let cal = [&value["calibration"]["start"], &value["calibration"]["end"]]
+            .into_iter()
+            .find(|c| c.is_object());
+        let field = |name: &str| cal.and_then(|c| text(&c[name]));
+        Some(RunInfo {
+            git_commit: text(&meta["git_commit"])?,
+            git_dirty: meta["git_dirty"].as_bool().unwrap_or(false),
+            started: text(&meta["started"]).unwrap_or_default(),
+            host: text(&meta["host"]).unwrap_or_default(),
+            cpu_model: field("cpu_model"),
+            cpu_signature: field("cpu_signature"),
+            logical_cpus: cal
+                .and_then(|c| c["logical_cpus"].as_u64())
+                .map(|n| n as usize),
+        })
+    }
+
     pub fn of(file: &ResultsFile) -> RunInfo {
         let cal = file
             .calibration
@@ -258,6 +311,10 @@ pub struct GateReport {
     /// Cases only the current run measured.
     pub extra: Vec<String>,
     pub warnings: Vec<String>,
+    /// Which ratio the cases were judged on.
+    pub judged_on: Judged,
+    /// Family-wise error of the run's regressions (Holm's step-down over its cases).
+    pub family_alpha: f64,
 }
 
 impl GateReport {
@@ -278,13 +335,14 @@ impl GateReport {
         self.count(Verdict::Regressed) > 0 || (self.fail_on_work_change && self.work_changed() > 0)
     }
 
-    /// 2 when baseline cases could not be compared (the comparison is incomplete, whatever
-    /// else it found), 1 when something regressed, else 0.
+    /// 1 when something regressed (whatever else the run found: a regression is never
+    /// hidden behind another exit code), else 2 when baseline cases could not be compared
+    /// (an incomplete comparison is not a pass), else 0.
     pub fn exit_code(&self) -> i32 {
-        if !self.missing.is_empty() {
-            2
-        } else if self.failed() {
+        if self.failed() {
             1
+        } else if !self.missing.is_empty() {
+            2
         } else {
             0
         }

@@ -592,3 +592,57 @@ fn calibrated_rates_too_far_apart_are_named() {
         report.warnings
     );
 }
+
+/// `n` samples of `level` with ±2% uniform noise.
+fn noisy(rng: &mut Pcg64Mcg, n: usize, level: f64) -> Vec<f64> {
+    (0..n)
+        .map(|_| level * (1.0 + 0.02 * (2.0 * rng.random::<f64>() - 1.0)))
+        .collect()
+}
+
+/// Twenty unchanged cases per gate run, judged at threshold 0 (each ratio's true value on the
+/// margin: the hardest null): judged alone at 2.5% each, some case is flagged in a large share
+/// of runs; under Holm's step-down the share of runs with any flagged case stays near the
+/// stated family-wise 2.5%. A case 10% slower among nineteen unchanged ones is flagged.
+#[test]
+fn the_family_wise_rule_holds_its_rate_over_twenty_cases() {
+    use super::compare::ratio_interval;
+    use super::family::{FAMILY_ALPHA, holm};
+    let mut rng = Pcg64Mcg::seed_from_u64(SEED_1);
+    let runs = 200;
+    let (mut alone, mut family) = (0, 0);
+    for run in 0..runs {
+        let p: Vec<f64> = (0..20)
+            .map(|case| {
+                let (b, c) = (noisy(&mut rng, 16, 1.0), noisy(&mut rng, 16, 1.0));
+                ratio_interval(&b, &c, 1000, (run * 20 + case) as u64, 0.0)
+                    .1
+                    .regressed
+            })
+            .collect();
+        alone += usize::from(p.iter().any(|&p| p <= FAMILY_ALPHA));
+        family += usize::from(holm(&p, FAMILY_ALPHA).contains(&true));
+    }
+    let (alone, family) = (alone as f64 / runs as f64, family as f64 / runs as f64);
+    assert!(alone > 0.2, "case by case: {alone}");
+    assert!(family <= 0.05, "family-wise: {family}");
+
+    let mut caught = 0;
+    for run in 0..50 {
+        let p: Vec<f64> = (0..20)
+            .map(|case| {
+                let slower = if case == 7 { 1.10 } else { 1.0 };
+                let (b, c) = (noisy(&mut rng, 16, 1.0), noisy(&mut rng, 16, slower));
+                ratio_interval(&b, &c, 1000, (run * 20 + case) as u64, 0.03)
+                    .1
+                    .regressed
+            })
+            .collect();
+        let flagged = holm(&p, FAMILY_ALPHA);
+        caught += usize::from(flagged[7] && flagged.iter().filter(|&&f| f).count() == 1);
+    }
+    assert!(
+        caught >= 48,
+        "the 10% case flagged alone in {caught} of 50 runs"
+    );
+}

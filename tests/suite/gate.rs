@@ -496,3 +496,41 @@ fn a_folder_of_baselines_gives_each_machine_class_its_own() {
     std::fs::create_dir(&empty).unwrap();
     assert_bad_input(&gate(&empty, &base, &[]), "holds no .json results file");
 }
+
+/// A baseline of this machine class that this build cannot reproduce (here: a key it does not
+/// know) is never a refusal: the gate says why in one line and measures the baseline's commit
+/// and this build side by side, sweeping configs/ci.toml with both.
+#[test]
+fn a_stale_baseline_of_this_class_takes_a_b_with_a_notice() {
+    let _serial = serial();
+    let (repo, target) = same_tree_repo();
+    let head = git(repo.path(), &["rev-parse", "HEAD"]);
+    std::fs::create_dir_all(repo.path().join("configs")).unwrap();
+    std::fs::write(repo.path().join("configs/ci.toml"), TINY).unwrap();
+    let folder = repo.path().join("baseline");
+    std::fs::create_dir(&folder).unwrap();
+    let stale = edited(&folder, "stale.json", |v| {
+        v["metadata"]["git_commit"] = head.clone().into();
+        v["config"]["retired_key"] = 1.into();
+        for side in ["start", "end"] {
+            let c = &mut v["calibration"][side];
+            c["cpu_model"] = nbody_bench::calibrate::cpu_model().into();
+            c["cpu_signature"] = nbody_bench::calibrate::cpu_signature().into();
+            c["logical_cpus"] = nbody_bench::run::logical_cpus().into();
+        }
+    });
+    assert!(stale.starts_with(&folder));
+    let o = bin()
+        .current_dir(repo.path())
+        .env("CARGO_TARGET_DIR", &target)
+        .args(["gate", "--baseline", "baseline", "--rounds", "2"])
+        .args(["--out", "stale", "--format", "json", "--threshold", "0.75"])
+        .output()
+        .unwrap();
+    let err = text(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("cannot be reproduced by this build"), "{err}");
+    assert!(err.contains("retired_key"), "{err}");
+    assert!(err.contains("A/B"), "{err}");
+    assert_eq!(verdicts(&o).len(), 3, "TINY's three cases, by both builds");
+}

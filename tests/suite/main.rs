@@ -20,6 +20,7 @@ mod external;
 mod external_phases;
 mod fit_cli;
 mod gate;
+mod gate_baselines;
 mod gate_refusals;
 mod init;
 mod initial;

@@ -1,0 +1,300 @@
+//! The tables of docs/explanation/gate.md, generated from the committed study files: the
+//! gate's false alarms and power as it is configured, and the measurements its rule,
+//! thresholds and mode were chosen from.
+
+use super::decide::Mode;
+use super::{Load, SLOWDOWNS, StudyFile, StudyRun};
+use crate::gate::{AB_THRESHOLD, FILE_THRESHOLD, GateOptions, Judged};
+use crate::render::tables::{Align, Table};
+
+/// Marks of the generated region in docs/explanation/gate.md.
+pub const BEGIN: &str =
+    "<!-- generated from results/gate-study/ by `nbody-bench gate-study --docs`: do not edit -->";
+pub const END: &str = "<!-- end of generated region -->";
+
+fn threshold(mode: Mode) -> f64 {
+    match mode {
+        Mode::Ab => AB_THRESHOLD,
+        Mode::Fast => FILE_THRESHOLD,
+    }
+}
+
+fn condition(run: &StudyRun) -> String {
+    match (run.duet, run.load) {
+        (true, _) => "duet (both sides at once, one per CPU)".into(),
+        (false, Load::Quiet) => "quiet".into(),
+        (false, Load::Spin) => "a process spinning on one CPU".into(),
+    }
+}
+
+fn percent(x: f64) -> String {
+    format!("{:.1}%", 100.0 * x)
+}
+
+/// "k/n (r%, 95% CI a–b%)", or "–" when the study made no such decision.
+fn cell(run: &StudyRun, mode: Mode, rule: Judged, threshold: f64, slowdown: f64) -> String {
+    match run.tally(mode, rule, threshold, slowdown) {
+        Some(t) if t.decisions > 0 => {
+            let (rate, [lo, hi]) = t.rate();
+            let k = if slowdown == 1.0 {
+                t.any_flagged
+            } else {
+                t.exactly_slowed
+            };
+            format!(
+                "{k}/{} ({}, {}–{})",
+                t.decisions,
+                percent(rate),
+                percent(lo),
+                percent(hi)
+            )
+        }
+        _ => "–".into(),
+    }
+}
+
+/// The generated region: for every study file (machine class), the gate as configured, the
+/// three rules side by side, the thresholds, and the interval widths of each mode.
+pub fn markdown(files: &[StudyFile]) -> String {
+    let rule = GateOptions::default().judge;
+    let mut s = String::new();
+    if files.is_empty() {
+        s += "No study file is committed yet: `nbody-bench gate-study` measures one.\n";
+    }
+    for file in files {
+        s += &format!(
+            "\n#### {} ({}, {} logical CPUs, SIMD {})\n\n",
+            file.class(),
+            file.cpu_model,
+            file.logical_cpus,
+            file.simd
+        );
+        s += &format!(
+            "Config `{}`; fast-path decisions against {}.\n\n",
+            file.config_name,
+            file.baseline
+                .as_deref()
+                .map_or("no baseline (none was committed)".into(), |b| format!(
+                    "`{b}`"
+                ))
+        );
+        s += "**The gate as configured** (rule `";
+        s += &format!(
+            "{}`, thresholds {} A/B and {} fast path): decisions that flagged any case on \
+             unchanged code (false alarms), and that flagged exactly the slowed kernel's cases \
+             (power), with 95% Clopper–Pearson intervals.\n\n",
+            rule_name(rule),
+            AB_THRESHOLD,
+            FILE_THRESHOLD
+        );
+        let mut header = vec![
+            "condition".to_string(),
+            "mode".into(),
+            "decisions measured in".into(),
+            "false alarms (A/A)".into(),
+        ];
+        header.extend(
+            SLOWDOWNS
+                .iter()
+                .map(|f| format!("{:.0}% slower", (f - 1.0) * 100.0)),
+        );
+        let columns = header.len();
+        let mut t = Table::new(header).aligned(
+            [Align::Default, Align::Default]
+                .into_iter()
+                .chain(std::iter::repeat_n(Align::Right, columns - 2)),
+        );
+        for run in &file.runs {
+            for mode in [Mode::Ab, Mode::Fast] {
+                if run.tally(mode, rule, threshold(mode), 1.0).is_none() {
+                    continue;
+                }
+                let mut row = vec![
+                    condition(run),
+                    mode.name().to_string(),
+                    format!("{:.1} s", run.decision_measure_s),
+                    cell(run, mode, rule, threshold(mode), 1.0),
+                ];
+                row.extend(
+                    SLOWDOWNS
+                        .iter()
+                        .map(|&f| cell(run, mode, rule, threshold(mode), f)),
+                );
+                t.row(row);
+            }
+        }
+        s += &t.markdown();
+        s += &rules_table(file);
+        s += &thresholds_table(file);
+        s += &widths_table(file);
+        for run in &file.runs {
+            s += &format!(
+                "\n- {}: {} blocks of {} rounds x {} samples per side, slowed kernel `{}`, \
+                 measured {} (commit {}{}), {:.0} s per block.\n",
+                condition(run),
+                run.blocks,
+                run.rounds,
+                run.samples_per_round,
+                run.slowed_kernel.name(),
+                run.started,
+                crate::gate::prefix(&run.git_commit, 10),
+                if run.git_dirty {
+                    ", uncommitted changes"
+                } else {
+                    ""
+                },
+                run.block_wall_s
+            );
+        }
+    }
+    s
+}
+
+fn rule_name(rule: Judged) -> &'static str {
+    match rule {
+        Judged::Normalized => "normalized",
+        Judged::Raw => "raw",
+        Judged::Both => "both",
+    }
+}
+
+/// Each rule at the configured thresholds: false alarms and power, every condition.
+fn rules_table(file: &StudyFile) -> String {
+    let mut t = Table::new([
+        "condition",
+        "mode",
+        "rule",
+        "false alarms (A/A)",
+        "10% slower",
+        "25% slower",
+    ])
+    .aligned([
+        Align::Default,
+        Align::Default,
+        Align::Default,
+        Align::Right,
+        Align::Right,
+        Align::Right,
+    ]);
+    let mut any = false;
+    for run in file.runs.iter().filter(|r| !r.duet) {
+        for mode in [Mode::Ab, Mode::Fast] {
+            for rule in super::decide::RULES {
+                if run.tally(mode, rule, threshold(mode), 1.0).is_none() {
+                    continue;
+                }
+                any = true;
+                t.row([
+                    condition(run),
+                    mode.name().to_string(),
+                    rule_name(rule).to_string(),
+                    cell(run, mode, rule, threshold(mode), 1.0),
+                    cell(run, mode, rule, threshold(mode), 1.10),
+                    cell(run, mode, rule, threshold(mode), 1.25),
+                ]);
+            }
+        }
+    }
+    if !any {
+        return String::new();
+    }
+    format!(
+        "\n**The rules compared** (normalised ratio, raw ratio, both), at the configured \
+         thresholds:\n\n{}",
+        t.markdown()
+    )
+}
+
+/// Each candidate threshold under the configured rule, quiet machine.
+fn thresholds_table(file: &StudyFile) -> String {
+    let rule = GateOptions::default().judge;
+    let mut t = Table::new([
+        "condition",
+        "mode",
+        "threshold",
+        "false alarms (A/A)",
+        "5% slower",
+        "10% slower",
+        "25% slower",
+    ])
+    .aligned([
+        Align::Default,
+        Align::Default,
+        Align::Right,
+        Align::Right,
+        Align::Right,
+        Align::Right,
+        Align::Right,
+    ]);
+    let mut any = false;
+    for run in file.runs.iter().filter(|r| !r.duet) {
+        for mode in [Mode::Ab, Mode::Fast] {
+            for &th in mode.candidates() {
+                if run.tally(mode, rule, th, 1.0).is_none() {
+                    continue;
+                }
+                any = true;
+                t.row([
+                    condition(run),
+                    mode.name().to_string(),
+                    format!("{th}"),
+                    cell(run, mode, rule, th, 1.0),
+                    cell(run, mode, rule, th, 1.05),
+                    cell(run, mode, rule, th, 1.10),
+                    cell(run, mode, rule, th, 1.25),
+                ]);
+            }
+        }
+    }
+    if !any {
+        return String::new();
+    }
+    format!(
+        "\n**The thresholds compared** (rule `{}`):\n\n{}",
+        rule_name(rule),
+        t.markdown()
+    )
+}
+
+/// Median relative width of A/A decisions' per-case 95% intervals, each condition and mode.
+fn widths_table(file: &StudyFile) -> String {
+    let mut t = Table::new(["condition", "mode", "normalised ratio", "raw ratio"]).aligned([
+        Align::Default,
+        Align::Default,
+        Align::Right,
+        Align::Right,
+    ]);
+    let mut any = false;
+    for run in &file.runs {
+        for w in &run.widths {
+            any = true;
+            t.row([
+                condition(run),
+                w.mode.name().to_string(),
+                percent(w.normalized),
+                percent(w.raw),
+            ]);
+        }
+    }
+    if !any {
+        return String::new();
+    }
+    format!(
+        "\n**Interval widths on unchanged code** (median over cases and decisions of the 95% \
+         interval's width over the ratio):\n\n{}",
+        t.markdown()
+    )
+}
+
+/// `page` with its generated region replaced by `region`; `None` when the page has no
+/// region marks.
+pub fn splice(page: &str, region: &str) -> Option<String> {
+    let start = page.find(BEGIN)? + BEGIN.len();
+    let end = start + page[start..].find(END)?;
+    Some(format!(
+        "{}\n{}\n{}",
+        &page[..start],
+        region.trim(),
+        &page[end..]
+    ))
+}
