@@ -44,7 +44,7 @@ pub enum Command {
     /// file); hand-written text between `<!-- keep:NAME -->` markers is kept.
     Report(ReportArgs),
     /// Compare a sweep's results with a baseline, case by case; exit 1 if a case got slower
-    /// beyond the threshold (with its whole confidence interval), 2 for bad input.
+    /// beyond the threshold (held across all the cases judged), 2 for bad input.
     Gate(GateArgs),
     /// Measure the gate's false-alarm rate and power on this machine: many gate decisions on
     /// unchanged code and with one kernel slowed by 5, 10 and 25% (needs the `test-slowdown`
@@ -579,16 +579,18 @@ pub struct FitArgs {
 #[derive(Debug, Args)]
 #[command(
     long_about = "Compare this build's timings with a baseline, case by case; exit 1 if a case got \
-        slower beyond the threshold (with its whole confidence interval), 2 for bad input or a \
-        comparison that cannot be made.\n\n\
+        slower beyond the threshold (at a family-wise error of 2.5% over all the cases judged, \
+        Holm's step-down on bootstrap p-values), 2 for bad input or a comparison that cannot \
+        be made.\n\n\
         The baseline is a results file or a folder of them, one per machine class (CPU model, \
         CPU signature, logical CPUs): from a folder the gate takes the file of the class it \
         compares with, else the newest.\n\n\
         Three ways:\n\
         - with --current: compare two results files (they must come from one machine class);\n\
-        - without --current: the gate sweeps the baseline's config with this build; if the \
-        baseline comes from this machine class it is compared with the baseline file (the fast \
-        path), else the gate builds the baseline's revision (a git worktree, cached in \
+        - without --current: the gate sweeps the config stored in the baseline (every key as \
+        it was resolved when measured) with this build; if the baseline comes from this \
+        machine class and this build reproduces it, it is compared with the baseline file (the \
+        fast path), else (another class, or a stale baseline: the gate says why) the gate builds the baseline's revision (a git worktree, cached in \
         target/gate-base/) and measures both builds here, interleaved case by case (A/B);\n\
         - with --against REV: always A/B against REV.\n\n\
         --save-baseline RESULTS files a sweep of the baseline's config as this machine class's \
@@ -634,11 +636,11 @@ pub struct GateArgs {
     /// Where a measuring gate keeps what it measured [default: results/runs/gate/<UTC time>/].
     #[arg(long, value_name = "DIR", conflicts_with = "current")]
     pub out: Option<PathBuf>,
-    /// Relative slowdown a case must exceed, with its whole 95% CI, to count as a regression
-    /// (0.10 = 10%); the same margin below 1 counts as an improvement [default: 0.10 for two
-    /// files and for A/B runs, 0.25 when the gate sweeps and compares with a baseline file
-    /// measured at another time: the margins the gate's noise studies found safe];
-    /// at most 1 (a doubling).
+    /// Relative slowdown a case must exceed to count as a regression (0.03 = 3%), at a
+    /// family-wise error of 2.5% over all the cases judged (Holm); the same margin below 1
+    /// counts as an improvement [default: 0.03 for A/B runs, 0.10 when the gate compares with
+    /// a baseline file measured at another time (the fast path, and two files): the smallest
+    /// margins with no false alarm in the gate's noise study]; at most 1 (a doubling).
     #[arg(long, value_parser = parse_threshold, allow_hyphen_values = true)]
     pub threshold: Option<f64>,
     /// Output format; markdown is made for a CI job summary.
@@ -649,10 +651,11 @@ pub struct GateArgs {
     #[arg(long, value_enum, default_value = "auto")]
     pub normalize: nbody_bench::gate::NormalizationChoice,
     /// Which ratio a case is judged on: the normalised one, the raw one, or both (a change is
-    /// claimed only when both show it, the rule the gate's noise study chose; see
-    /// docs/explanation/gate.md).
-    #[arg(long, value_enum, default_value = "both")]
-    pub judge: nbody_bench::gate::Judged,
+    /// claimed only when both show it) [default: raw for A/B runs, where interleaving keeps raw
+    /// times fair; both for the fast path and two files, measured at different times: the
+    /// rules the gate's noise study chose, docs/explanation/gate.md].
+    #[arg(long, value_enum)]
+    pub judge: Option<nbody_bench::gate::Judged>,
     /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
     #[arg(long)]
     pub force: bool,
@@ -664,8 +667,22 @@ pub struct GateArgs {
 
 #[derive(Debug, Args)]
 #[command(
-    long_about = "Measure the gate's false-alarm rate and power on this machine.\n\n        One long interleaved run is cut into disjoint blocks. Each block measures every case         of the gate's config (this machine class's baseline's) as two sides of the same code, A         and B, and the slowed kernel's cases at 5, 10 and 25% slower (the test-only knob),         each for the rounds and samples one gate decision takes. Every block gives an A/B         decision (A against B) and a fast-path decision (B against the committed baseline), on         unchanged code and at each slowdown, judged under each rule and candidate threshold.         The summary goes to results/gate-study/<machine class>.json (a run of the same load and         mode replaces the earlier one), the raw measurements to         results/runs/gate-study/<UTC time>/raw.json. Run it on a quiet machine, under the lock         the gate uses (flock /tmp/nbody-bench.lock).",
-    after_help = "Examples:\n  cargo build --release --features test-slowdown\n      flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --blocks 120\n      flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --load spin --blocks 60\n      flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --duet --blocks 30\n      nbody-bench gate-study --docs     # docs/explanation/gate.md's tables from the study files"
+    long_about = "Measure the gate's false-alarm rate and power on this machine.\n\n\
+        One long interleaved run is cut into disjoint blocks. Each block measures every case \
+        of the gate's config (this machine class's baseline's) as two sides of the same code, A \
+        and B, and the slowed kernel's cases at 5, 10 and 25% slower (the test-only knob), \
+        each for the rounds and samples one gate decision takes. Every block gives an A/B \
+        decision (A against B) and a fast-path decision (B against the committed baseline), on \
+        unchanged code and at each slowdown, judged under each rule and candidate threshold. \
+        The summary goes to results/gate-study/<machine class>.json (a run of the same load and \
+        mode replaces the earlier one), the raw measurements to \
+        results/runs/gate-study/<UTC time>/raw.json. Run it on a quiet machine, under the lock \
+        the gate uses (flock /tmp/nbody-bench.lock).",
+    after_help = "Examples:\n  cargo build --release --features test-slowdown\n  \
+    flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --blocks 125\n  \
+    flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --load spin --blocks 50\n  \
+    flock /tmp/nbody-bench.lock target/release/nbody-bench gate-study --duet --blocks 30\n  \
+    nbody-bench gate-study --docs     # docs/explanation/gate.md's tables from the study files"
 )]
 pub struct GateStudyArgs {
     /// Blocks to measure: one decision per mode and slowdown each.
@@ -692,8 +709,12 @@ pub struct GateStudyArgs {
     pub out: PathBuf,
     /// Measure nothing: rewrite the generated tables of docs/explanation/gate.md from the
     /// study files of --out.
-    #[arg(long, conflicts_with_all = ["duet", "config"])]
+    #[arg(long, conflicts_with_all = ["duet", "config", "from"])]
     pub docs: bool,
+    /// Measure nothing: summarise this raw file of an earlier run
+    /// (results/runs/gate-study/<UTC time>/raw.json) into its class's study file again.
+    #[arg(long, value_name = "RAW", conflicts_with_all = ["duet", "config"])]
+    pub from: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]

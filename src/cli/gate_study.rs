@@ -12,6 +12,15 @@ pub fn gate_study(args: GateStudyArgs) -> anyhow::Result<i32> {
     if args.docs {
         return write_docs(&args.out);
     }
+    if let Some(raw) = &args.from {
+        let study = run::resummarise(raw, &args.baseline, &args.out)?;
+        eprintln!(
+            "gate-study: {} summarised into {}",
+            raw.display(),
+            study.display()
+        );
+        return Ok(0);
+    }
     measure(args)
 }
 

@@ -5,8 +5,8 @@
 use super::ab::{self, AbPlan};
 use super::route::{self, Route, short};
 use super::{
-    AB_THRESHOLD, FILE_THRESHOLD, GateOptions, GateReport, Judged, NormalizationChoice, base_build,
-    compare,
+    AB_JUDGE, AB_THRESHOLD, FILE_JUDGE, FILE_THRESHOLD, GateOptions, GateReport, Judged,
+    NormalizationChoice, base_build, compare,
 };
 use crate::experiment::estimate::{self, Done};
 use crate::experiment::runner::{SweepOptions, run_sweep_wall};
@@ -36,7 +36,8 @@ pub struct Request {
     pub out: Option<PathBuf>,
     pub threshold: Option<f64>,
     pub normalize: NormalizationChoice,
-    pub judge: Judged,
+    /// The ratio cases are judged on [default: each mode's, `AB_JUDGE` or `FILE_JUDGE`].
+    pub judge: Option<Judged>,
     pub force: bool,
     pub fail_on_work_change: bool,
 }
@@ -86,13 +87,13 @@ pub fn run(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Result<Outco
     Ok(outcome)
 }
 
-fn options(request: &Request, default_threshold: f64) -> GateOptions {
+fn options(request: &Request, default_threshold: f64, default_judge: Judged) -> GateOptions {
     GateOptions {
         threshold: request.threshold.unwrap_or(default_threshold),
         force: request.force,
         normalization: request.normalize,
         fail_on_work_change: request.fail_on_work_change,
-        judge: request.judge,
+        judge: request.judge.unwrap_or(default_judge),
         ..GateOptions::default()
     }
 }
@@ -109,7 +110,11 @@ fn compare_files(request: &Request, current: &Path) -> anyhow::Result<Outcome> {
         ResultsFile::load(&locate::find_results(&request.baseline, root)?)?
     };
     Ok(Outcome {
-        report: compare(&baseline, &current, &options(request, AB_THRESHOLD))?,
+        report: compare(
+            &baseline,
+            &current,
+            &options(request, FILE_THRESHOLD, FILE_JUDGE),
+        )?,
         kept_in: None,
     })
 }
@@ -309,7 +314,11 @@ fn fast_path(
         let prepared = prepare_a_b(request, &rev, config, text, say)?;
         return a_b(request, &prepared, config, text, out, say);
     }
-    let judged = compare(baseline, &current, &options(request, FILE_THRESHOLD))?;
+    let judged = compare(
+        baseline,
+        &current,
+        &options(request, FILE_THRESHOLD, FILE_JUDGE),
+    )?;
     say(&format!("results kept in {}", out.display()));
     Ok(judged)
 }
@@ -363,7 +372,7 @@ fn a_b(
     }
     results.base.save(&out.join("base.json"))?;
     results.current.save(&out.join("current.json"))?;
-    let mut opts = options(request, AB_THRESHOLD);
+    let mut opts = options(request, AB_THRESHOLD, AB_JUDGE);
     // Each build times its own copy of the reference workload. If that copy itself got faster
     // or slower (another compiler, profile or SIMD dispatch), dividing by it would hide or
     // invent a change of the kernels: then judge raw times, which interleaving keeps fair.

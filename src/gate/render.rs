@@ -60,6 +60,15 @@ fn normalizations(report: &GateReport) -> String {
         .join("; ")
 }
 
+/// Which ratio the verdicts come from, in words.
+fn judged_on(judged: super::Judged) -> &'static str {
+    match judged {
+        super::Judged::Normalized => "the normalised ratio",
+        super::Judged::Raw => "the raw ratio",
+        super::Judged::Both => "the normalised and the raw ratio both",
+    }
+}
+
 fn percent(fraction: f64) -> String {
     let p = format!("{:.2}", fraction * 100.0);
     p.trim_end_matches('0').trim_end_matches('.').to_string()
@@ -87,7 +96,14 @@ fn text(report: &GateReport) -> String {
     let _ = writeln!(s, "gate {verdict}: {}", headline(report));
     let _ = writeln!(s, "baseline {}", origin(&report.baseline));
     let _ = writeln!(s, "current  {}", origin(&report.current));
-    let _ = writeln!(s, "times normalised by {}\n", normalizations(report));
+    let _ = writeln!(s, "times normalised by {}", normalizations(report));
+    let _ = writeln!(
+        s,
+        "a case regresses above {:.2} ({}), family-wise error {}% over the cases (Holm)\n",
+        1.0 + report.threshold,
+        judged_on(report.judged_on),
+        percent(report.family_alpha)
+    );
     let width = report
         .cases
         .iter()
@@ -136,12 +152,16 @@ fn markdown(report: &GateReport) -> String {
     let _ = writeln!(s, "{}.\n", headline(report));
     let _ = writeln!(
         s,
-        "Baseline `{}`, current `{}`; times normalised by {}. A case regresses when the whole \
-         95% CI of the ratio current / baseline lies above {:.2}.\n",
+        "Baseline `{}`, current `{}`; times normalised by {}. A case regresses when its ratio \
+         current / baseline lies above {:.2} ({}), at a family-wise error of {}% over the {} \
+         cases (Holm's step-down on one-sided bootstrap p-values).\n",
         origin(&report.baseline),
         origin(&report.current),
         normalizations(report),
-        1.0 + report.threshold
+        1.0 + report.threshold,
+        judged_on(report.judged_on),
+        percent(report.family_alpha),
+        report.cases.len()
     );
     // Numbers line up on their last digit; the case and the verdict are words.
     let (word, number) = (Align::Default, Align::Right);

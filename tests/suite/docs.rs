@@ -344,3 +344,26 @@ fn every_relative_link_of_the_docs_leads_somewhere() {
     }
     assert!(broken.is_empty(), "broken links: {broken:#?}");
 }
+
+/// The gate page's figures are the committed study files', through the generator: its
+/// generated region equals `gate-study --docs`'s (rewritten under `UPDATE=1`), and every study
+/// file of a committed baseline's machine class reads back.
+#[test]
+fn the_gate_page_tables_come_from_the_study_files() {
+    use nbody_bench::gate::study::{run, table};
+    let files = run::study_files(&root().join("results/gate-study")).unwrap();
+    let path = root().join("docs/explanation/gate.md");
+    let page = std::fs::read_to_string(&path).unwrap();
+    let generated = table::splice(&page, &table::markdown(&files))
+        .expect("docs/explanation/gate.md keeps its generated region's marks");
+    if std::env::var(UPDATE).as_deref() == Ok("1") {
+        std::fs::write(&path, &generated).unwrap();
+        return;
+    }
+    assert!(
+        page == generated,
+        "docs/explanation/gate.md's study tables are stale ({}): `nbody-bench gate-study \
+         --docs` regenerates them",
+        first_difference(&page, &generated)
+    );
+}

@@ -143,6 +143,7 @@ fn same_code_passes_and_a_slower_kernel_is_flagged_alone() {
         &["--threshold", "0.75", "--format", "markdown"],
     );
     let md = text(&o.stdout);
+    assert_eq!(o.status.code(), Some(1), "markdown: {md}");
     assert!(
         md.starts_with("### Performance gate: regression found"),
         "{md}"
@@ -151,6 +152,28 @@ fn same_code_passes_and_a_slower_kernel_is_flagged_alone() {
         md.contains("| `lj-box/symmetric/n=1000/p=1/r=1/seed=1` |"),
         "{md}"
     );
+    let o = gate(&base, &slow, &["--threshold", "0.75"]);
+    assert_eq!(o.status.code(), Some(1), "text: {}", text(&o.stdout));
+
+    // Through the CI script too, with and without a job summary to append to.
+    let summary = dir.path().join("summary.md");
+    for job_summary in [false, true] {
+        let mut cmd =
+            Command::new(Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/ci-gate.sh"));
+        cmd.env("NBODY_BENCH_BIN", env!("CARGO_BIN_EXE_nbody-bench"))
+            .env("NBODY_BENCH_GATE_BASELINE", &base)
+            .env("NBODY_BENCH_GATE_CURRENT", &slow)
+            .env("NBODY_BENCH_GATE_THRESHOLD", "0.75")
+            .env_remove("NBODY_BENCH_GATE_AGAINST")
+            .env_remove("GITHUB_STEP_SUMMARY");
+        if job_summary {
+            cmd.env("GITHUB_STEP_SUMMARY", &summary);
+        }
+        let o = cmd.output().unwrap();
+        assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
+    }
+    let appended = std::fs::read_to_string(&summary).unwrap();
+    assert!(appended.contains("regression found"), "{appended}");
 }
 
 /// A committed baseline: a real results file of some machine class.

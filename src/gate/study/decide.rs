@@ -78,11 +78,26 @@ pub struct Widths {
     pub raw: f64,
 }
 
+/// What a slowdown of the force computation made of the slowed kernel's whole step: the median
+/// over decisions and cases of the ratio the gate saw (the step also builds, integrates and
+/// applies the walls, which the knob leaves alone).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct StepRatio {
+    pub mode: Mode,
+    pub slowdown: f64,
+    pub normalized: f64,
+    pub raw: f64,
+}
+
 /// Every tally of a measured study; `baseline` is the class's baseline file for the fast
 /// path (none: no fast-path decisions).
-pub fn tally(raw: &RawStudy, baseline: Option<&ResultsFile>) -> (Vec<Tally>, Vec<Widths>) {
+pub fn tally(
+    raw: &RawStudy,
+    baseline: Option<&ResultsFile>,
+) -> (Vec<Tally>, Vec<Widths>, Vec<StepRatio>) {
     let mut tallies: Vec<Tally> = Vec::new();
     let mut widths: Vec<(Mode, Vec<f64>, Vec<f64>)> = Vec::new();
+    let mut steps: Vec<(Mode, f64, Vec<f64>, Vec<f64>)> = Vec::new();
     let levels: Vec<f64> = std::iter::once(1.0)
         .chain(if raw.duet {
             Vec::new()
@@ -98,6 +113,16 @@ pub fn tally(raw: &RawStudy, baseline: Option<&ResultsFile>) -> (Vec<Tally>, Vec
             .collect()
     };
     for outcome in judged.into_iter().flatten() {
+        if outcome.slowdown != 1.0 {
+            let (mode, level) = (outcome.mode, outcome.slowdown);
+            match steps.iter_mut().find(|s| s.0 == mode && s.1 == level) {
+                Some(s) => {
+                    s.2.extend(&outcome.slowed.0);
+                    s.3.extend(&outcome.slowed.1)
+                }
+                None => steps.push((mode, level, outcome.slowed.0, outcome.slowed.1)),
+            }
+        }
         if outcome.slowdown == 1.0 {
             match widths.iter_mut().find(|w| w.0 == outcome.mode) {
                 Some(w) => {
@@ -148,7 +173,16 @@ pub fn tally(raw: &RawStudy, baseline: Option<&ResultsFile>) -> (Vec<Tally>, Vec
             raw: median(&r),
         })
         .collect();
-    (tallies, widths)
+    let steps = steps
+        .into_iter()
+        .map(|(mode, slowdown, n, r)| StepRatio {
+            mode,
+            slowdown,
+            normalized: median(&n),
+            raw: median(&r),
+        })
+        .collect();
+    (tallies, widths, steps)
 }
 
 /// Per case of a decision: (is the slowed kernel's, flagged as regressed).
@@ -162,6 +196,8 @@ struct Outcome {
     flags: Vec<(Judged, f64, CaseFlags)>,
     /// Per-case interval widths, normalised and raw (A/A decisions).
     widths: (Vec<f64>, Vec<f64>),
+    /// The slowed kernel's cases' ratios, normalised and raw (slowdown decisions).
+    slowed: (Vec<f64>, Vec<f64>),
 }
 
 fn judge_block(
@@ -182,6 +218,7 @@ fn judge_block(
         for (mode, base) in pairs {
             let mut flags = Vec::new();
             let mut widths = (Vec::new(), Vec::new());
+            let mut slowed = (Vec::new(), Vec::new());
             for &threshold in mode.candidates() {
                 let options = GateOptions {
                     threshold,
@@ -195,10 +232,16 @@ fn judge_block(
                 if !report.missing.is_empty() {
                     continue;
                 }
-                if widths.0.is_empty() {
+                if widths.0.is_empty() && slowed.0.is_empty() {
+                    let target = format!("/{}/", raw.slowed_kernel.name());
                     for c in &report.cases {
-                        widths.0.push((c.ci95[1] - c.ci95[0]) / c.ratio);
-                        widths.1.push((c.raw_ci95[1] - c.raw_ci95[0]) / c.raw_ratio);
+                        if slowdown == 1.0 {
+                            widths.0.push((c.ci95[1] - c.ci95[0]) / c.ratio);
+                            widths.1.push((c.raw_ci95[1] - c.raw_ci95[0]) / c.raw_ratio);
+                        } else if c.key.contains(&target) {
+                            slowed.0.push(c.ratio);
+                            slowed.1.push(c.raw_ratio);
+                        }
                     }
                 }
                 for rule in RULES {
@@ -211,6 +254,7 @@ fn judge_block(
                     slowdown,
                     flags,
                     widths,
+                    slowed,
                 });
             }
         }

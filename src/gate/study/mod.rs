@@ -109,12 +109,15 @@ pub struct StudyRun {
     pub decision_measure_s: f64,
     pub tallies: Vec<decide::Tally>,
     pub widths: Vec<decide::Widths>,
+    /// What each slowdown of the force computation made of the slowed kernel's step.
+    #[serde(default)]
+    pub step_ratios: Vec<decide::StepRatio>,
 }
 
 impl StudyRun {
     /// The summary of a measured run.
     pub fn of(raw: &RawStudy, baseline: Option<&crate::records::results::ResultsFile>) -> Self {
-        let (tallies, widths) = decide::tally(raw, baseline);
+        let (tallies, widths, step_ratios) = decide::tally(raw, baseline);
         let walls: Vec<f64> = raw.blocks.iter().map(|b| b.wall_s).collect();
         let block_wall_s = crate::stats::median(&walls).unwrap_or(f64::NAN);
         // The two sides' share of a block: A and B of every case against the slowed sides.
@@ -139,7 +142,16 @@ impl StudyRun {
             decision_measure_s: crate::stats::median(&decision).unwrap_or(f64::NAN),
             tallies,
             widths,
+            step_ratios,
         }
+    }
+
+    /// The median step ratio of the slowed kernel's cases at `slowdown` (A/B, normalised).
+    pub fn step_ratio(&self, slowdown: f64) -> Option<f64> {
+        self.step_ratios
+            .iter()
+            .find(|s| s.mode == decide::Mode::Ab && s.slowdown == slowdown)
+            .map(|s| s.normalized)
     }
 
     /// Its tally of `mode`, `rule`, `threshold` and `slowdown`.

@@ -31,18 +31,45 @@ pub struct StudyPaths {
     pub raw: PathBuf,
 }
 
+/// This machine class's reproducible baseline in `dir`: its file name and contents.
+fn own_baseline(dir: &Path) -> Option<(PathBuf, Box<baselines::Reproducible>)> {
+    let here = this_machine();
+    let chosen = baselines::choose(dir, &here).ok()?;
+    if chosen.info.machine_class_differs(&here).is_some() {
+        return None;
+    }
+    match chosen.fitness {
+        Fitness::Reproducible(r) => Some((chosen.path, r)),
+        Fitness::Stale(_) => None,
+    }
+}
+
+/// Summarises a raw file measured earlier (after a change of how decisions are judged) into
+/// its class's study file, against this class's baseline in `baselines`; the file's path.
+pub fn resummarise(raw_path: &Path, baselines: &Path, out: &Path) -> anyhow::Result<PathBuf> {
+    let text = crate::input::read_text(raw_path)
+        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", raw_path.display()))?;
+    let raw: RawStudy = serde_json::from_str(&text)
+        .map_err(|e| anyhow::anyhow!("{}: not a gate-study raw file ({e})", raw_path.display()))?;
+    if raw.schema != STUDY_SCHEMA {
+        anyhow::bail!(
+            "{}: schema `{}`, this build reads `{STUDY_SCHEMA}`",
+            raw_path.display(),
+            raw.schema
+        );
+    }
+    let own = own_baseline(baselines).filter(|(_, r)| r.config == raw.config);
+    let name = own
+        .as_ref()
+        .and_then(|(p, _)| p.file_name().map(|n| n.to_string_lossy().into_owned()));
+    summarise(&raw, own.as_ref().map(|(_, r)| &r.file), name, out)
+}
+
 /// Measures and summarises; `say` hears the plan and every block. Only in a build with the
 /// `test-slowdown` feature: the study slows a kernel on purpose.
 #[cfg(feature = "test-slowdown")]
 pub fn run(options: &StudyOptions, say: &mut dyn FnMut(&str)) -> anyhow::Result<StudyPaths> {
-    let here = this_machine();
-    let chosen = baselines::choose(&options.baselines, &here).ok();
-    let own = chosen
-        .filter(|c| c.info.machine_class_differs(&here).is_none())
-        .and_then(|c| match c.fitness {
-            Fitness::Reproducible(r) => Some((c.path, r)),
-            Fitness::Stale(_) => None,
-        });
+    let own = own_baseline(&options.baselines);
     let (config, baseline, baseline_name) = match (own, &options.config) {
         (_, Some((config, _))) => (config.clone(), None, None),
         (Some((path, r)), None) => {

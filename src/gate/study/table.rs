@@ -4,7 +4,7 @@
 
 use super::decide::Mode;
 use super::{Load, SLOWDOWNS, StudyFile, StudyRun};
-use crate::gate::{AB_THRESHOLD, FILE_THRESHOLD, GateOptions, Judged};
+use crate::gate::{AB_JUDGE, AB_THRESHOLD, FILE_JUDGE, FILE_THRESHOLD, Judged};
 use crate::render::tables::{Align, Table};
 
 /// Marks of the generated region in docs/explanation/gate.md.
@@ -16,6 +16,13 @@ fn threshold(mode: Mode) -> f64 {
     match mode {
         Mode::Ab => AB_THRESHOLD,
         Mode::Fast => FILE_THRESHOLD,
+    }
+}
+
+fn rule(mode: Mode) -> Judged {
+    match mode {
+        Mode::Ab => AB_JUDGE,
+        Mode::Fast => FILE_JUDGE,
     }
 }
 
@@ -56,7 +63,6 @@ fn cell(run: &StudyRun, mode: Mode, rule: Judged, threshold: f64, slowdown: f64)
 /// The generated region: for every study file (machine class), the gate as configured, the
 /// three rules side by side, the thresholds, and the interval widths of each mode.
 pub fn markdown(files: &[StudyFile]) -> String {
-    let rule = GateOptions::default().judge;
     let mut s = String::new();
     if files.is_empty() {
         s += "No study file is committed yet: `nbody-bench gate-study` measures one.\n";
@@ -78,14 +84,15 @@ pub fn markdown(files: &[StudyFile]) -> String {
                     "`{b}`"
                 ))
         );
-        s += "**The gate as configured** (rule `";
         s += &format!(
-            "{}`, thresholds {} A/B and {} fast path): decisions that flagged any case on \
-             unchanged code (false alarms), and that flagged exactly the slowed kernel's cases \
-             (power), with 95% Clopper–Pearson intervals.\n\n",
-            rule_name(rule),
-            AB_THRESHOLD,
-            FILE_THRESHOLD
+            "**The gate as configured** (A/B: the `{}` ratio above {}; fast path: `{}` above \
+             {}): decisions that flagged any case on unchanged code (false alarms), and that \
+             flagged exactly the slowed kernel's cases (power), with 95% Clopper–Pearson \
+             intervals.\n\n",
+            rule_name(AB_JUDGE),
+            1.0 + AB_THRESHOLD,
+            rule_name(FILE_JUDGE),
+            1.0 + FILE_THRESHOLD
         );
         let mut header = vec![
             "condition".to_string(),
@@ -93,11 +100,16 @@ pub fn markdown(files: &[StudyFile]) -> String {
             "decisions measured in".into(),
             "false alarms (A/A)".into(),
         ];
-        header.extend(
-            SLOWDOWNS
+        // The knob slows the force computation; the step the gate times also builds,
+        // integrates and applies the walls, so its own ratio is shown beside.
+        header.extend(SLOWDOWNS.iter().map(|&f| {
+            let step = file
+                .runs
                 .iter()
-                .map(|f| format!("{:.0}% slower", (f - 1.0) * 100.0)),
-        );
+                .find_map(|r| r.step_ratio(f))
+                .map_or(String::new(), |r| format!(" (step ×{r:.3})"));
+            format!("force {:.0}% slower{step}", (f - 1.0) * 100.0)
+        }));
         let columns = header.len();
         let mut t = Table::new(header).aligned(
             [Align::Default, Align::Default]
@@ -106,19 +118,19 @@ pub fn markdown(files: &[StudyFile]) -> String {
         );
         for run in &file.runs {
             for mode in [Mode::Ab, Mode::Fast] {
-                if run.tally(mode, rule, threshold(mode), 1.0).is_none() {
+                if run.tally(mode, rule(mode), threshold(mode), 1.0).is_none() {
                     continue;
                 }
                 let mut row = vec![
                     condition(run),
                     mode.name().to_string(),
                     format!("{:.1} s", run.decision_measure_s),
-                    cell(run, mode, rule, threshold(mode), 1.0),
+                    cell(run, mode, rule(mode), threshold(mode), 1.0),
                 ];
                 row.extend(
                     SLOWDOWNS
                         .iter()
-                        .map(|&f| cell(run, mode, rule, threshold(mode), f)),
+                        .map(|&f| cell(run, mode, rule(mode), threshold(mode), f)),
                 );
                 t.row(row);
             }
@@ -165,8 +177,8 @@ fn rules_table(file: &StudyFile) -> String {
         "mode",
         "rule",
         "false alarms (A/A)",
-        "10% slower",
-        "25% slower",
+        "force 10% slower",
+        "force 25% slower",
     ])
     .aligned([
         Align::Default,
@@ -205,19 +217,20 @@ fn rules_table(file: &StudyFile) -> String {
     )
 }
 
-/// Each candidate threshold under the configured rule, quiet machine.
+/// Each candidate threshold under each mode's configured rule.
 fn thresholds_table(file: &StudyFile) -> String {
-    let rule = GateOptions::default().judge;
     let mut t = Table::new([
         "condition",
         "mode",
+        "rule",
         "threshold",
         "false alarms (A/A)",
-        "5% slower",
-        "10% slower",
-        "25% slower",
+        "force 5% slower",
+        "force 10% slower",
+        "force 25% slower",
     ])
     .aligned([
+        Align::Default,
         Align::Default,
         Align::Default,
         Align::Right,
@@ -229,6 +242,7 @@ fn thresholds_table(file: &StudyFile) -> String {
     let mut any = false;
     for run in file.runs.iter().filter(|r| !r.duet) {
         for mode in [Mode::Ab, Mode::Fast] {
+            let rule = rule(mode);
             for &th in mode.candidates() {
                 if run.tally(mode, rule, th, 1.0).is_none() {
                     continue;
@@ -237,6 +251,7 @@ fn thresholds_table(file: &StudyFile) -> String {
                 t.row([
                     condition(run),
                     mode.name().to_string(),
+                    rule_name(rule).to_string(),
                     format!("{th}"),
                     cell(run, mode, rule, th, 1.0),
                     cell(run, mode, rule, th, 1.05),
@@ -250,8 +265,7 @@ fn thresholds_table(file: &StudyFile) -> String {
         return String::new();
     }
     format!(
-        "\n**The thresholds compared** (rule `{}`):\n\n{}",
-        rule_name(rule),
+        "\n**The thresholds compared** (each mode's rule):\n\n{}",
         t.markdown()
     )
 }

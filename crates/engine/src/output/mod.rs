@@ -169,6 +169,10 @@ pub fn remove_temporaries_and_exit(code: i32) -> ! {
 /// A file written under a temporary name and renamed into place by [`AtomicFile::commit`];
 /// dropped without commit, or if the commit fails, the temporary file is removed and `path`
 /// is untouched. A symbolic link is written through: the file it points at is replaced.
+///
+/// The temporary beside the target has an unpredictable name and is created exclusively
+/// (`O_CREAT | O_EXCL | O_NOFOLLOW`): in a directory others can write to, nobody can plant a
+/// link under the name a write is about to use and have the write land in another file.
 pub(crate) struct AtomicFile {
     path: PathBuf,
     tmp: PathBuf,
@@ -188,18 +192,7 @@ impl AtomicFile {
         let name = target
             .file_name()
             .ok_or_else(|| err(io::Error::other("not a file name")))?;
-        let mut tmp_name = std::ffi::OsString::from(".");
-        tmp_name.push(name);
-        tmp_name.push(format!(".{}.tmp", std::process::id()));
-        let tmp = target.with_file_name(tmp_name);
-        temporaries().push(tmp.clone());
-        let file = match File::create(&tmp) {
-            Ok(file) => file,
-            Err(e) => {
-                temporaries().retain(|t| *t != tmp);
-                return Err(err(e));
-            }
-        };
+        let (tmp, file) = create_temporary(&target, name).map_err(err)?;
         Ok(AtomicFile {
             path: target,
             tmp,
@@ -248,6 +241,36 @@ impl Drop for AtomicFile {
     }
 }
 
+/// Creates `.<name>.<random>.tmp` beside `target`, never opening an existing file or link, and
+/// registers it for removal on an interrupt. Mode 0666 less the umask, as `File::create`.
+fn create_temporary(target: &Path, name: &std::ffi::OsStr) -> io::Result<(PathBuf, File)> {
+    use std::os::unix::fs::OpenOptionsExt;
+    let mut last = None;
+    for _ in 0..16 {
+        let mut tmp_name = std::ffi::OsString::from(".");
+        tmp_name.push(name);
+        tmp_name.push(format!(".{:016x}.tmp", rand::random::<u64>()));
+        let tmp = target.with_file_name(tmp_name);
+        let mut registry = temporaries();
+        let opened = fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(0o666)
+            .custom_flags(libc::O_NOFOLLOW)
+            .open(&tmp);
+        match opened {
+            Ok(file) => {
+                registry.push(tmp.clone());
+                return Ok((tmp, file));
+            }
+            // Someone's file or link under that name: another name, never that one.
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => last = Some(e),
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last.unwrap_or_else(|| io::Error::other("no free temporary name")))
+}
+
 /// Checks an output whose name is derived from the path the user typed (`--dump out` writing
 /// `out.lj-box`, ...): the typed path must itself be a possible output (not a device, pipe,
 /// directory or broken link, which it would otherwise escape by a suffix), and so must each
@@ -285,6 +308,36 @@ mod tests {
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
         write_atomic(&path, b"new").unwrap();
         assert_eq!(fs::read_to_string(&path).unwrap(), "new");
+    }
+
+    /// A link planted beside the target, under any name the old scheme would have used, is
+    /// never written through: the temporary's name is random and it is created exclusively.
+    #[test]
+    fn a_planted_link_beside_the_target_is_not_followed() {
+        let dir = tempfile::tempdir().unwrap();
+        let victim = dir.path().join("victim.txt");
+        fs::write(&victim, "precious").unwrap();
+        let path = dir.path().join("out.json");
+        let planted = dir
+            .path()
+            .join(format!(".out.json.{}.tmp", std::process::id()));
+        std::os::unix::fs::symlink(&victim, &planted).unwrap();
+        write_atomic(&path, b"new").unwrap();
+        assert_eq!(fs::read_to_string(&victim).unwrap(), "precious");
+        assert_eq!(fs::read_to_string(&path).unwrap(), "new");
+        assert!(
+            !fs::symlink_metadata(&path)
+                .unwrap()
+                .file_type()
+                .is_symlink()
+        );
+        // And an existing name is refused by the exclusive create itself.
+        let e = fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&planted)
+            .unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::AlreadyExists);
     }
 
     #[test]
