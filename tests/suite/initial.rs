@@ -460,3 +460,68 @@ fn a_sweep_starts_every_case_from_the_configs_file_of_bodies() {
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains("initial"), "{err}");
 }
+
+/// The file of bodies a run or an export starts from is an input: naming it (or a link to it)
+/// as an output is refused before anything runs, and the file stays as it was.
+#[test]
+fn the_initial_file_is_never_overwritten() {
+    let dir = tempfile::tempdir().unwrap();
+    let bodies = export(
+        dir.path(),
+        "bodies.txt",
+        &["--scenario", "lj-box", "-n", "20"],
+    );
+    let before = std::fs::read(&bodies).unwrap();
+    let link = dir.path().join("link.txt");
+    std::os::unix::fs::symlink(&bodies, &link).unwrap();
+    let f = bodies.to_str().unwrap();
+    for target in [f, link.to_str().unwrap()] {
+        for flag in ["--dump-state", "--json", "--trajectory"] {
+            let o = nbody(&[
+                "run",
+                "--scenario",
+                "lj-box",
+                "--kernel",
+                "naive",
+                "--steps",
+                "2",
+                "--initial",
+                f,
+                flag,
+                target,
+            ]);
+            assert_eq!(
+                o.status.code(),
+                Some(2),
+                "{flag} {target}: {}",
+                text(&o.stderr)
+            );
+            let err = text(&o.stderr);
+            assert!(err.contains("--initial"), "{flag}: {err}");
+        }
+        for format in ["text", "npy", "lammps-data"] {
+            let o = nbody(&[
+                "export",
+                "--scenario",
+                "lj-box",
+                "--initial",
+                f,
+                "--format",
+                format,
+                "--out",
+                target,
+            ]);
+            assert_eq!(
+                o.status.code(),
+                Some(2),
+                "export {format}: {}",
+                text(&o.stderr)
+            );
+        }
+    }
+    assert_eq!(
+        std::fs::read(&bodies).unwrap(),
+        before,
+        "the bodies are untouched"
+    );
+}
