@@ -4,15 +4,10 @@ use crate::cli::args::ExportArgs;
 use nbody_bench::export::export_setup;
 
 pub fn export(args: ExportArgs) -> anyhow::Result<i32> {
-    // The bodies exported from are an input: the export may not replace them.
-    let inputs: Vec<(&str, &std::path::Path)> = args
-        .start
-        .initial
-        .as_deref()
-        .map(|path| ("--initial", path))
-        .into_iter()
-        .collect();
-    nbody_bench::output::check_outputs(&[("--out", args.out.as_path())], &inputs)?;
+    nbody_bench::output::check_outputs(
+        &[("--out", args.out.as_path())],
+        &super::initial_input(&args.start),
+    )?;
     let setup = super::start_setup(args.scenario, &args.system, &args.start)?;
     let bytes = export_setup(&setup, args.format)??;
     nbody_bench::output::write_atomic(&args.out, &bytes)?;

@@ -50,6 +50,16 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
     }
 }
 
+/// The file of bodies a command starts from (`--initial`), as an input no output may replace.
+fn initial_input(start: &StartArgs) -> Vec<(&'static str, &std::path::Path)> {
+    start
+        .initial
+        .as_deref()
+        .map(|path| ("--initial", path))
+        .into_iter()
+        .collect()
+}
+
 /// An error and its causes on one line, `outer: cause: root cause`, leaving out a cause whose
 /// text the message already carries (an error type that prints its source in its own
 /// message, as most of ours do, would otherwise show it twice).

@@ -15,15 +15,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     .into_iter()
     .filter_map(|(flag, path)| Some((flag, path?)))
     .collect();
-    // The bodies a run starts from are an input: no output may replace them.
-    let inputs: Vec<(&str, &std::path::Path)> = args
-        .start
-        .initial
-        .as_deref()
-        .map(|path| ("--initial", path))
-        .into_iter()
-        .collect();
-    nbody_bench::output::check_outputs(&outputs, &inputs)?;
+    nbody_bench::output::check_outputs(&outputs, &super::initial_input(&args.start))?;
     if let Some(decomp) = args.decomp {
         return super::mpi::run(args, decomp);
     }

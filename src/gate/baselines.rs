@@ -13,7 +13,7 @@
 
 use super::RunInfo;
 use crate::records::config::SweepConfig;
-use crate::records::results::{RESULTS_SCHEMA, ResultsError, ResultsFile};
+use crate::records::results::{RESULTS_SCHEMA, ResultsError, ResultsFile, read_json};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -59,20 +59,12 @@ impl Fitness {
 /// results file at all (unreadable, not JSON, no commit or machine recorded) is an error: that
 /// needs the user, while a stale one only needs the A/B route.
 pub fn examine(path: &Path) -> Result<Chosen, BaselinesError> {
-    let text = crate::input::read_text(path).map_err(|source| ResultsError::Read {
-        path: path.into(),
-        source,
-    })?;
-    let value: serde_json::Value =
-        serde_json::from_str(&text).map_err(|e| ResultsError::Corrupt {
-            path: path.into(),
-            detail: e.to_string(),
-        })?;
+    let value = read_json(path)?;
     let info = RunInfo::from_json(&value).ok_or_else(|| ResultsError::Corrupt {
         path: path.into(),
         detail: "no metadata.git_commit or machine calibration: not a baseline".into(),
     })?;
-    let fitness = match ResultsFile::load(path) {
+    let fitness = match ResultsFile::from_value(path, value.clone()) {
         Err(ResultsError::Schema { found, .. }) => Fitness::Stale(format!(
             "its schema `{found}` is not this build's `{RESULTS_SCHEMA}`"
         )),
@@ -152,7 +144,7 @@ pub fn examine_all(dir: &Path) -> Result<Vec<Chosen>, BaselinesError> {
     json_files(dir)?.iter().map(|p| examine(p)).collect()
 }
 
-fn json_files(dir: &Path) -> Result<Vec<PathBuf>, BaselinesError> {
+pub(crate) fn json_files(dir: &Path) -> Result<Vec<PathBuf>, BaselinesError> {
     let read_err = |source| BaselinesError::Read {
         path: dir.to_path_buf(),
         source,
@@ -204,13 +196,19 @@ pub fn choose(dir: &Path, here: &RunInfo) -> Result<Chosen, BaselinesError> {
 /// A file name for a baseline of `info`'s machine class: `ci-<vendor>-<family>-<model>-
 /// <stepping>-<cpus>cpu.json`, e.g. `ci-AuthenticAMD-25-1-1-2cpu.json`.
 pub fn file_name(info: &RunInfo) -> String {
-    let signature = info.cpu_signature.as_deref().unwrap_or("unknown");
+    format!(
+        "ci-{}.json",
+        class_name(info.cpu_signature.as_deref(), info.logical_cpus)
+    )
+}
+
+/// A machine class as file names spell it, e.g. `AuthenticAMD-25-1-1-2cpu`.
+pub fn class_name(signature: Option<&str>, logical_cpus: Option<usize>) -> String {
     let slug: String = signature
+        .unwrap_or("unknown")
         .chars()
         .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
         .collect();
-    let cpus = info
-        .logical_cpus
-        .map_or("unknown".into(), |n| n.to_string());
-    format!("ci-{slug}-{cpus}cpu.json")
+    let cpus = logical_cpus.map_or("unknown".into(), |n| n.to_string());
+    format!("{slug}-{cpus}cpu")
 }

@@ -126,12 +126,12 @@ fn measure_and_judge(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Re
     // Every refusal comes before anything long: the route, and what it needs, is checked
     // before a sweep or a build starts.
     let route = route::route(request.against.as_deref(), reference, say)?;
-    let prepared = match &route {
-        Route::Fast { .. } => {
+    let planned = match route {
+        Route::Fast { path, baseline } => {
             fast_path_fits(&config)?;
-            None
+            Planned::Fast { path, baseline }
         }
-        Route::AB { rev } => Some(prepare_a_b(request, rev, &config, &text, say)?),
+        Route::AB { rev } => Planned::AB(prepare_a_b(request, &rev, &config, &text, say)?),
     };
     let out = match out {
         Some(dir) => {
@@ -141,12 +141,11 @@ fn measure_and_judge(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Re
         }
         None => locate::new_run_dir(Path::new("results"), "gate", &utc_now())?,
     };
-    let judged = match (prepared, route) {
-        (Some(prepared), _) => a_b(request, &prepared, &config, &text, &out, say),
-        (None, Route::Fast { path, baseline }) => {
+    let judged = match planned {
+        Planned::AB(prepared) => a_b(request, &prepared, &config, &text, &out, say),
+        Planned::Fast { path, baseline } => {
             fast_path(request, &path, &baseline, &config, &text, &out, say)
         }
-        (None, Route::AB { .. }) => unreachable!("an A/B route is always prepared"),
     };
     match judged {
         Ok(report) => {
@@ -198,6 +197,15 @@ fn fast_path_fits(config: &SweepConfig) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// A route with everything it needs checked.
+enum Planned {
+    Fast {
+        path: PathBuf,
+        baseline: Box<ResultsFile>,
+    },
+    AB(PreparedAB),
 }
 
 /// An A/B run checked and planned before anything is built.

@@ -168,17 +168,27 @@ pub enum ResultsError {
     Write(#[from] crate::output::WriteError),
 }
 
+/// The JSON of the file at `path`, for [`ResultsFile::from_value`] and readers that look at a
+/// file this version may not load whole (an old baseline).
+pub fn read_json(path: &Path) -> Result<serde_json::Value, ResultsError> {
+    let text = crate::input::read_text(path).map_err(|source| ResultsError::Read {
+        path: path.into(),
+        source,
+    })?;
+    serde_json::from_str(&text).map_err(|e| ResultsError::Corrupt {
+        path: path.into(),
+        detail: e.to_string(),
+    })
+}
+
 impl ResultsFile {
     pub fn load(path: &Path) -> Result<ResultsFile, ResultsError> {
-        let text = crate::input::read_text(path).map_err(|source| ResultsError::Read {
-            path: path.into(),
-            source,
-        })?;
-        let value: serde_json::Value =
-            serde_json::from_str(&text).map_err(|e| ResultsError::Corrupt {
-                path: path.into(),
-                detail: e.to_string(),
-            })?;
+        ResultsFile::from_value(path, read_json(path)?)
+    }
+
+    /// A results file from its JSON `value`, read from `path` (named in errors): the schema,
+    /// the fields, unique case keys, the summaries recomputed from the samples.
+    pub fn from_value(path: &Path, value: serde_json::Value) -> Result<ResultsFile, ResultsError> {
         let schema = value
             .get("schema")
             .and_then(|s| s.as_str())

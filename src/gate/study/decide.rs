@@ -133,28 +133,26 @@ pub fn tally(
             }
         }
         for (rule, threshold, flags) in outcome.flags {
-            let slot = tallies.iter_mut().find(|t| {
+            let found = tallies.iter().position(|t| {
                 t.mode == outcome.mode
                     && t.rule == rule
                     && t.threshold == threshold
                     && t.slowdown == outcome.slowdown
             });
-            let t = match slot {
-                Some(t) => t,
-                None => {
-                    tallies.push(Tally {
-                        mode: outcome.mode,
-                        rule,
-                        threshold,
-                        slowdown: outcome.slowdown,
-                        decisions: 0,
-                        any_flagged: 0,
-                        exactly_slowed: 0,
-                        other_flagged: 0,
-                    });
-                    tallies.last_mut().expect("just pushed")
-                }
-            };
+            let index = found.unwrap_or_else(|| {
+                tallies.push(Tally {
+                    mode: outcome.mode,
+                    rule,
+                    threshold,
+                    slowdown: outcome.slowdown,
+                    decisions: 0,
+                    any_flagged: 0,
+                    exactly_slowed: 0,
+                    other_flagged: 0,
+                });
+                tallies.len() - 1
+            });
+            let t = &mut tallies[index];
             t.decisions += 1;
             let flagged =
                 |target: bool| flags.iter().any(|&(is_target, f)| f && is_target == target);

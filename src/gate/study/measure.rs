@@ -116,13 +116,12 @@ pub fn measure_blocks(
                     };
                     let outcome = one_round(config, case, samples, factor)?;
                     let drift = config.measure.max_energy_drift;
-                    match side {
-                        Side::A => block.a[i].add_round(outcome, drift),
-                        Side::B => block.b[i].add_round(outcome, drift),
-                        Side::Slowed(k) => {
-                            let j = slot.expect("a slowed side only for the slowed kernel");
-                            block.slowed[k][j].add_round(outcome, drift)
-                        }
+                    match (side, slot) {
+                        (Side::A, _) => block.a[i].add_round(outcome, drift),
+                        (Side::B, _) => block.b[i].add_round(outcome, drift),
+                        (Side::Slowed(k), Some(j)) => block.slowed[k][j].add_round(outcome, drift),
+                        // Slowed sides are only planned for the slowed kernel's cases.
+                        (Side::Slowed(_), None) => {}
                     }
                 }
             }

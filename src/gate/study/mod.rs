@@ -186,14 +186,7 @@ impl StudyFile {
 
     /// The class's name as the baseline files spell it, e.g. `AuthenticAMD-26-2-1-2cpu`.
     pub fn class(&self) -> String {
-        let slug: String = self
-            .cpu_signature
-            .as_deref()
-            .unwrap_or("unknown")
-            .chars()
-            .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
-            .collect();
-        format!("{slug}-{}cpu", self.logical_cpus)
+        crate::gate::baselines::class_name(self.cpu_signature.as_deref(), Some(self.logical_cpus))
     }
 
     /// Adds `run`, replacing an earlier run of the same load and mode (duet or not).

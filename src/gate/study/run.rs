@@ -224,14 +224,9 @@ fn save_json<T: serde::Serialize>(path: &Path, value: &T) -> anyhow::Result<()> 
 
 /// Every study file of `dir`, sorted by name.
 pub fn study_files(dir: &Path) -> Result<Vec<StudyFile>, String> {
-    let Ok(entries) = std::fs::read_dir(dir) else {
+    if !dir.is_dir() {
         return Ok(Vec::new());
-    };
-    let mut paths: Vec<PathBuf> = entries
-        .flatten()
-        .map(|e| e.path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    paths.sort();
+    }
+    let paths = baselines::json_files(dir).map_err(|e| e.to_string())?;
     paths.iter().map(|p| StudyFile::load(p)).collect()
 }
