@@ -48,15 +48,18 @@ pub struct Point {
     pub ci95_s: [f64; 2],
     pub oversubscribed: bool,
     pub ns_per_particle_step: f64,
-    pub pair_evals_per_s: f64,
+    /// `None` when the code counted no pair (an external program).
+    pub pair_evals_per_s: Option<f64>,
     pub phases: PhaseTimes,
     /// The phases an external program timed itself (`phases`), by name.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub named_phases: Vec<NamedPhase>,
-    pub step_ns: StepPercentiles,
+    /// `None` when no step was timed alone (an external program is timed per run).
+    pub step_ns: Option<StepPercentiles>,
     pub force_error: Option<[f64; 2]>,
-    pub max_energy_drift: f64,
-    pub sanity_ok: bool,
+    /// `None` when nothing measured the energy (an external program).
+    pub max_energy_drift: Option<f64>,
+    pub sanity_ok: Option<bool>,
 }
 
 impl Point {

@@ -153,15 +153,13 @@ impl Analysis {
         precision: crate::scenario::Precision,
     ) -> Option<f64> {
         let c = self.calibration.as_ref()?;
-        if p.pair_evals_per_s <= 0.0 {
-            return None;
-        }
+        let pair_evals_per_s = p.pair_evals_per_s?;
         let per_number = match precision {
             crate::scenario::Precision::F32 => 1.0,
             crate::scenario::Precision::F64 => 0.5,
         };
         let flops = c.fma_gflops_1t * 1e9 * p.p() as f64 * per_number;
-        Some(p.pair_evals_per_s * law.flops_per_pair() / flops)
+        Some(pair_evals_per_s * law.flops_per_pair() / flops)
     }
 }
 
@@ -396,7 +394,14 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
         None => external_serial_fraction(one),
     });
     let serial_comparison = match (&timed_serial, &fit.fit) {
-        (Some(t), Some(f)) => Some(fit::compare_serial_fractions(t, &f.serial_fraction)),
+        (Some(t), Some(f)) => {
+            let best = measured
+                .iter()
+                .filter(|m| m.p > 1.0)
+                .map(|m| m.speedup.estimate)
+                .reduce(f64::max);
+            Some(fit::compare_serial_fractions(t, &f.serial_fraction, best))
+        }
         _ => None,
     };
     StrongAnalysis {

@@ -93,7 +93,11 @@ pub(crate) fn case_label(p: &Point) -> String {
     if let Some(t) = p.theta {
         s.push_str(&format!(" θ={t}"));
     }
-    if p.case.multipole != crate::kernels::Multipole::Monopole {
+    // The octree names its expansion whichever it is: a bare "octree θ=0.5" would read as the
+    // default, which is the quadrupole.
+    if p.case.kernel.kernel() == Some(crate::kernels::KernelKind::Octree)
+        || p.case.multipole != crate::kernels::Multipole::Monopole
+    {
         s.push_str(&format!(" {}", p.case.multipole.name()));
     }
     if let Some(order) = p.case.order {
@@ -401,13 +405,13 @@ mod tests {
             ci95_s: [median_s * 0.99, median_s * 1.01],
             oversubscribed: false,
             ns_per_particle_step: median_s * 1e9 / n as f64,
-            pair_evals_per_s: 0.0,
+            pair_evals_per_s: None,
             phases: Default::default(),
             named_phases: Vec::new(),
-            step_ns: Default::default(),
+            step_ns: None,
             force_error: None,
-            max_energy_drift: 0.0,
-            sanity_ok: true,
+            max_energy_drift: None,
+            sanity_ok: None,
         }
     }
 

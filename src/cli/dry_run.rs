@@ -108,12 +108,26 @@ fn print_plan(
     path: Option<&Path>,
 ) {
     let m = &config.measure;
+    let external: Vec<_> = cases(config)
+        .into_iter()
+        .filter(|c| c.kernel.is_external())
+        .collect();
+    let all = est.cases.len() + external.len();
     outln!(
-        "dry run of sweep `{}` ({}): {} case{}, {} rounds of {} samples in all; nothing is measured or written",
+        "dry run of sweep `{}` ({}): {all} case{}{}, {} rounds of {} samples in all; nothing is \
+         measured or written",
         config.name,
         args.config.display(),
-        est.cases.len(),
-        if est.cases.len() == 1 { "" } else { "s" },
+        if all == 1 { "" } else { "s" },
+        if external.is_empty() {
+            String::new()
+        } else {
+            format!(
+                " ({} of the built-in kernels, {} of external programs)",
+                est.cases.len(),
+                external.len()
+            )
+        },
         m.rounds,
         m.samples
     );
@@ -144,11 +158,18 @@ fn print_plan(
             WallTime(c.wall_s)
         );
     }
-    let external: Vec<_> = cases(config)
-        .into_iter()
-        .filter(|c| c.kernel.is_external())
-        .collect();
     for c in &external {
+        // Not estimated: the steps of one run stand where the step time would.
+        let steps = config
+            .external
+            .iter()
+            .find(|e| e.name == c.kernel.name())
+            .map_or("-".to_string(), |e| {
+                format!(
+                    "{} steps",
+                    nbody_bench::experiment::external::run::steps(e, c)
+                )
+            });
         outln!(
             "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
             c.key(),
@@ -158,7 +179,7 @@ fn print_plan(
             c.theta.map_or("-".to_string(), |t| t.to_string()),
             m.rounds,
             m.samples,
-            "-",
+            steps,
             "external"
         );
     }

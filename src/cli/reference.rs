@@ -136,6 +136,7 @@ empty = ["other", "--empty"]
 timeout_s = 60
 warmup_runs = 1
 scenarios = ["lj-box"]
+n = [1000]
 threads = [1]
 ranks = [1]
 "#;
@@ -212,7 +213,7 @@ fn meaning(key: &str) -> Option<&'static str> {
             "run once per round before the samples, untimed and without the launcher"
         }
         "external.steps" => {
-            "time steps of one run: a sample's time per step is its time divided by this"
+            "time steps of one run, the same at every n or fewer as n grows: a sample's time per step is its run's time divided by the run's steps"
         }
         "external.time" => {
             "how a run is timed: the whole process, or the first group of the last match in its output"
@@ -241,6 +242,9 @@ fn meaning(key: &str) -> Option<&'static str> {
         }
         "external.warmup_runs" => "untimed runs before each round's samples",
         "external.scenarios" => "the scenarios its cases stand for (when left out: the config's)",
+        "external.n" => {
+            "the particle counts of its cases (when left out: the config's); not in a weak study"
+        }
         "external.threads" => "thread counts (when left out: the config's)",
         "external.ranks" => "rank counts (when left out: the `[mpi]` table's, else 1)",
         _ => return None,
@@ -257,7 +261,9 @@ fn external_forms(key: &str) -> Option<&'static str> {
         "external.version" => {
             "a list of strings (argv), with the placeholders {config_dir} and {nbody_bench} only"
         }
-        "external.steps" => "a whole number of at least 1, such as steps = 2000",
+        "external.steps" => {
+            "a whole number of at least 1, such as steps = 2000; or the cost of one run and how a step's cost grows with n, such as steps = { work = 4e8, grows = \"n^2\" } (work / n² steps, rounded, at least 1), grows = \"n\" | \"n log n\" | \"n^2\""
+        }
         "external.time" => nbody_bench::records::external::config::TIME_FORMS,
         "external.check" => "a regular expression, such as check = 'Total wall time'",
         "external.force_error" => {
@@ -273,6 +279,7 @@ fn external_forms(key: &str) -> Option<&'static str> {
         "external.timeout_s" => "seconds above 0, at most 7 days, such as timeout_s = 600",
         "external.warmup_runs" => "a whole number of at least 0, such as warmup_runs = 1",
         "external.scenarios" => "a list of scenario names, such as scenarios = [\"lj-box\"]",
+        "external.n" => "a list of counts of at least 1, such as n = [500, 1000, 2000]",
         "external.threads" => "a list of thread counts of at least 1, such as threads = [1, 2]",
         "external.ranks" => "a list of rank counts of at least 1, such as ranks = [1, 2]",
         _ => return None,

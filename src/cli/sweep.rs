@@ -30,6 +30,20 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         Target::Existing(dir) => Some(dir.join("results.json")),
         Target::New => None,
     };
+    let config_dir = config_path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty() && !from_pipe)
+        .map(Path::to_path_buf);
+    if args.dry_run {
+        // What the sweep checks before its first case, the dry run checks too: a program that
+        // cannot start, an `initial` file that cannot be read or lacks an n.
+        let options = SweepOptions {
+            out: args.out.clone(),
+            config_dir: config_dir.clone(),
+            ..Default::default()
+        };
+        nbody_bench::experiment::runner::check_before_running(&config, &options)?;
+    }
     if let Some(code) = super::dry_run::before_sweep(&args, &config, existing.as_deref())? {
         return Ok(code);
     }
@@ -51,10 +65,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         out: args.out.clone(),
         run_dir,
         calibrate: !args.no_calibration,
-        config_dir: config_path
-            .parent()
-            .filter(|p| !p.as_os_str().is_empty() && !from_pipe)
-            .map(Path::to_path_buf),
+        config_dir,
         nbody_bench: None,
     };
     let mut observer = progress::for_stderr();
@@ -215,13 +226,19 @@ fn print_table(results: &ResultsFile) {
             continue;
         };
         outln!(
-            "{:<52} {:>11} {:>23} {:>11.1} {:>10.2e} {:>6}{}",
+            "{:<52} {:>11} {:>23} {:>11.1} {:>10} {:>6}{}",
             c.key,
             Duration(s.median_s),
             format!("[{}, {}]", Duration(s.ci95_s[0]), Duration(s.ci95_s[1])),
             s.ns_per_particle_step,
-            s.pair_evals_per_s,
-            if s.sanity_ok { "ok" } else { "DRIFT" },
+            // An external program counts no pairs and checks no energy: "–", not 0 or "ok".
+            s.pair_evals_per_s
+                .map_or("–".to_string(), |r| format!("{r:.2e}")),
+            match s.sanity_ok {
+                Some(true) => "ok",
+                Some(false) => "DRIFT",
+                None => "–",
+            },
             if c.oversubscribed {
                 "  (oversubscribed)"
             } else {

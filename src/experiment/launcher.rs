@@ -153,7 +153,7 @@ pub(crate) fn round_from_json(
         },
         work: run.counters.total,
         pairs_interacting: run.counters.pairs_interacting_final,
-        energy_drift: run.energy.rel_drift,
+        energy_drift: Some(run.energy.rel_drift),
         force_error: None,
         n: run.n,
         clock_overhead: if median > 0.0 {

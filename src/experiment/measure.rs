@@ -121,7 +121,7 @@ fn measure<C: Clock>(
         phases,
         work,
         pairs_interacting: sim.probe_work().pairs_interacting,
-        energy_drift: (e1 - e0) / e0.abs(),
+        energy_drift: Some((e1 - e0) / e0.abs()),
         force_error,
         n,
         clock_overhead: if median_step > 0.0 {

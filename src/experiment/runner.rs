@@ -162,48 +162,11 @@ pub fn run_sweep<C: Clock>(
             config: config.name.clone(),
         });
     }
-    // Everything that can be known before the first case is checked before it: a case whose
-    // system cannot be built (a box its precision cannot resolve, too many particles) would
-    // otherwise fail only when its turn comes, after the cases before it ran, and again at
-    // every --resume.
-    let planned = crate::records::plan::unique_cases(config).map_err(SweepError::Plan)?;
-    let initial = initial_bodies(config, options)?;
-    for case in planned {
-        let setup = case_setup(&case, initial.as_ref().map(|(_, b)| b.clone()));
-        let copies = match case.decomp {
-            // Every rank holds all the particles.
-            Some(crate::decomp::Decomposition::Allgather) => case.ranks,
-            _ => 1,
-        };
-        let checked = setup
-            .validate()
-            .map_err(|e| Box::new(e) as Box<dyn std::error::Error + Send + Sync>)
-            .and_then(|()| match case.kernel.kernel() {
-                Some(kernel) => {
-                    let params = case.kernel_params();
-                    crate::run::check_memory(&setup, kernel, &params, case.threads, copies)
-                }
-                .map_err(|e| Box::new(e) as _),
-                None => Ok(()),
-            });
-        checked.map_err(|source| SweepError::Case {
-            key: case.key(),
-            source,
-        })?;
-    }
     let path = match &options.run_dir {
         Some(dir) => dir.join("results.json"),
         None => results_path(config, options.out.as_deref()),
     };
-    let mut context = external_context(options, &path)?;
-    context.initial = initial
-        .as_ref()
-        .map(|(record, _)| PathBuf::from(&record.path));
-    context.bodies = initial.as_ref().map(|(_, bodies)| bodies.clone());
-    for ext in &config.external {
-        let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
-        super::external::check_programs(ext, launcher, &context)?;
-    }
+    let (initial, context) = preflight(config, options, &path)?;
     if config.scheduler.is_some() {
         slurm::check_available()?;
     }
@@ -460,6 +423,68 @@ fn calibrate(
         ));
     }
     Ok(calibration)
+}
+
+/// The config's bodies, read once, with their record.
+type Initial = Option<(InitialRecord, Arc<InitialBodies>)>;
+
+/// Checks everything that can be known before the first case, as `sweep --dry-run` does too:
+/// every case's system can be built (a box its precision cannot resolve, too many particles,
+/// an n the `initial` file does not have) and every external program can be started. Otherwise
+/// a case would fail only when its turn comes, after the cases before it ran, and again at
+/// every --resume. Writes nothing.
+pub fn check_before_running(
+    config: &SweepConfig,
+    options: &SweepOptions,
+) -> Result<(), SweepError> {
+    let path = match &options.run_dir {
+        Some(dir) => dir.join("results.json"),
+        None => results_path(config, options.out.as_deref()),
+    };
+    preflight(config, options, &path).map(|_| ())
+}
+
+/// [`check_before_running`], keeping the bodies it read and the externals' context.
+fn preflight(
+    config: &SweepConfig,
+    options: &SweepOptions,
+    path: &Path,
+) -> Result<(Initial, super::external::Context), SweepError> {
+    let planned = crate::records::plan::unique_cases(config).map_err(SweepError::Plan)?;
+    let initial = initial_bodies(config, options)?;
+    for case in planned {
+        let setup = case_setup(&case, initial.as_ref().map(|(_, b)| b.clone()));
+        let copies = match case.decomp {
+            // Every rank holds all the particles.
+            Some(crate::decomp::Decomposition::Allgather) => case.ranks,
+            _ => 1,
+        };
+        let checked = setup
+            .validate()
+            .map_err(|e| Box::new(e) as Box<dyn std::error::Error + Send + Sync>)
+            .and_then(|()| match case.kernel.kernel() {
+                Some(kernel) => {
+                    let params = case.kernel_params();
+                    crate::run::check_memory(&setup, kernel, &params, case.threads, copies)
+                }
+                .map_err(|e| Box::new(e) as _),
+                None => Ok(()),
+            });
+        checked.map_err(|source| SweepError::Case {
+            key: case.key(),
+            source,
+        })?;
+    }
+    let mut context = external_context(options, path)?;
+    context.initial = initial
+        .as_ref()
+        .map(|(record, _)| PathBuf::from(&record.path));
+    context.bodies = initial.as_ref().map(|(_, bodies)| bodies.clone());
+    for ext in &config.external {
+        let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
+        super::external::check_programs(ext, launcher, &context)?;
+    }
+    Ok((initial, context))
 }
 
 /// The config's file of bodies (`initial`), read once before anything runs, and its record for

@@ -345,7 +345,7 @@ pub(crate) fn unmeasured_round(case: &Case, spec: &RoundSpec, job: JobRecord) ->
         phases: Default::default(),
         work: Default::default(),
         pairs_interacting: 0,
-        energy_drift: 0.0,
+        energy_drift: None,
         force_error: None,
         n: case.n,
         clock_overhead: 0.0,

@@ -187,7 +187,8 @@ pub fn fit_power(samples: &[Samples], seed: u64) -> Result<PowerFit, FitError> {
         ),
         support,
     };
-    let notes = notes(&exponent, &selected);
+    let mut notes = notes(&exponent, &selected);
+    notes.extend(range_note(&hypotheses, chosen.class, &data.xs));
     Ok(PowerFit {
         inputs: data.inputs(),
         exponent,
@@ -342,6 +343,41 @@ fn select(candidates: &[ClassCandidate]) -> Option<usize> {
         }
     }
     best.map(|(i, _)| i)
+}
+
+/// Below this ratio between two classes' growth over the measured n, the range cannot tell
+/// them apart: effects the classes leave out (a working set leaving a cache level) change a
+/// step's time by as much.
+const DISTINCT_GROWTH: f64 = 4.0;
+
+/// A note when the runner-up class grows over the measured range of n by less than
+/// [`DISTINCT_GROWTH`] times differently from the chosen one (n log n against n^1.5 over
+/// n = 500–8000 differ by 2.8×): the choice between them is the range's, not the code's.
+fn range_note(
+    candidates: &[ClassCandidate],
+    chosen: ComplexityClass,
+    xs: &[f64],
+) -> Option<String> {
+    let lo = xs.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = xs.iter().copied().fold(0.0, f64::max);
+    let runner_up = candidates
+        .iter()
+        .filter(|c| c.admissible && c.class != chosen)
+        .filter_map(|c| Some((c.class, c.loo_smape_percent?)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))?
+        .0;
+    let growth = |c: ComplexityClass| c.g(hi) / c.g(lo);
+    let apart = growth(chosen) / growth(runner_up);
+    let apart = apart.max(1.0 / apart);
+    (apart < DISTINCT_GROWTH).then(|| {
+        format!(
+            "n = {lo}–{hi} is too short a range to tell {} from {} for sure: their growth over \
+             it differs by only {apart:.1}×, which effects outside the model (a working set \
+             leaving a cache) can give as well; widen the range of n to confirm the class",
+            chosen.name(),
+            runner_up.name()
+        )
+    })
 }
 
 fn notes(exponent: &Estimate, selected: &SelectedClass) -> Vec<String> {

@@ -107,3 +107,26 @@ fn degenerate_input_is_refused() {
     s[0].x = 0.0;
     assert!(matches!(fit_power(&s, 1), Err(FitError::BadX { .. })));
 }
+
+#[test]
+fn a_range_too_short_to_tell_two_classes_apart_is_said() {
+    // A tree code's n log n over n = 500–8000: n^1.5 grows only 2.8× differently over it.
+    let short: Vec<f64> = [500.0, 1000.0, 2000.0, 4000.0, 8000.0].to_vec();
+    let s = noisy(&short, 5, 0.02, 4, |n| 4e-8 * n * n.log2());
+    let fit = fit_power(&s, 1).unwrap();
+    let note = fit
+        .notes
+        .iter()
+        .find(|n| n.contains("too short a range"))
+        .unwrap_or_else(|| panic!("{:?}", fit.notes));
+    assert!(note.contains("n = 500–8000"), "{note}");
+    assert!(note.contains(fit.class.name()), "{note}");
+    // n^1.5 against its neighbours over 2^10–2^17 (6.6× from n log n, 11× from n²): no note.
+    let s = noisy(&sizes(), 5, 0.02, 5, |n| 1e-7 * n * n.sqrt());
+    let fit = fit_power(&s, 1).unwrap();
+    assert!(
+        fit.notes.iter().all(|n| !n.contains("too short")),
+        "{:?}",
+        fit.notes
+    );
+}

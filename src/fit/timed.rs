@@ -58,10 +58,17 @@ pub(crate) fn timed_serial_fraction(
     })
 }
 
-/// Compares the timed serial fraction with the one fitted to the speedups.
+/// Below this timed serial fraction, a series none of whose parallel runs is faster than its
+/// one-worker run is read as a program that does not use its workers: Amdahl's law on the
+/// timed phases would give it at least 1.6× on two.
+const UNUSED_WORKERS_SERIAL: f64 = 0.25;
+
+/// Compares the timed serial fraction with the one fitted to the speedups; `best_speedup` is
+/// the largest measured speedup of the series' parallel runs, when it has any.
 pub(crate) fn compare_serial_fractions(
     timed: &TimedSerialFraction,
     fitted: &Estimate,
+    best_speedup: Option<f64>,
 ) -> SerialFractionComparison {
     let t = timed.fraction;
     let gap = fitted.estimate - t;
@@ -72,7 +79,18 @@ pub(crate) fn compare_serial_fractions(
         percent(fitted.ci95[0]),
         percent(fitted.ci95[1])
     );
-    let explanation = if agree {
+    let unused = best_speedup.filter(|&s| s <= 1.0 && t <= UNUSED_WORKERS_SERIAL);
+    let explanation = if let Some(best) = unused {
+        format!(
+            "No run on more workers is faster than the one-worker run (best speedup {best:.2}×), \
+             though only {} of the one-worker time is in serial phases: the program most \
+             likely does not use its workers (it ignores the thread or rank count it is given, \
+             or its parallel loop runs serially). Check how the count reaches it (for OpenMP, \
+             OMP_NUM_THREADS in `env`) before reading the fitted serial fraction {fitted_text} as \
+             overhead.",
+            percent(t)
+        )
+    } else if agree {
         format!(
             "The fitted serial fraction {fitted_text} agrees with the {} of the one-worker time \
              spent in serial phases: the serial code accounts for the loss of speedup.",
@@ -136,7 +154,7 @@ mod tests {
             estimate: 0.12,
             ci95: [0.1, 0.14],
         };
-        let c = compare_serial_fractions(&timed, &larger);
+        let c = compare_serial_fractions(&timed, &larger, Some(1.6));
         assert!(!c.agree && (c.gap - 0.07).abs() < 1e-12);
         assert!(
             c.explanation.contains("7.0% of the one-worker time"),
@@ -148,16 +166,40 @@ mod tests {
             estimate: 0.051,
             ci95: [0.04, 0.06],
         };
-        assert!(compare_serial_fractions(&timed, &same).agree);
+        assert!(compare_serial_fractions(&timed, &same, Some(1.9)).agree);
         let smaller = Estimate {
             estimate: 0.01,
             ci95: [0.0, 0.02],
         };
         assert!(
-            compare_serial_fractions(&timed, &smaller)
+            compare_serial_fractions(&timed, &smaller, None)
                 .explanation
                 .contains("below")
         );
+    }
+
+    #[test]
+    fn a_program_that_ignores_its_threads_is_named_as_such() {
+        // 0.09% of the time serial, f fitted to 100%, 0.91× on two threads.
+        let timed = timed_serial_fraction(&[0.0009], &[0.9991]).unwrap();
+        let all = Estimate {
+            estimate: 1.0,
+            ci95: [0.95, 1.0],
+        };
+        let c = compare_serial_fractions(&timed, &all, Some(0.91));
+        assert!(
+            c.explanation.contains("does not use its workers"),
+            "{}",
+            c.explanation
+        );
+        assert!(c.explanation.contains("0.91×"));
+        assert!(!c.explanation.contains("contention"));
+        // A speedup above 1 keeps the overhead reading; so does a mostly serial program.
+        let c = compare_serial_fractions(&timed, &all, Some(1.2));
+        assert!(c.explanation.contains("contention"), "{}", c.explanation);
+        let serial = timed_serial_fraction(&[0.9], &[0.1]).unwrap();
+        let c = compare_serial_fractions(&serial, &all, Some(0.99));
+        assert!(!c.explanation.contains("does not use its workers"));
     }
 
     #[test]

@@ -116,7 +116,11 @@ fn compare_case(
                 record.rounds_done, record.rounds_planned
             ));
         }
-        if record.summary.as_ref().is_some_and(|s| !s.sanity_ok) {
+        if record
+            .summary
+            .as_ref()
+            .is_some_and(|s| s.sanity_ok == Some(false))
+        {
             notes.push(format!("{which} failed its energy-drift check"));
         }
     }

@@ -109,7 +109,7 @@ fn results(run: Run) -> ResultsFile {
                 phases: PhaseTimes::default(),
                 work: WorkCounters::default(),
                 pairs_interacting: 10,
-                energy_drift: 1e-6,
+                energy_drift: Some(1e-6),
                 force_error: None,
                 n: 1000,
                 clock_overhead: 1e-5,

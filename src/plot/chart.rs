@@ -14,15 +14,24 @@ use super::spec::{Chart, Point, Scale, SeriesStyle};
 
 const BAND_ALPHA: f64 = 0.18;
 const REGION_ALPHA: f64 = 0.09;
+/// Category names down the y axis never take more than this share of the figure width.
+const MAX_NAME_SHARE: f64 = 0.32;
 
 pub(crate) fn draw(root: &Area, chart: &Chart) -> DrawResult {
     let mut x = ResolvedAxis::resolve(&chart.x, x_values(chart));
-    let y = ResolvedAxis::resolve(&chart.y, y_values(chart));
+    let mut y = ResolvedAxis::resolve(&chart.y, y_values(chart));
     let page = Page::new(root, &chart.title, &chart.caption, legend(chart))?;
-    // Category names are cut to the width of their slot so that neighbours never overlap.
+    // Category names are cut to the width of their slot so that neighbours never overlap;
+    // names down the y axis (one row each) keep up to a third of the figure's width.
     let slot = page.plot.dim_in_pixel().0.saturating_sub(120) / x.major.len().max(1) as u32;
     for (_, label) in &mut x.major {
         *label = page::shorten(root, label, &page::style(TICK_SIZE), slot.saturating_sub(8));
+    }
+    if !chart.y.categories.is_empty() {
+        let room = (f64::from(root.dim_in_pixel().0) * MAX_NAME_SHARE) as u32;
+        for (_, label) in &mut y.major {
+            *label = page::shorten(root, label, &page::style(TICK_SIZE), room);
+        }
     }
     let axes = (x.clone(), y.clone());
     let mut plot = page.plot(axes, (&chart.x.label, &chart.y.label), TICK_SIZE, true)?;

@@ -47,12 +47,18 @@ impl<'a> Page<'a> {
             let title = shorten(root, title, &bold, max_text * 85 / 100);
             area = area.titled(&title, bold).map_err(err)?;
         }
-        if !caption.trim().is_empty() {
-            let (rest, bottom) = area.split_vertically(area.dim_in_pixel().1 - CAPTION_ROOM);
+        // One line per line of the caption (a note on what is not drawn goes above the
+        // machine line).
+        let lines: Vec<&str> = caption.lines().filter(|l| !l.trim().is_empty()).collect();
+        if !lines.is_empty() {
+            let room = CAPTION_ROOM * lines.len() as u32;
+            let (rest, bottom) = area.split_vertically(area.dim_in_pixel().1 - room);
             let muted = anchored(CAPTION_SIZE, HPos::Center, VPos::Bottom).color(&MUTED_COLOR);
-            let caption = shorten(root, caption, &muted, max_text);
-            let at = (width as i32 / 2, CAPTION_ROOM as i32);
-            bottom.draw_text(&caption, &muted, at).map_err(err)?;
+            for (i, line) in lines.iter().enumerate() {
+                let line = shorten(root, line, &muted, max_text);
+                let at = (width as i32 / 2, (CAPTION_ROOM * (i as u32 + 1)) as i32);
+                bottom.draw_text(&line, &muted, at).map_err(err)?;
+            }
             area = rest;
         }
         let legend = Legend::new(root, legend, area.dim_in_pixel().1 - PLOT_TOP as u32);

@@ -582,6 +582,7 @@ impl SweepConfig {
             threads: &self.threads,
             mpi_ranks: self.mpi.as_ref().map(|m| m.ranks.as_slice()),
             strong: self.study == Study::Strong,
+            weak: self.study == Study::Weak,
             weak_cost_model: self
                 .weak
                 .as_ref()

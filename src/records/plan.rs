@@ -228,8 +228,11 @@ fn external_cases(config: &SweepConfig, out: &mut Vec<Case>) {
         for &scenario in &scenarios {
             for &t in &threads {
                 for &r in &ranks {
-                    let sizes = match (&config.study, &config.weak) {
-                        (Study::Weak, Some(w)) => vec![weak_size(None, w.rule, w.base_n, t * r)],
+                    let sizes = match (&config.study, &config.weak, &ext.n) {
+                        (Study::Weak, Some(w), _) => {
+                            vec![weak_size(None, w.rule, w.base_n, t * r)]
+                        }
+                        (_, _, Some(n)) => n.iter().map(|&n| (n, 1)).collect(),
                         _ => fixed_sizes(config),
                     };
                     for &(n, time_factor) in &sizes {

@@ -115,11 +115,13 @@ pub struct Summary {
     pub(crate) min_s: f64,
     pub(crate) mean_s: f64,
     pub samples: usize,
-    /// Per-step percentiles from the histogram, nanoseconds.
-    pub step_ns: StepPercentiles,
+    /// Per-step percentiles from the histogram, nanoseconds; `None` when no step was timed
+    /// alone (an external program is timed per run).
+    pub step_ns: Option<StepPercentiles>,
     pub ns_per_particle_step: f64,
     pub particle_steps_per_s: f64,
-    pub pair_evals_per_s: f64,
+    /// `None` when the code counted no pair (an external program).
+    pub pair_evals_per_s: Option<f64>,
     /// Seconds per step in each phase, averaged over rounds.
     pub phases: PhaseTimes,
     /// Work per step.
@@ -132,10 +134,12 @@ pub struct Summary {
     pub(crate) rebuilds_per_step: f64,
     #[serde(default)]
     pub(crate) list_entries_per_step: f64,
-    pub pairs_interacting: u64,
-    /// Largest |energy drift| of any round, and whether it exceeded the config's limit.
-    pub max_energy_drift: f64,
-    pub sanity_ok: bool,
+    /// `None` when the code counted no pair (an external program).
+    pub pairs_interacting: Option<u64>,
+    /// Largest |energy drift| of any round, and whether it stayed within the config's limit;
+    /// `None` when no round measured a drift (an external program).
+    pub max_energy_drift: Option<f64>,
+    pub sanity_ok: Option<bool>,
     pub force_error: Option<[f64; 2]>,
     /// Largest timing overhead (clock readings) relative to the median step.
     pub(crate) clock_overhead: f64,
@@ -353,8 +357,11 @@ impl CaseRecord {
         let drift = self
             .rounds
             .iter()
-            .map(|r| r.energy_drift.abs())
-            .fold(0.0, f64::max);
+            .filter_map(|r| r.energy_drift)
+            .map(f64::abs)
+            .reduce(f64::max);
+        // An external program's rounds count no work: zeros there are "not counted".
+        let counted = measured().any(|r| r.external.is_none());
         let n = self.n.max(1) as f64;
         Some(Summary {
             median_s: med,
@@ -364,11 +371,11 @@ impl CaseRecord {
             min_s: samples.iter().copied().fold(f64::INFINITY, f64::min),
             mean_s: samples.iter().sum::<f64>() / samples.len() as f64,
             samples: samples.len(),
-            step_ns: hist.percentiles().unwrap_or_default(),
+            step_ns: hist.percentiles(),
             ns_per_particle_step: med * 1e9 / n,
             // Vetted samples take more than zero time.
             particle_steps_per_s: n / med,
-            pair_evals_per_s: pair_checks / med,
+            pair_evals_per_s: (counted && pair_checks > 0.0).then(|| pair_checks / med),
             phases: PhaseTimes {
                 force_build: mean_of(&|r| r.phases.force_build),
                 force_interact: mean_of(&|r| r.phases.force_interact),
@@ -382,9 +389,13 @@ impl CaseRecord {
             nodes_accepted_per_step: per_step(&|w| w.nodes_accepted),
             rebuilds_per_step: per_step(&|w| w.rebuilds),
             list_entries_per_step: per_step(&|w| w.list_entries),
-            pairs_interacting: self.rounds.last().map(|r| r.pairs_interacting).unwrap_or(0),
+            pairs_interacting: self
+                .rounds
+                .iter()
+                .rfind(|r| r.external.is_none() && !r.samples_s.is_empty())
+                .map(|r| r.pairs_interacting),
             max_energy_drift: drift,
-            sanity_ok: drift <= max_drift,
+            sanity_ok: drift.map(|d| d <= max_drift),
             force_error: self.rounds.iter().filter_map(|r| r.force_error).next_back(),
             clock_overhead: self
                 .rounds
@@ -539,7 +550,7 @@ mod tests {
                     round.reference_s = samples.clone();
                     round.samples_s = samples.clone();
                     round.force_error = error.map(|(a, b)| [a, b]);
-                    round.energy_drift = drift;
+                    round.energy_drift = Some(drift);
                     record.add_round(round, max_drift);
                 }
                 file.cases[0] = record;

@@ -22,8 +22,10 @@ pub struct RoundOutcome {
     pub work: WorkCounters,
     /// Interacting pairs in the final configuration.
     pub pairs_interacting: u64,
-    /// Relative energy drift from the start of the warm-up to the end of the samples.
-    pub energy_drift: f64,
+    /// Relative energy drift from the start of the warm-up to the end of the samples; `None`
+    /// (`null`) where nothing measured it: an external program, a job that ended without its
+    /// round, an MPI run of a system whose initial energy is zero.
+    pub energy_drift: Option<f64>,
     /// Median and max relative force error against an f64 direct sum, when asked.
     pub force_error: Option<[f64; 2]>,
     /// Particles actually simulated (fewer than asked only with `allow_fewer`).

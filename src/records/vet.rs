@@ -7,6 +7,7 @@
 //!
 //! [`CaseRecord`]: super::results::CaseRecord
 
+use super::external::ExternalRound;
 use super::round::RoundOutcome;
 use serde::{Deserialize, Serialize};
 
@@ -111,14 +112,19 @@ pub fn round(index: usize, round: &mut RoundOutcome) -> Vec<Rejected> {
         });
         round.force_error = None;
     }
-    if !round.energy_drift.is_finite() {
+    if let Some(drift) = round.energy_drift
+        && !drift.is_finite()
+    {
         rejected.push(Rejected {
             round: index,
             what: "energy drift".into(),
-            value: format!("{}", round.energy_drift),
+            value: format!("{drift}"),
             reason: "not a finite number: the sanity check fails".into(),
         });
-        round.energy_drift = f64::MAX;
+        round.energy_drift = Some(f64::MAX);
+    }
+    if let Some(external) = &mut round.external {
+        rejected.extend(external_phases(index, external));
     }
     let p = &mut round.phases;
     for x in [
@@ -130,6 +136,51 @@ pub fn round(index: usize, round: &mut RoundOutcome) -> Vec<Rejected> {
         &mut round.clock_overhead,
     ] {
         finite_or_zero(x);
+    }
+    rejected
+}
+
+/// A phase an external program printed, in seconds over its run of `run_s` seconds (wall), or
+/// why it cannot be one: a phase is part of the run, so it is no longer than the run (with a
+/// margin for the two clocks' readings and rounding in the printed number).
+pub(crate) fn phase_time(seconds: f64, run_s: f64) -> Result<f64, String> {
+    if !seconds.is_finite() {
+        Err("not a finite number".into())
+    } else if seconds < 0.0 {
+        Err("a duration is not negative".into())
+    } else if seconds > run_s * PHASE_MARGIN + PHASE_SLACK_S {
+        Err(format!(
+            "longer than the run it is part of ({run_s:.3e} s): a unit or parsing error"
+        ))
+    } else {
+        Ok(seconds)
+    }
+}
+
+/// How much longer than its run a printed phase may read: the program's clock and ours differ
+/// by their readings, and the printed number is rounded.
+const PHASE_MARGIN: f64 = 1.05;
+const PHASE_SLACK_S: f64 = 0.01;
+
+/// Takes out of every run the phases it cannot have taken (a file written before the runs were
+/// checked, or edited): the analysis then averages the phase over the runs that keep it.
+fn external_phases(index: usize, round: &mut ExternalRound) -> Vec<Rejected> {
+    let mut rejected = Vec::new();
+    for (i, run) in round.runs.iter_mut().enumerate() {
+        let wall_s = run.wall_s;
+        run.phases
+            .retain(|name, &mut t| match phase_time(t, wall_s) {
+                Ok(_) => true,
+                Err(reason) => {
+                    rejected.push(Rejected {
+                        round: index,
+                        what: format!("run {i}, phase `{name}`"),
+                        value: format!("{t:e} s"),
+                        reason,
+                    });
+                    false
+                }
+            });
     }
     rejected
 }
@@ -148,5 +199,15 @@ mod tests {
         assert_eq!(force_error([1e-4, 1e-3]), Ok([1e-4, 1e-3]));
         assert!(force_error([f64::NAN, 1.0]).is_err());
         assert!(force_error([1e-4, -1.0]).is_err());
+        assert_eq!(phase_time(0.4, 0.5), Ok(0.4));
+        assert_eq!(phase_time(0.0, 0.5), Ok(0.0));
+        for bad in [100.0, f64::MAX, f64::INFINITY, f64::NAN, -1e-3] {
+            assert!(phase_time(bad, 0.5).is_err(), "{bad}");
+        }
+        assert!(
+            phase_time(100.0, 0.5)
+                .unwrap_err()
+                .contains("longer than the run")
+        );
     }
 }

@@ -54,7 +54,9 @@ pub(crate) fn render_all(analysis: &Analysis, dir: &Path) -> (Vec<Figure>, Vec<S
 pub fn caption(analysis: &Analysis) -> String {
     let machine = match &analysis.calibration {
         Some(c) => format!("{} ({} logical CPUs)", c.cpu_model, c.logical_cpus),
-        None => analysis.metadata.host.clone(),
+        // Without a calibration the machine is not described; its host name is not shown
+        // (figures are shared).
+        None => "machine not calibrated".to_string(),
     };
     let commit: String = analysis.metadata.git_commit.chars().take(7).collect();
     let dirty = if analysis.metadata.git_dirty {
@@ -232,18 +234,37 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         let mut bars = fig::phase_breakdown(&phases, &cap);
         bars.title = format!("{scen}: time per step by phase");
         out.push((format!("phases-{}", slug(scen)), Drawing::Bars(bars)));
-        let rows: Vec<Percentiles> = cases
+        // A code timed per run (an external program) has no step times: it is left out and
+        // named under the figure, never drawn at zero.
+        let (timed, untimed): (Vec<&&Point>, Vec<&&Point>) =
+            cases.iter().partition(|c| c.step_ns.is_some());
+        let rows: Vec<Percentiles> = timed
             .iter()
-            .map(|c| Percentiles {
-                kernel: case_label(c),
-                p50: c.step_ns.p50 as f64 * 1e-9,
-                p90: c.step_ns.p90 as f64 * 1e-9,
-                p99: c.step_ns.p99 as f64 * 1e-9,
-                max: c.step_ns.max as f64 * 1e-9,
+            .filter_map(|c| {
+                let s = c.step_ns.as_ref()?;
+                Some(Percentiles {
+                    kernel: case_label(c),
+                    p50: s.p50 as f64 * 1e-9,
+                    p90: s.p90 as f64 * 1e-9,
+                    p99: s.p99 as f64 * 1e-9,
+                    max: s.max as f64 * 1e-9,
+                })
             })
             .collect();
-        let mut chart = fig::step_percentiles(&rows, &cap);
-        chart.title = format!("{scen}: step-time percentiles");
+        if rows.is_empty() {
+            continue;
+        }
+        let mut note = cap.clone();
+        if !untimed.is_empty() {
+            let mut programs: Vec<&str> = untimed.iter().map(|c| c.case.kernel.name()).collect();
+            programs.dedup();
+            note = format!(
+                "not drawn: {} (timed per run, not per step)\n{cap}",
+                programs.join(", ")
+            );
+        }
+        let mut chart = fig::step_percentiles(&rows, &note);
+        chart.title = format!("{scen}: step-time percentiles at each case's largest n");
         out.push((format!("percentiles-{}", slug(scen)), Drawing::Chart(chart)));
     }
     // Octree accuracy vs cost.
@@ -300,10 +321,19 @@ fn setting_label(p: &Point, series: &KernelOrProgram) -> Option<String> {
 
 /// "octree θ=0.5 p=2 n=16384" — short enough for a category axis: the case key (whose form
 /// the results file fixes) without its scenario, seed and single rank.
+/// A case in a figure or a table of cases: its code with θ and expansion, n, then the workers
+/// (the seed and the scenario are the figure's).
 pub(crate) fn case_label(c: &Point) -> String {
-    let mut parts: Vec<&str> = c.key.split('/').collect();
-    parts.retain(|p| !p.starts_with("seed=") && *p != "r=1");
-    parts[1..].join(" ").replace("theta=", "θ=")
+    let code = crate::analysis::peers::case_label(c);
+    let (code, workers) = code.split_once(", ").unwrap_or((&code, ""));
+    let mut label = match code.split_once(' ') {
+        Some((kernel, rest)) => format!("{kernel} n={} {rest}", c.n),
+        None => format!("{code} n={}", c.n),
+    };
+    if !workers.is_empty() {
+        label.push_str(&format!(", {workers}"));
+    }
+    label
 }
 
 fn oversubscribed_at(points: &[Point], p: f64) -> bool {

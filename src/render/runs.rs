@@ -43,7 +43,7 @@ pub fn external_runs(a: &Analysis) -> String {
             let _ = write!(md, ", environment {}", code(&command_line(&env)));
         }
         let _ = write!(md, "; {}", workers(a, &e.name));
-        let _ = write!(md, "; {} steps per run, {}", e.steps, timing(e));
+        let _ = write!(md, "; {} steps per run, {}", e.steps.describe(), timing(e));
         if e.warmup_runs > 0 {
             let _ = write!(md, ", after {} untimed runs each round", e.warmup_runs);
         }

@@ -78,15 +78,15 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.cases.is_empty() {
         let _ = writeln!(md, "## Energy checks\n\n{}", tables::sanity([a], false));
     }
-    let flagged: Vec<_> = a.cases.iter().filter(|c| !c.sanity_ok).collect();
+    let flagged: Vec<_> = a
+        .cases
+        .iter()
+        .filter_map(|c| Some((c, c.max_energy_drift?)).filter(|_| c.sanity_ok == Some(false)))
+        .collect();
     if !flagged.is_empty() {
         md.push_str("## Physics checks that failed\n\n");
-        for c in flagged {
-            let _ = writeln!(
-                md,
-                "- {}: energy drift {:.2e} over the limit",
-                c.key, c.max_energy_drift
-            );
+        for (c, drift) in flagged {
+            let _ = writeln!(md, "- {}: energy drift {drift:.2e} over the limit", c.key);
         }
         md.push('\n');
     }

@@ -152,11 +152,8 @@ pub fn complexity(a: &Analysis) -> String {
             Duration(last.median_s).to_string(),
             format!("{:.1}", last.ns_per_particle_step),
             // An external program counts no pairs: none, rather than a rate of zero.
-            if last.pair_evals_per_s > 0.0 {
-                format!("{:.2e}", last.pair_evals_per_s)
-            } else {
-                NONE.to_string()
-            },
+            last.pair_evals_per_s
+                .map_or(NONE.to_string(), |r| format!("{r:.2e}")),
             peak,
             k,
             class,
@@ -345,18 +342,24 @@ pub fn sanity<'a>(analyses: impl IntoIterator<Item = &'a Analysis>, by_sweep: bo
 
 /// The rows of `a` in the energy-check table, led by `sweep` when given.
 fn sanity_rows(table: &mut Table, a: &Analysis, sweep: Option<&str>) {
-    let mut rows: Vec<(&Point, usize, f64, usize)> = Vec::new();
+    // Per scenario and code: its cases, the largest drift and the cases over the limit among
+    // those that measured one (none for an external program: "–", not a drift of zero).
+    let mut rows: Vec<(&Point, usize, Option<f64>, usize)> = Vec::new();
     for c in &a.cases {
-        let same = |r: &&mut (&Point, usize, f64, usize)| {
+        let same = |r: &&mut (&Point, usize, Option<f64>, usize)| {
             r.0.case.scenario == c.case.scenario && r.0.case.kernel == c.case.kernel
         };
+        let flagged = usize::from(c.sanity_ok == Some(false));
         match rows.iter_mut().find(same) {
             Some(r) => {
                 r.1 += 1;
-                r.2 = r.2.max(c.max_energy_drift);
-                r.3 += usize::from(!c.sanity_ok);
+                r.2 = match (r.2, c.max_energy_drift) {
+                    (Some(a), Some(b)) => Some(a.max(b)),
+                    (a, b) => a.or(b),
+                };
+                r.3 += flagged;
             }
-            None => rows.push((c, 1, c.max_energy_drift, usize::from(!c.sanity_ok))),
+            None => rows.push((c, 1, c.max_energy_drift, flagged)),
         }
     }
     for (c, cases, drift, flagged) in rows {
@@ -364,8 +367,8 @@ fn sanity_rows(table: &mut Table, a: &Analysis, sweep: Option<&str>) {
             c.case.scenario.name().to_string(),
             c.case.kernel.name().to_string(),
             cases.to_string(),
-            format!("{drift:.1e}"),
-            flagged.to_string(),
+            drift.map_or(NONE.to_string(), |d| format!("{d:.1e}")),
+            drift.map_or(NONE.to_string(), |_| flagged.to_string()),
         ]));
     }
 }

@@ -110,7 +110,7 @@ fn communication_phases_stand_as_the_cases_communication() {
     let table = nbody_bench::render::runs::external_phases(&analysis);
     let row = table
         .lines()
-        .find(|l| l.contains("mpi-like") && l.contains("p=2"))
+        .find(|l| l.contains("mpi-like") && l.contains("2 threads"))
         .unwrap_or_else(|| panic!("no row for the 2-thread case in\n{table}"));
     let quarter = nbody_bench::units::Duration(0.25e-3);
     assert!(

@@ -19,9 +19,10 @@ use std::path::Path;
 /// Empty runs whose median is the launch overhead.
 const EMPTY_RUNS: usize = 3;
 
-/// The steps one run of `ext` simulates for `case` (a weak-by-time case multiplies them).
+/// The steps one run of `ext` simulates for `case`: its rule at the case's n (a weak-by-time
+/// case multiplies them).
 pub fn steps(ext: &External, case: &Case) -> u64 {
-    ext.steps * case.time_factor.max(1)
+    ext.steps.at(case.n).saturating_mul(case.time_factor.max(1))
 }
 
 /// The placeholder values of `case`.
@@ -314,12 +315,15 @@ fn sample(
     for (name, re, unit) in phases {
         let t = match last_number(re, done) {
             // Zero is a duration: a phase the run did not enter (no frame written, say).
-            Some(Ok(t)) if t.is_finite() && t >= 0.0 => t * unit,
-            Some(Ok(t)) => {
-                return fail(format!(
-                    "it printed the phase `{name}` as {t}, not a duration"
-                ));
-            }
+            Some(Ok(t)) => match crate::records::vet::phase_time(t * unit, done.wall_s) {
+                Ok(t) => t,
+                Err(why) => {
+                    return fail(format!(
+                        "it printed the phase `{name}` as {t} ({:e} s): {why}",
+                        t * unit
+                    ));
+                }
+            },
             Some(Err(text)) => {
                 return fail(format!(
                     "the phase `{name}` regex `{}` matched `{text}`, which is not a number",
@@ -376,7 +380,7 @@ fn outcome(ext: &External, case: &Case, round: ExternalRound, steps: u64) -> Rou
         phases: Default::default(),
         work: Default::default(),
         pairs_interacting: 0,
-        energy_drift: 0.0,
+        energy_drift: None,
         force_error,
         n: case.n,
         clock_overhead: round.overhead_share.unwrap_or(0.0),

@@ -82,19 +82,21 @@ pub struct Percentiles {
     pub max: f64,
 }
 
-/// p50, p90, p99 and max step time per kernel on a log time axis; the four markers of a kernel
-/// sit side by side around its position so that close values stay visible.
+/// p50, p90, p99 and max step time per case on a log time axis, one row per case (the first on
+/// top, its whole name on the left); the four markers of a case sit one above the other around
+/// its row so that close values stay visible.
 pub fn step_percentiles(rows: &[Percentiles], caption: &str) -> Chart {
-    let names = rows.iter().map(|r| r.kernel.clone()).collect();
-    let x = Axis::categorical("kernel", names);
-    let y = Axis::log("time per step").unit(Unit::Seconds);
-    let mut chart = Chart::new("Step-time percentiles per kernel", x, y).caption(caption);
+    let names = rows.iter().rev().map(|r| r.kernel.clone()).collect();
+    let x = Axis::log("time per step").unit(Unit::Seconds);
+    let y = Axis::categorical("", names);
+    let mut chart = Chart::new("Step-time percentiles per case", x, y).caption(caption);
+    let last = rows.len().saturating_sub(1);
     for (k, name) in ["p50", "p90", "p99", "max"].into_iter().enumerate() {
-        let offset = (k as f64 - 1.5) * 0.1;
+        let offset = (1.5 - k as f64) * 0.1;
         let points = rows
             .iter()
             .enumerate()
-            .map(|(i, r)| Point::new(i as f64 + offset, [r.p50, r.p90, r.p99, r.max][k]))
+            .map(|(i, r)| Point::new([r.p50, r.p90, r.p99, r.max][k], (last - i) as f64 + offset))
             .collect();
         chart
             .series
@@ -241,7 +243,8 @@ mod tests {
         }];
         let chart = step_percentiles(&rows, "");
         assert_eq!(chart.series.len(), 4);
-        assert!(chart.series.iter().all(|s| s.points[0].x.abs() < 0.5));
+        assert!(chart.series.iter().all(|s| s.points[0].y.abs() < 0.5));
+        assert_eq!(chart.y.categories, ["naive"]);
     }
 
     #[test]

@@ -17,8 +17,9 @@ pub struct External {
     /// Run (untimed) before each round's samples, e.g. to write the initial state.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub setup: Vec<String>,
-    /// Time steps of one run: a sample's time per step is its time divided by this.
-    pub steps: u64,
+    /// Time steps of one run: a number, or a number that falls as n grows
+    /// (`{ work, grows }`); a sample's time per step is its time divided by the run's steps.
+    pub steps: Steps,
     /// How a run is timed: `"wall"` or `{ regex, unit }` on its output.
     pub time: TimeSource,
     /// Phases the program times itself, each found in its output like `time` (its total over
@@ -57,12 +58,91 @@ pub struct External {
     /// Scenarios its cases stand for [default: the config's].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scenarios: Option<Vec<ScenarioKind>>,
+    /// Particle counts of its cases [default: the config's]; not in a weak study, whose
+    /// sizes follow from the workers.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub n: Option<Vec<usize>>,
     /// Thread counts [default: the config's].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<Vec<usize>>,
     /// Rank counts [default: the `[mpi]` table's, else 1].
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ranks: Option<Vec<usize>>,
+}
+
+/// The time steps of one run of an external program.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Steps {
+    /// The same at every n.
+    Fixed(u64),
+    /// About `work` units of the program's cost per run, a step costing `grows`(n): fewer
+    /// steps at larger n, so that a direct O(n²) code runs long enough at small n without
+    /// running for hours at large n.
+    Scaled(ScaledSteps),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ScaledSteps {
+    /// The cost of one run, in the units of `grows` (pair interactions for `"n^2"`).
+    pub work: f64,
+    pub grows: Growth,
+}
+
+/// How the cost of one step grows with n.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Growth {
+    #[serde(rename = "n")]
+    Linear,
+    #[serde(rename = "n log n")]
+    NLogN,
+    #[serde(rename = "n^2")]
+    Quadratic,
+}
+
+/// The most steps one run may be asked for: a scaled rule at a small n stays a run, not a
+/// lifetime.
+pub const MAX_STEPS: u64 = 1 << 40;
+
+impl Growth {
+    pub fn name(self) -> &'static str {
+        match self {
+            Growth::Linear => "n",
+            Growth::NLogN => "n log n",
+            Growth::Quadratic => "n^2",
+        }
+    }
+
+    /// The cost of one step at `n`, in the rule's units.
+    fn cost(self, n: usize) -> f64 {
+        let n = n.max(1) as f64;
+        match self {
+            Growth::Linear => n,
+            Growth::NLogN => n * n.log2().max(1.0),
+            Growth::Quadratic => n * n,
+        }
+    }
+}
+
+impl Steps {
+    /// The steps of one run at `n`: at least 1.
+    pub fn at(self, n: usize) -> u64 {
+        match self {
+            Steps::Fixed(s) => s,
+            Steps::Scaled(r) => (r.work / r.grows.cost(n))
+                .round()
+                .clamp(1.0, MAX_STEPS as f64) as u64,
+        }
+    }
+
+    /// For a person: "100", or "about 4e8 / n^2 (at least 1)".
+    pub fn describe(self) -> String {
+        match self {
+            Steps::Fixed(s) => s.to_string(),
+            Steps::Scaled(r) => format!("{:e} / {} (at least 1)", r.work, r.grows.name()),
+        }
+    }
 }
 
 /// Letters, digits, '-', '_' and '.', not empty: what names a case or a family.
@@ -268,8 +348,31 @@ impl External {
                 return bad(&format!("env.{name}"), e.to_string());
             }
         }
-        if self.steps == 0 {
-            return bad("steps", "must be at least 1".into());
+        match self.steps {
+            Steps::Fixed(s) if s == 0 || s > MAX_STEPS => {
+                return bad(
+                    "steps",
+                    format!("must be at least 1 (and at most {MAX_STEPS})"),
+                );
+            }
+            Steps::Scaled(r) if !(r.work.is_finite() && r.work >= 1.0) => {
+                return bad(
+                    "steps.work",
+                    format!(
+                        "is {}: it must be a finite cost of one run, at least 1",
+                        r.work
+                    ),
+                );
+            }
+            _ => {}
+        }
+        if let Some(n) = &self.n
+            && (n.is_empty() || n.contains(&0))
+        {
+            return bad(
+                "n",
+                "must be a non-empty list of particle counts >= 1".into(),
+            );
         }
         if !(self.timeout_s.is_finite()
             && self.timeout_s > 0.0
@@ -322,6 +425,19 @@ impl External {
                 return bad(
                     "family",
                     format!("is `{f}`: it must be letters, digits, '-', '_' and '.'"),
+                );
+            }
+            // A family names a series in tables and figures beside the built-in kernels' own.
+            if crate::kernels::KernelKind::ALL
+                .iter()
+                .any(|k| k.name() == f)
+            {
+                return bad(
+                    "family",
+                    format!(
+                        "is `{f}`, a built-in kernel's name: its series would read as that \
+                         kernel's; choose another"
+                    ),
                 );
             }
             if self.force_error.is_none() {
@@ -397,6 +513,7 @@ pub(crate) struct Around<'a> {
     /// The `[mpi]` table's rank counts, if it has one.
     pub(crate) mpi_ranks: Option<&'a [usize]>,
     pub strong: bool,
+    pub(crate) weak: bool,
     /// A weak study whose rule is the kernels' cost model.
     pub(crate) weak_cost_model: bool,
 }
@@ -422,6 +539,14 @@ pub(crate) fn validate_entries(
             return Err((
                 format!("external.{}.threads", e.name),
                 "must include 1 thread and 1 rank for a strong-scaling study".into(),
+            ));
+        }
+        if around.weak && e.n.is_some() {
+            return Err((
+                format!("external.{}.n", e.name),
+                "does not apply to study = \"weak\": its sizes follow from weak.base_n and the \
+                 workers; remove `n`"
+                    .into(),
             ));
         }
         if around.weak_cost_model {

@@ -119,6 +119,11 @@ pub enum LineProblem {
     Columns(String),
     #[error("a body before the `# columns:` line: an exported state names its columns first")]
     NoColumns,
+    #[error(
+        "a second `# columns:` line (the first is line {first}): one file holds bodies of one \
+         dimension; remove one of them"
+    )]
+    ColumnsTwice { first: usize },
     #[error("{found} values where {} were expected ({})", .want.len(), .want.join(" "))]
     Count {
         found: usize,
@@ -320,6 +325,12 @@ impl Reader {
     /// A `#` line of an exported state: the columns, and the scenario it came from.
     fn header(&mut self, number: usize, comment: &str) -> Result<(), LineProblem> {
         if let Some(columns) = comment.strip_prefix("columns:") {
+            // A second line would switch the dimension of the bodies after it, silently.
+            if self.dim.is_some() {
+                return Err(LineProblem::ColumnsTwice {
+                    first: self.dim_line,
+                });
+            }
             let columns = columns.split_whitespace().collect::<Vec<_>>().join(" ");
             let dim = [2, 3]
                 .into_iter()

@@ -117,6 +117,13 @@ fn an_empty_file_and_a_headless_export_are_refused() {
     assert!(line == 2 && matches!(p, LineProblem::Version(_)), "{p:?}");
     let (line, p) = line_error("# nbody-bench initial state v1\n# columns: id x vx mass\n");
     assert!(line == 2 && matches!(p, LineProblem::Columns(_)), "{p:?}");
+    // A second columns line would read the bodies after it in another dimension.
+    let (line, p) = line_error(
+        "# nbody-bench initial state v1\n# columns: id x y vx vy mass strength\n\
+         0 0.1 0.2 0 0 1 1\n# columns: id x y z vx vy vz mass strength\n\
+         1 0.1 0.2 0.3 0 0 0 1 1\n",
+    );
+    assert_eq!((line, p), (4, LineProblem::ColumnsTwice { first: 2 }));
 }
 
 #[test]
