@@ -60,8 +60,9 @@ pub enum Command {
     /// Write a scenario's initial state for another code: a LAMMPS data file (reduced units),
     /// or a text / .npy table of positions, velocities, masses and strengths.
     Export(ExportArgs),
-    /// Write a commented sweep config for your own program, every key explained (NAME.toml):
-    /// edit it, then `nbody-bench sweep --config NAME.toml`.
+    /// Write a commented sweep config for your own program, every key explained (NAME.toml;
+    /// with `--lang python` also NAME.py, a driver to put your code in): edit it, then
+    /// `nbody-bench sweep --config NAME.toml`.
     Init(InitArgs),
     /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
     /// every key of a sweep config.
@@ -74,14 +75,31 @@ pub enum Command {
 }
 
 #[derive(Debug, Args)]
+#[command(
+    after_help = "Examples:\n  nbody-bench init --external mycode                # mycode.toml, for mycode.c\n  \
+    nbody-bench init --external mysim --lang python   # mysim.toml and the driver mysim.py"
+)]
 pub struct InitArgs {
     /// Your program's name: the name of its cases and of the config file.
     #[arg(long, value_name = "NAME")]
     pub external: String,
+    /// The language of the program, which sets how the config builds and runs it.
+    #[arg(long, value_enum, default_value_t = InitLang::C)]
+    pub lang: InitLang,
     /// Write the config here [default: NAME.toml in the current directory]; an existing file
-    /// is never replaced.
+    /// is never replaced. With `--lang python` the driver NAME.py is written beside it.
     #[arg(long, value_name = "FILE")]
     pub out: Option<std::path::PathBuf>,
+}
+
+/// The language an `init` template is written for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum InitLang {
+    /// A C program with OpenMP, compiled by `setup` (cc -fopenmp) from NAME.c beside the config.
+    C,
+    /// A Python program run by python3: also writes NAME.py, a standard-library direct-summation
+    /// driver that prints its time, where your code's calls go (REBOUND's, for example).
+    Python,
 }
 
 #[derive(Debug, Args)]

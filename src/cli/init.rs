@@ -1,14 +1,36 @@
-//! `nbody-bench init --external NAME`: a commented sweep config for the user's own program,
-//! written from configs/templates/external.toml with the program's name in it.
+//! `nbody-bench init --external NAME [--lang c|python]`: a commented sweep config for the user's
+//! own program, written from a template of configs/templates/ with the program's name in it;
+//! for Python also the driver NAME.py beside it, the program the config runs.
 
-use crate::cli::args::InitArgs;
+use crate::cli::args::{InitArgs, InitLang};
 use anyhow::bail;
 use nbody_bench::records::config::SweepConfig;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-const TEMPLATE: &str = include_str!("../../configs/templates/external.toml");
-/// The program name the template is written for.
+/// The program name the templates are written for.
 const TEMPLATE_NAME: &str = "mycode";
+
+/// What `init` writes for one language: the config and, when the template has one, the program
+/// that goes beside it (its file extension and text).
+struct Template {
+    config: &'static str,
+    program: Option<(&'static str, &'static str)>,
+}
+
+impl Template {
+    fn of(lang: InitLang) -> Template {
+        match lang {
+            InitLang::C => Template {
+                config: include_str!("../../configs/templates/external.toml"),
+                program: None,
+            },
+            InitLang::Python => Template {
+                config: include_str!("../../configs/templates/external-python.toml"),
+                program: Some(("py", include_str!("../../configs/templates/external.py"))),
+            },
+        }
+    }
+}
 
 pub fn init(args: InitArgs) -> anyhow::Result<i32> {
     let name = args.external.as_str();
@@ -24,25 +46,73 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
     {
         bail!("--external `{name}` is a built-in kernel's name; choose another");
     }
+    let template = Template::of(args.lang);
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{name}.toml")));
-    nbody_bench::output::check_outputs(&[("--out", out.as_path())], &[])?;
-    if std::fs::symlink_metadata(&out).is_ok() {
-        bail!(
-            "{} exists: init never replaces a file; remove it or write elsewhere with --out FILE",
-            out.display()
-        );
+    // The config runs the program as {config_dir}/NAME.EXT: it goes in the config's directory.
+    let program = template.program.map(|(ext, text)| {
+        let dir = out.parent().unwrap_or(Path::new(""));
+        (
+            dir.join(format!("{name}.{ext}")),
+            text.replace(TEMPLATE_NAME, name),
+        )
+    });
+    let mut outputs = vec![("--out", out.as_path())];
+    outputs.extend(
+        program
+            .iter()
+            .map(|(path, _)| ("the program", path.as_path())),
+    );
+    nbody_bench::output::check_outputs(&outputs, &[])?;
+    // Both are checked before either is written: a refusal leaves nothing behind.
+    for (_, path) in &outputs {
+        if std::fs::symlink_metadata(path).is_ok() {
+            bail!(
+                "{} exists: init never replaces a file; remove it or write elsewhere with --out \
+                 FILE{}",
+                path.display(),
+                if program.is_some() {
+                    " (the program goes beside the config)"
+                } else {
+                    ""
+                }
+            );
+        }
     }
-    let text = TEMPLATE.replace(TEMPLATE_NAME, name);
+    let text = template.config.replace(TEMPLATE_NAME, name);
     // What is written is a config the sweep accepts as it is.
     SweepConfig::parse(&text, &out)?;
-    nbody_bench::output::write_atomic(&out, text.as_bytes())?;
-    eprintln!(
-        "wrote {out}: put your source beside it as {name}.c (or edit `setup` and `command`), make \
-         it print `time total SECONDS`, then\n  nbody-bench sweep --config {out} --dry-run\n  \
-         nbody-bench sweep --config {out}",
-        out = out.display()
-    );
+    if let Some((path, code)) = &program {
+        nbody_bench::output::write_atomic(path, code.as_bytes())?;
+    }
+    if let Err(e) = nbody_bench::output::write_atomic(&out, text.as_bytes()) {
+        // A program without its config is half an init: take it back, so that a second try
+        // does not find it in the way.
+        if let Some((path, _)) = &program {
+            let _ = std::fs::remove_file(path);
+        }
+        return Err(e.into());
+    }
+    next_steps(&out, name, program.as_ref().map(|(path, _)| path.as_path()));
     Ok(0)
+}
+
+/// What to do with the files just written.
+fn next_steps(out: &Path, name: &str, program: Option<&Path>) {
+    let out = out.display();
+    match program {
+        None => eprintln!(
+            "wrote {out}: put your source beside it as {name}.c (or edit `setup` and `command`), \
+             make it print `time total SECONDS`, then\n  nbody-bench sweep --config {out} \
+             --dry-run\n  nbody-bench sweep --config {out}"
+        ),
+        Some(program) => eprintln!(
+            "wrote {out} and {program}, a direct-summation program that prints `time total \
+             SECONDS`: try it with\n  python3 {program} --n 200 --steps 10\nput your code's \
+             calls in its `evolve`, then\n  nbody-bench sweep --config {out} --dry-run\n  \
+             nbody-bench sweep --config {out}",
+            program = program.display()
+        ),
+    }
 }

@@ -25,6 +25,7 @@ mod gate;
 mod gate_baselines;
 mod gate_refusals;
 mod init;
+mod init_python;
 mod initial;
 mod integrity;
 mod invariants;
