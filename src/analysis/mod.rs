@@ -395,9 +395,11 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
     });
     let serial_comparison = match (&timed_serial, &fit.fit) {
         (Some(t), Some(f)) => {
+            // Only a program's use of its workers is in doubt: a built-in kernel is known to
+            // use them (no speedup there is the cost of running in parallel at this n).
             let best = measured
                 .iter()
-                .filter(|m| m.p > 1.0)
+                .filter(|m| m.p > 1.0 && kernel_of(s).is_none())
                 .map(|m| m.speedup.estimate)
                 .reduce(f64::max);
             Some(fit::compare_serial_fractions(t, &f.serial_fraction, best))

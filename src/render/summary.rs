@@ -31,6 +31,10 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             tables::peak_note(),
             tables::complexity(a)
         );
+        let notes = tables::complexity_notes(a);
+        if !notes.is_empty() {
+            let _ = writeln!(md, "What the fits cannot tell:\n\n{notes}");
+        }
     }
     if !a.crossovers.is_empty() {
         let _ = writeln!(md, "## Crossovers\n\n{}", tables::crossovers(a));

@@ -237,6 +237,18 @@ pub fn strong(a: &Analysis) -> String {
     table.markdown()
 }
 
+/// The notes of each complexity fit (a class not firmly determined, a range of n too short to
+/// tell two classes apart), one line each.
+pub(crate) fn complexity_notes(a: &Analysis) -> String {
+    let mut md = String::new();
+    for c in &a.complexity {
+        for note in c.fit.fit.iter().flat_map(|f| &f.notes) {
+            let _ = writeln!(md, "- {} {}: {note}", c.series.scenario.name(), c.label);
+        }
+    }
+    md
+}
+
 /// Each strong series' timed serial fraction next to the fitted one, one line each.
 pub(crate) fn serial_comparisons(a: &Analysis) -> String {
     let mut md = String::new();

@@ -196,6 +196,10 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
             tables::peak_note()
         );
         md.push_str(&tables::complexity(a));
+        let notes = tables::complexity_notes(a);
+        if !notes.is_empty() {
+            let _ = write!(md, "\nWhat the fits cannot tell:\n\n{notes}");
+        }
         if !a.crossovers.is_empty() {
             md.push_str("\nCrossovers of the fitted curves:\n\n");
             md.push_str(&tables::crossovers(a));

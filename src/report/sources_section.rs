@@ -132,6 +132,10 @@ fn lj_box(md: &mut String, sweeps: &[Sweep]) {
     if !a.complexity.is_empty() {
         md.push_str("Growth with n, every code:\n\n");
         md.push_str(&tables::complexity(a));
+        let notes = tables::complexity_notes(a);
+        if !notes.is_empty() {
+            let _ = write!(md, "\nWhat the fits cannot tell:\n\n{notes}");
+        }
         md.push('\n');
     }
     s.figure_links(md, "phases-");

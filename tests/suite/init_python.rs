@@ -193,6 +193,11 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
     assert_eq!(out.status.code(), Some(0), "{said}");
     assert!(said.contains("galaxy/pysim/n=250/p=1/r=1/seed=1"), "{said}");
     assert!(!said.contains("galaxy/pysim/n=250/p=2/"), "{said}");
+    // Steps that fall as n grows: 2.5e6 / 250² and / 1000² (rounded).
+    assert!(
+        said.contains("40 steps") && said.contains("3 steps"),
+        "{said}"
+    );
 
     // One small n, one kernel, two samples in one round: a real sweep in about a second.
     let config = dir.path().join("pysim.toml");
@@ -203,6 +208,11 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
         (
             "\nkernels = [\"symmetric\", \"naive\", \"octree\"]\n",
             "\nkernels = [\"symmetric\"]\n",
+        ),
+        // 16000 / 40² = 10 steps a run.
+        (
+            "\nsteps = { work = 2.5e6, grows = \"n^2\" }\n",
+            "\nsteps = { work = 16000, grows = \"n^2\" }\n",
         ),
         ("\nsamples = 5\n", "\nsamples = 2\n"),
         ("\nrounds = 2\n", "\nrounds = 1\n"),
@@ -234,7 +244,8 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
     for round in &case.rounds {
         let runs = &round.external.as_ref().unwrap().runs;
         assert_eq!(runs.len(), 2);
-        // Each sample is the printed loop time over the entry's 10 steps.
+        // Each sample is the printed loop time over the run's 10 steps.
+        assert_eq!(round.steps_per_sample, 10);
         for (run, sample) in runs.iter().zip(&round.samples_s) {
             let printed = run.reported_s.unwrap();
             assert!(printed > 0.0 && (sample * 10.0 - printed).abs() <= 1e-12 * printed);
