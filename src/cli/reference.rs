@@ -162,7 +162,7 @@ fn meaning(key: &str) -> Option<&'static str> {
         "precision" => "overrides each scenario's precision (when left out: each scenario's own)",
         "out" => "the results directory",
         "initial" => {
-            "every case starts from the bodies in this file (relative to the config's directory) instead of the seeded placement: the built-in kernels, in this process or under [mpi]"
+            "every case starts from the bodies in this file (relative to the config's directory) instead of the seeded placement: the built-in kernels, in this process or under [mpi]; read once at the start (launched runs read the sweep's copy, initial/ beside the results)"
         }
         "measure" => "how each case is measured",
         "weak" => "weak studies only: how n grows with the workers",

@@ -98,6 +98,8 @@ pub enum SweepError {
     Initial {
         source: crate::scenario::initial::InitialError,
     },
+    #[error("cannot keep the sweep's copy of the file of bodies: {source}")]
+    InitialCopy { source: crate::output::WriteError },
     #[error(transparent)]
     Lock(#[from] super::lock::LockError),
     #[error(transparent)]
@@ -169,7 +171,7 @@ pub fn run_sweep<C: Clock>(
     let planned = crate::records::plan::unique_cases(config).map_err(SweepError::Plan)?;
     let initial = initial_bodies(config, options)?;
     for case in planned {
-        let setup = case_setup(&case, initial.as_ref().map(|(_, b)| b.clone()));
+        let setup = case_setup(&case, initial.as_ref().map(|i| i.bodies.clone()));
         let copies = match case.decomp {
             // Every rank holds all the particles.
             Some(crate::decomp::Decomposition::Allgather) => case.ranks,
@@ -196,10 +198,8 @@ pub fn run_sweep<C: Clock>(
         None => results_path(config, options.out.as_deref()),
     };
     let mut context = external_context(options, &path)?;
-    context.initial = initial
-        .as_ref()
-        .map(|(record, _)| PathBuf::from(&record.path));
-    context.bodies = initial.as_ref().map(|(_, bodies)| bodies.clone());
+    // `context.initial`, the file launched runs read, is the sweep's own copy (made below).
+    context.bodies = initial.as_ref().map(|i| i.bodies.clone());
     for ext in &config.external {
         let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
         super::external::check_programs(ext, launcher, &context)?;
@@ -218,6 +218,24 @@ pub fn run_sweep<C: Clock>(
     // Held until the sweep returns: nobody else reads, backs up or saves this file meanwhile.
     let _writer = WriterLock::acquire(&path)?;
     let mut results = open(config, config_text, options, &path)?;
+    if let Some(initial) = initial {
+        // A resumed sweep goes on from the same bodies, or not at all.
+        if let Some(before) = results.metadata.initial.as_ref()
+            && before.fnv1a != initial.record.fnv1a
+            && !options.force
+        {
+            return Err(SweepError::Mismatch {
+                path: path.clone(),
+                what: "file of bodies",
+                detail: format!(
+                    "{} had fingerprint {}, now {}",
+                    initial.record.path, before.fnv1a, initial.record.fnv1a
+                ),
+            });
+        }
+        context.initial = Some(keep_initial(&path, &initial)?);
+        results.metadata.initial = Some(initial.record);
+    }
     #[cfg(feature = "test-slowdown")]
     if let Some(s) = slowdown {
         observer.message(&format!(
@@ -258,23 +276,6 @@ pub fn run_sweep<C: Clock>(
             observer.message(&cal.summary());
         }
         results.calibration.start = cal;
-    }
-    if let Some((record, _)) = initial {
-        // A resumed sweep goes on from the same bodies, or not at all.
-        if let Some(before) = results.metadata.initial.as_ref()
-            && before.fnv1a != record.fnv1a
-            && !options.force
-        {
-            return Err(SweepError::Mismatch {
-                path: path.clone(),
-                what: "file of bodies",
-                detail: format!(
-                    "{} had fingerprint {}, now {}",
-                    record.path, before.fnv1a, record.fnv1a
-                ),
-            });
-        }
-        results.metadata.initial = Some(record);
     }
     if results.metadata.externals.is_empty() && !config.external.is_empty() {
         results.metadata.externals = config
@@ -462,33 +463,66 @@ fn calibrate(
     Ok(calibration)
 }
 
-/// The config's file of bodies (`initial`), read once before anything runs, and its record for
-/// the results metadata (the path made absolute, so that MPI ranks and later rounds find it).
+/// The config's file of bodies (`initial`), as read once before anything runs.
+struct Initial {
+    /// For the results metadata (the path made absolute).
+    record: InitialRecord,
+    bodies: Arc<InitialBodies>,
+    /// The text its fingerprint is of.
+    text: String,
+}
+
+/// Reads the config's file of bodies (`initial`), if it has one.
 fn initial_bodies(
     config: &SweepConfig,
     options: &SweepOptions,
-) -> Result<Option<(InitialRecord, Arc<InitialBodies>)>, SweepError> {
+) -> Result<Option<Initial>, SweepError> {
     let Some(file) = &config.initial else {
         return Ok(None);
     };
     let dir = options.config_dir.as_deref().unwrap_or(Path::new("."));
     let path = dir.join(file);
     let path = std::path::absolute(&path).unwrap_or(path);
-    let bytes = crate::input::read_text(&path).map_err(|source| SweepError::Initial {
+    let text = crate::input::read_text(&path).map_err(|source| SweepError::Initial {
         source: crate::scenario::initial::InitialError::Read {
             path: path.clone(),
             source,
         },
     })?;
-    let bodies = crate::scenario::initial::parse(&path, &bytes)
+    let bodies = crate::scenario::initial::parse(&path, &text)
         .map_err(|source| SweepError::Initial { source })?;
     let record = InitialRecord {
         path: path.display().to_string(),
         format: bodies.format.name().to_string(),
         bodies: bodies.len(),
-        fnv1a: format!("{:016x}", crate::records::results::fnv1a(bytes.as_bytes())),
+        fnv1a: format!("{:016x}", crate::records::results::fnv1a(text.as_bytes())),
     };
-    Ok(Some((record, Arc::new(bodies))))
+    Ok(Some(Initial {
+        record,
+        bodies: Arc::new(bodies),
+        text,
+    }))
+}
+
+/// Writes the sweep's own copy of its file of bodies, `initial/<file name>` beside the results,
+/// from the text read at the start; its absolute path. Runs launched later (each round under
+/// an MPI launcher is a new process that reads the file) read this copy: the user's file may
+/// be edited or replaced while the sweep runs, and every round must start from the bodies the
+/// results' fingerprint names.
+fn keep_initial(results: &Path, initial: &Initial) -> Result<PathBuf, SweepError> {
+    let dir = results.parent().unwrap_or(Path::new(".")).join("initial");
+    std::fs::create_dir_all(&dir).map_err(|source| SweepError::Dir {
+        path: dir.clone(),
+        source,
+    })?;
+    let name = Path::new(&initial.record.path)
+        .file_name()
+        .map_or_else(|| "bodies.txt".into(), |n| n.to_os_string());
+    let copy = dir.join(name);
+    let copy = std::path::absolute(&copy).unwrap_or(copy);
+    crate::output::write_atomic(&copy, initial.text.as_bytes())
+        .map_err(|source| SweepError::InitialCopy { source })?;
+    Ok(copy)
 }
 
 /// Where external programs find the sweep; their work directories go next to the results.
