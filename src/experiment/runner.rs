@@ -271,7 +271,15 @@ pub fn run_sweep<C: Clock>(
     };
     if options.calibrate && results.calibration.start.is_none() {
         observer.message("calibrating the machine...");
-        let cal = calibrate(config, &context, &path, "start", &thread_counts, observer)?;
+        let cal = calibrate(
+            config,
+            &context,
+            &path,
+            "start",
+            &thread_counts,
+            options.resume,
+            observer,
+        )?;
         if let Some(cal) = &cal {
             observer.message(&cal.summary());
         }
@@ -338,6 +346,7 @@ pub fn run_sweep<C: Clock>(
                         results: &path,
                         config,
                         context: &context,
+                        resume: options.resume,
                     };
                     job.measure(&record.case, round, &spec, observer)?
                 }
@@ -357,8 +366,15 @@ pub fn run_sweep<C: Clock>(
         }
     }
     if options.calibrate && !stopped {
-        results.calibration.end =
-            calibrate(config, &context, &path, "end", &thread_counts, observer)?;
+        results.calibration.end = calibrate(
+            config,
+            &context,
+            &path,
+            "end",
+            &thread_counts,
+            options.resume,
+            observer,
+        )?;
         results.save(&path)?;
     }
     observer.finish();
@@ -381,6 +397,9 @@ struct JobRound<'a> {
     results: &'a Path,
     config: &'a SweepConfig,
     context: &'a super::external::Context,
+    /// `--resume`: a job an earlier sweep submitted for the round is waited for, not submitted
+    /// again. Without it nothing found in the job's directory is used.
+    resume: bool,
 }
 
 impl JobRound<'_> {
@@ -406,7 +425,15 @@ impl JobRound<'_> {
             cpus_per_task: case.threads,
         };
         let mut say = |m: &str| observer.message(m);
-        let ended = slurm::run(self.scheduler, &dir, &task, resources, &what, &mut say)?;
+        let ended = slurm::run(
+            self.scheduler,
+            &dir,
+            &task,
+            resources,
+            &what,
+            self.resume,
+            &mut say,
+        )?;
         let measured = ended.result.and_then(|r| Some((r.round?, r.step_ns)));
         Ok(match measured {
             Some((mut outcome, step_ns)) => {
@@ -437,6 +464,7 @@ fn calibrate(
     results: &Path,
     when: &str,
     threads: &[usize],
+    resume: bool,
     observer: &mut dyn Observer,
 ) -> Result<Option<crate::calibrate::Calibration>, SweepError> {
     let Some(scheduler) = &config.scheduler else {
@@ -453,11 +481,13 @@ fn calibrate(
     };
     let what = format!("calibration ({when})");
     let mut say = |m: &str| observer.message(m);
-    let ended = slurm::run(scheduler, &dir, &task, resources, &what, &mut say)?;
+    let ended = slurm::run(scheduler, &dir, &task, resources, &what, resume, &mut say)?;
     let calibration = ended.result.and_then(|r| r.calibration);
     if calibration.is_none() {
+        let why = ended.record.error.map(|e| e.what);
         observer.message(&format!(
-            "warning: {what}: the job ended without a result; the sweep goes on without it"
+            "warning: {what}: {}; the sweep goes on without it",
+            why.as_deref().unwrap_or("the job ended without a result")
         ));
     }
     Ok(calibration)

@@ -36,6 +36,7 @@ mod peers;
 mod report;
 mod runs;
 mod slurm;
+mod slurm_stand_ins;
 mod supervision;
 mod sweep;
 mod verlet;
