@@ -163,7 +163,7 @@ fn meaning(key: &str) -> Option<&'static str> {
         "precision" => "overrides each scenario's precision (when left out: each scenario's own)",
         "out" => "the results directory",
         "initial" => {
-            "every case starts from the bodies in this file (relative to the config's directory) instead of the seeded placement: the built-in kernels, in this process or under [mpi]"
+            "every case starts from the bodies in this file (relative to the config's directory) instead of the seeded placement: the built-in kernels, in this process or under [mpi]; read once at the start (launched runs read the sweep's copy, initial/ beside the results)"
         }
         "measure" => "how each case is measured",
         "weak" => "weak studies only: how n grows with the workers",
@@ -202,7 +202,10 @@ fn meaning(key: &str) -> Option<&'static str> {
         "scheduler.kind" => "the batch system",
         "scheduler.partition" => "`sbatch --partition` (when left out: the cluster's default)",
         "scheduler.account" => "`sbatch --account` (when left out: the user's default)",
-        "scheduler.time_limit" => "`sbatch --time` of each job",
+        "scheduler.time_limit" => {
+            "`sbatch --time` of each job; the sweep waits for a running job this long plus a \
+             margin (10 minutes; NBODY_BENCH_JOB_GRACE_S), then stops for --resume"
+        }
         "scheduler.sbatch_args" => "more `sbatch` arguments, given to every job",
         "scheduler.poll_s" => "seconds between two looks at the queue while a job waits or runs",
         "external.name" => "the kernel name of its cases (keys, tables, figures)",

@@ -67,7 +67,8 @@ struct CountersRecord {
 
 #[derive(Deserialize)]
 struct EnergyRecord {
-    rel_drift: f64,
+    /// `null` when the initial energy is 0: no relative drift exists then.
+    rel_drift: Option<f64>,
 }
 
 /// The launcher's arguments for one round of `case`, writing its result to `json`.
@@ -153,7 +154,9 @@ pub(crate) fn round_from_json(
         },
         work: run.counters.total,
         pairs_interacting: run.counters.pairs_interacting_final,
-        energy_drift: Some(run.energy.rel_drift),
+        // A null drift (zero initial energy) is not measured: null in the results, "–" in the
+        // tables, as for an external program's round.
+        energy_drift: run.energy.rel_drift,
         force_error: None,
         n: run.n,
         clock_overhead: if median > 0.0 {
@@ -214,7 +217,7 @@ pub(crate) fn measure_round(
         command: command.clone(),
         source,
     })?;
-    let text = std::fs::read_to_string(&json);
+    let text = crate::input::read_text(&json);
     if !output.status.success() {
         let all = String::from_utf8_lossy(&output.stderr).into_owned()
             + &String::from_utf8_lossy(&output.stdout);

@@ -11,6 +11,11 @@ use crate::run::RunError;
 use crate::scenario::{Setup, SetupError};
 use crate::stepper::{Stepper, stepper};
 
+/// The most steps a sample takes when the round chooses (from the warm-up's step times).
+pub(crate) const MAX_STEPS_PER_SAMPLE: u64 = 1_000_000;
+/// The most warm-up steps a round takes, however short its steps.
+pub(crate) const MAX_WARMUP_STEPS: u64 = 1_000_000;
+
 /// How one round of a case is measured (a batch job reads it from its task file).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub(crate) struct RoundSpec {
@@ -75,14 +80,16 @@ fn measure<C: Clock>(
         let t = clock.now();
         sim.step()?;
         warm.push((clock.now() - t).as_secs_f64());
-        if (clock.now() - warm_start).as_secs_f64() >= spec.warmup_s || warm.len() >= 1_000_000 {
+        if (clock.now() - warm_start).as_secs_f64() >= spec.warmup_s
+            || warm.len() as u64 >= MAX_WARMUP_STEPS
+        {
             break;
         }
     }
     let typical = crate::stats::median(&warm).unwrap_or(0.0).max(1e-9);
-    let k = spec
-        .steps_per_sample
-        .unwrap_or_else(|| ((spec.min_sample_s / typical).ceil() as u64).clamp(1, 1_000_000));
+    let k = spec.steps_per_sample.unwrap_or_else(|| {
+        ((spec.min_sample_s / typical).ceil() as u64).clamp(1, MAX_STEPS_PER_SAMPLE)
+    });
     let (phases0, work0, steps0) = (sim.phases(), sim.work(), sim.steps());
     let mut samples = Vec::with_capacity(spec.samples);
     let mut reference = Vec::new();
@@ -121,7 +128,9 @@ fn measure<C: Clock>(
         phases,
         work,
         pairs_interacting: sim.probe_work().pairs_interacting,
-        energy_drift: Some((e1 - e0) / e0.abs()),
+        // Relative to nothing when the initial energy is zero: not measured, as the MPI
+        // drivers record it.
+        energy_drift: (e0 != 0.0).then(|| (e1 - e0) / e0.abs()),
         force_error,
         n,
         clock_overhead: if median_step > 0.0 {

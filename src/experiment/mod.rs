@@ -17,4 +17,6 @@ pub mod runner;
 pub mod slowdown;
 pub mod slurm;
 
+// The gate study's measuring loop (built with the test-only slowdown) sets cases up as sweeps do.
+#[cfg(feature = "test-slowdown")]
 pub(crate) use case_round::case_setup;

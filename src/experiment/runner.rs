@@ -98,6 +98,8 @@ pub enum SweepError {
     Initial {
         source: crate::scenario::initial::InitialError,
     },
+    #[error("cannot keep the sweep's copy of the file of bodies: {source}")]
+    InitialCopy { source: crate::output::WriteError },
     #[error(transparent)]
     Lock(#[from] super::lock::LockError),
     #[error(transparent)]
@@ -166,7 +168,7 @@ pub fn run_sweep<C: Clock>(
         Some(dir) => dir.join("results.json"),
         None => results_path(config, options.out.as_deref()),
     };
-    let (initial, context) = preflight(config, options, &path)?;
+    let (initial, mut context) = preflight(config, options, &path)?;
     if config.scheduler.is_some() {
         slurm::check_available()?;
     }
@@ -181,6 +183,24 @@ pub fn run_sweep<C: Clock>(
     // Held until the sweep returns: nobody else reads, backs up or saves this file meanwhile.
     let _writer = WriterLock::acquire(&path)?;
     let mut results = open(config, config_text, options, &path)?;
+    if let Some(initial) = initial {
+        // A resumed sweep goes on from the same bodies, or not at all.
+        if let Some(before) = results.metadata.initial.as_ref()
+            && before.fnv1a != initial.record.fnv1a
+            && !options.force
+        {
+            return Err(SweepError::Mismatch {
+                path: path.clone(),
+                what: "file of bodies",
+                detail: format!(
+                    "{} had fingerprint {}, now {}",
+                    initial.record.path, before.fnv1a, initial.record.fnv1a
+                ),
+            });
+        }
+        context.initial = Some(keep_initial(&path, &initial)?);
+        results.metadata.initial = Some(initial.record);
+    }
     #[cfg(feature = "test-slowdown")]
     if let Some(s) = slowdown {
         observer.message(&format!(
@@ -216,28 +236,19 @@ pub fn run_sweep<C: Clock>(
     };
     if options.calibrate && results.calibration.start.is_none() {
         observer.message("calibrating the machine...");
-        let cal = calibrate(config, &context, &path, "start", &thread_counts, observer)?;
+        let cal = calibrate(
+            config,
+            &context,
+            &path,
+            "start",
+            &thread_counts,
+            options.resume,
+            observer,
+        )?;
         if let Some(cal) = &cal {
             observer.message(&cal.summary());
         }
         results.calibration.start = cal;
-    }
-    if let Some((record, _)) = initial {
-        // A resumed sweep goes on from the same bodies, or not at all.
-        if let Some(before) = results.metadata.initial.as_ref()
-            && before.fnv1a != record.fnv1a
-            && !options.force
-        {
-            return Err(SweepError::Mismatch {
-                path: path.clone(),
-                what: "file of bodies",
-                detail: format!(
-                    "{} had fingerprint {}, now {}",
-                    record.path, before.fnv1a, record.fnv1a
-                ),
-            });
-        }
-        results.metadata.initial = Some(record);
     }
     if results.metadata.externals.is_empty() && !config.external.is_empty() {
         results.metadata.externals = config
@@ -300,6 +311,7 @@ pub fn run_sweep<C: Clock>(
                         results: &path,
                         config,
                         context: &context,
+                        resume: options.resume,
                     };
                     job.measure(&record.case, round, &spec, observer)?
                 }
@@ -319,8 +331,15 @@ pub fn run_sweep<C: Clock>(
         }
     }
     if options.calibrate && !stopped {
-        results.calibration.end =
-            calibrate(config, &context, &path, "end", &thread_counts, observer)?;
+        results.calibration.end = calibrate(
+            config,
+            &context,
+            &path,
+            "end",
+            &thread_counts,
+            options.resume,
+            observer,
+        )?;
         results.save(&path)?;
     }
     observer.finish();
@@ -343,6 +362,9 @@ struct JobRound<'a> {
     results: &'a Path,
     config: &'a SweepConfig,
     context: &'a super::external::Context,
+    /// `--resume`: a job an earlier sweep submitted for the round is waited for, not submitted
+    /// again. Without it nothing found in the job's directory is used.
+    resume: bool,
 }
 
 impl JobRound<'_> {
@@ -368,7 +390,15 @@ impl JobRound<'_> {
             cpus_per_task: case.threads,
         };
         let mut say = |m: &str| observer.message(m);
-        let ended = slurm::run(self.scheduler, &dir, &task, resources, &what, &mut say)?;
+        let ended = slurm::run(
+            self.scheduler,
+            &dir,
+            &task,
+            resources,
+            &what,
+            self.resume,
+            &mut say,
+        )?;
         let measured = ended.result.and_then(|r| Some((r.round?, r.step_ns)));
         Ok(match measured {
             Some((mut outcome, step_ns)) => {
@@ -399,6 +429,7 @@ fn calibrate(
     results: &Path,
     when: &str,
     threads: &[usize],
+    resume: bool,
     observer: &mut dyn Observer,
 ) -> Result<Option<crate::calibrate::Calibration>, SweepError> {
     let Some(scheduler) = &config.scheduler else {
@@ -415,18 +446,17 @@ fn calibrate(
     };
     let what = format!("calibration ({when})");
     let mut say = |m: &str| observer.message(m);
-    let ended = slurm::run(scheduler, &dir, &task, resources, &what, &mut say)?;
+    let ended = slurm::run(scheduler, &dir, &task, resources, &what, resume, &mut say)?;
     let calibration = ended.result.and_then(|r| r.calibration);
     if calibration.is_none() {
+        let why = ended.record.error.map(|e| e.what);
         observer.message(&format!(
-            "warning: {what}: the job ended without a result; the sweep goes on without it"
+            "warning: {what}: {}; the sweep goes on without it",
+            why.as_deref().unwrap_or("the job ended without a result")
         ));
     }
     Ok(calibration)
 }
-
-/// The config's bodies, read once, with their record.
-type Initial = Option<(InitialRecord, Arc<InitialBodies>)>;
 
 /// Checks everything that can be known before the first case, as `sweep --dry-run` does too:
 /// every case's system can be built (a box its precision cannot resolve, too many particles,
@@ -449,11 +479,11 @@ fn preflight(
     config: &SweepConfig,
     options: &SweepOptions,
     path: &Path,
-) -> Result<(Initial, super::external::Context), SweepError> {
+) -> Result<(Option<Initial>, super::external::Context), SweepError> {
     let planned = crate::records::plan::unique_cases(config).map_err(SweepError::Plan)?;
     let initial = initial_bodies(config, options)?;
     for case in planned {
-        let setup = case_setup(&case, initial.as_ref().map(|(_, b)| b.clone()));
+        let setup = case_setup(&case, initial.as_ref().map(|i| i.bodies.clone()));
         let copies = match case.decomp {
             // Every rank holds all the particles.
             Some(crate::decomp::Decomposition::Allgather) => case.ranks,
@@ -476,10 +506,9 @@ fn preflight(
         })?;
     }
     let mut context = external_context(options, path)?;
-    context.initial = initial
-        .as_ref()
-        .map(|(record, _)| PathBuf::from(&record.path));
-    context.bodies = initial.as_ref().map(|(_, bodies)| bodies.clone());
+    // `context.initial`, the file launched runs read, is the sweep's own copy (made when the
+    // sweep starts measuring).
+    context.bodies = initial.as_ref().map(|i| i.bodies.clone());
     for ext in &config.external {
         let launcher = config.mpi.as_ref().map(|m| m.launcher.as_str());
         super::external::check_programs(ext, launcher, &context)?;
@@ -487,33 +516,66 @@ fn preflight(
     Ok((initial, context))
 }
 
-/// The config's file of bodies (`initial`), read once before anything runs, and its record for
-/// the results metadata (the path made absolute, so that MPI ranks and later rounds find it).
+/// The config's file of bodies (`initial`), as read once before anything runs.
+struct Initial {
+    /// For the results metadata (the path made absolute).
+    record: InitialRecord,
+    bodies: Arc<InitialBodies>,
+    /// The text its fingerprint is of.
+    text: String,
+}
+
+/// Reads the config's file of bodies (`initial`), if it has one.
 fn initial_bodies(
     config: &SweepConfig,
     options: &SweepOptions,
-) -> Result<Option<(InitialRecord, Arc<InitialBodies>)>, SweepError> {
+) -> Result<Option<Initial>, SweepError> {
     let Some(file) = &config.initial else {
         return Ok(None);
     };
     let dir = options.config_dir.as_deref().unwrap_or(Path::new("."));
     let path = dir.join(file);
     let path = std::path::absolute(&path).unwrap_or(path);
-    let bytes = crate::input::read_text(&path).map_err(|source| SweepError::Initial {
+    let text = crate::input::read_text(&path).map_err(|source| SweepError::Initial {
         source: crate::scenario::initial::InitialError::Read {
             path: path.clone(),
             source,
         },
     })?;
-    let bodies = crate::scenario::initial::parse(&path, &bytes)
+    let bodies = crate::scenario::initial::parse(&path, &text)
         .map_err(|source| SweepError::Initial { source })?;
     let record = InitialRecord {
         path: path.display().to_string(),
         format: bodies.format.name().to_string(),
         bodies: bodies.len(),
-        fnv1a: format!("{:016x}", crate::records::results::fnv1a(bytes.as_bytes())),
+        fnv1a: format!("{:016x}", crate::records::results::fnv1a(text.as_bytes())),
     };
-    Ok(Some((record, Arc::new(bodies))))
+    Ok(Some(Initial {
+        record,
+        bodies: Arc::new(bodies),
+        text,
+    }))
+}
+
+/// Writes the sweep's own copy of its file of bodies, `initial/<file name>` beside the results,
+/// from the text read at the start; its absolute path. Runs launched later (each round under
+/// an MPI launcher is a new process that reads the file) read this copy: the user's file may
+/// be edited or replaced while the sweep runs, and every round must start from the bodies the
+/// results' fingerprint names.
+fn keep_initial(results: &Path, initial: &Initial) -> Result<PathBuf, SweepError> {
+    let dir = results.parent().unwrap_or(Path::new(".")).join("initial");
+    std::fs::create_dir_all(&dir).map_err(|source| SweepError::Dir {
+        path: dir.clone(),
+        source,
+    })?;
+    let name = Path::new(&initial.record.path)
+        .file_name()
+        .map_or_else(|| "bodies.txt".into(), |n| n.to_os_string());
+    let copy = dir.join(name);
+    let copy = std::path::absolute(&copy).unwrap_or(copy);
+    crate::output::write_atomic(&copy, initial.text.as_bytes())
+        .map_err(|source| SweepError::InitialCopy { source })?;
+    Ok(copy)
 }
 
 /// Where external programs find the sweep; their work directories go next to the results.

@@ -117,7 +117,7 @@ pub fn allowed(key: &str) -> Option<&'static str> {
         "scheduler.partition" => "a partition name, such as partition = \"short\"",
         "scheduler.account" => "an account name, such as account = \"proj42\"",
         "scheduler.time_limit" => {
-            "a Slurm time limit per job: minutes, MM:SS, HH:MM:SS or D-HH[:MM[:SS]], such as time_limit = \"10:00\""
+            "a Slurm time limit per job, above zero: minutes, MM:SS, HH:MM:SS or D-HH[:MM[:SS]], such as time_limit = \"10:00\""
         }
         "scheduler.sbatch_args" => "a list of strings, such as sbatch_args = [\"--qos=short\"]",
         "scheduler.poll_s" => "seconds above 0, at most 3600, such as poll_s = 5",

@@ -2,6 +2,7 @@
 //! Slurm) and what a round's results keep of its job.
 
 use serde::{Deserialize, Serialize};
+use std::time::Duration;
 
 /// How a sweep submits its work to a batch system.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -51,6 +52,16 @@ impl Scheduler {
                 ),
             ));
         }
+        if self.time_limit().is_some_and(|t| t.is_zero()) {
+            return Err((
+                "scheduler.time_limit".into(),
+                format!(
+                    "is `{}`: a limit of zero asks Slurm for no limit, and the sweep bounds its \
+                     wait for a job by it; give one, such as \"10:00\"",
+                    self.time_limit
+                ),
+            ));
+        }
         if !(self.poll_s.is_finite() && self.poll_s > 0.0 && self.poll_s <= 3600.0) {
             return Err((
                 "scheduler.poll_s".into(),
@@ -74,6 +85,37 @@ impl Scheduler {
             ));
         }
         Ok(())
+    }
+}
+
+impl Scheduler {
+    /// The time limit of each job (Slurm's forms: "M", "M:S", "H:M:S", "D-H", "D-H:M",
+    /// "D-H:M:S"); `None` if it is not in one of them.
+    pub(crate) fn time_limit(&self) -> Option<Duration> {
+        if !valid_time_limit(&self.time_limit) {
+            return None;
+        }
+        let numbers =
+            |s: &str| -> Option<Vec<u64>> { s.split(':').map(|p| p.parse::<u64>().ok()).collect() };
+        let seconds = match self.time_limit.split_once('-') {
+            Some((days, rest)) => {
+                let d: u64 = days.parse().ok()?;
+                let [h, m, s] = match numbers(rest)?.as_slice() {
+                    [h] => [*h, 0, 0],
+                    [h, m] => [*h, *m, 0],
+                    [h, m, s] => [*h, *m, *s],
+                    _ => return None,
+                };
+                ((d * 24 + h) * 60 + m) * 60 + s
+            }
+            None => match numbers(&self.time_limit)?.as_slice() {
+                [m] => m * 60,
+                [m, s] => m * 60 + s,
+                [h, m, s] => (h * 60 + m) * 60 + s,
+                _ => return None,
+            },
+        };
+        Some(Duration::from_secs(seconds))
     }
 }
 
@@ -138,5 +180,45 @@ mod tests {
         ] {
             assert!(!valid_time_limit(bad), "{bad}");
         }
+    }
+
+    #[test]
+    fn time_limits_are_read_as_slurm_reads_them() {
+        let limit = |t: &str| {
+            Scheduler {
+                kind: SchedulerKind::Slurm,
+                partition: None,
+                account: None,
+                time_limit: t.into(),
+                sbatch_args: Vec::new(),
+                poll_s: 1.0,
+            }
+            .time_limit()
+            .map(|d| d.as_secs())
+        };
+        for (t, s) in [
+            ("30", 1800),
+            ("10:00", 600),
+            ("0:1", 1),
+            ("1:00:00", 3600),
+            ("1-0", 86_400),
+            ("2-12:30", 2 * 86_400 + 12 * 3600 + 1800),
+            ("1-00:00:30", 86_430),
+        ] {
+            assert_eq!(limit(t), Some(s), "{t}");
+        }
+        assert_eq!(limit("1h"), None);
+        assert_eq!(limit("0:0"), Some(0));
+        let zero = Scheduler {
+            kind: SchedulerKind::Slurm,
+            partition: None,
+            account: None,
+            time_limit: "0:00:00".into(),
+            sbatch_args: Vec::new(),
+            poll_s: 1.0,
+        };
+        let (key, problem) = zero.validate().unwrap_err();
+        assert_eq!(key, "scheduler.time_limit");
+        assert!(problem.contains("no limit"), "{problem}");
     }
 }

@@ -33,18 +33,22 @@ mod kernel_parts;
 mod kernels_agree;
 mod layering;
 mod mpi_cli;
+mod mpi_launch;
 mod parsers;
 mod peers;
 mod report;
 mod runs;
 mod slurm;
+mod slurm_stand_ins;
 mod supervision;
 mod sweep;
 mod verlet;
 mod whole_step;
 
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::Duration;
+use wait_timeout::ChildExt;
 
 /// A sweep observer that stops the sweep after this many measured rounds, as an interrupt
 /// would.
@@ -66,6 +70,39 @@ pub fn bin() -> Command {
     c.env_remove("NBODY_BENCH_TEST_SLOWDOWN")
         .stdin(Stdio::null());
     c
+}
+
+/// Longest any command the tests wait for with [`finish`] may take before it counts as a hang.
+pub const HANG_S: u64 = 120;
+
+/// Waits for `child` for at most [`HANG_S`]; a hang is killed and fails the test.
+pub fn finish(mut child: Child, what: &str) -> Output {
+    use std::io::Read;
+    // Drain the pipes while waiting, so that a chatty child cannot block on a full pipe.
+    let drain = |r: Option<Box<dyn Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut v = Vec::new();
+            if let Some(mut r) = r {
+                let _ = r.read_to_end(&mut v);
+            }
+            v
+        })
+    };
+    let out = drain(child.stdout.take().map(|s| Box::new(s) as _));
+    let err = drain(child.stderr.take().map(|s| Box::new(s) as _));
+    let status = match child.wait_timeout(Duration::from_secs(HANG_S)).unwrap() {
+        Some(s) => s,
+        None => {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what}: still running after {HANG_S} s");
+        }
+    };
+    Output {
+        status,
+        stdout: out.join().unwrap(),
+        stderr: err.join().unwrap(),
+    }
 }
 
 pub fn text(bytes: &[u8]) -> String {

@@ -5,16 +5,12 @@
 //! anything runs; configs, results and CSV tables are read from pipes, and a pipe nobody
 //! writes to is given up after a bounded wait. Every child has a timeout.
 
-use crate::{refused, text};
+use crate::{finish, refused, text};
 use nbody_bench::children::{alive, members_left};
 use nbody_bench::records::results::ResultsFile;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
+use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-use wait_timeout::ChildExt;
-
-/// Longest any command of these tests may take before it counts as a hang.
-const HANG_S: u64 = 120;
 
 fn bin() -> Command {
     let mut c = crate::bin();
@@ -22,36 +18,6 @@ fn bin() -> Command {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     c
-}
-
-/// Waits for `child` for at most [`HANG_S`]; a hang is killed and fails the test.
-fn finish(mut child: Child, what: &str) -> Output {
-    use std::io::Read;
-    // Drain the pipes while waiting, so that a chatty child cannot block on a full pipe.
-    let drain = |r: Option<Box<dyn Read + Send>>| {
-        std::thread::spawn(move || {
-            let mut v = Vec::new();
-            if let Some(mut r) = r {
-                let _ = r.read_to_end(&mut v);
-            }
-            v
-        })
-    };
-    let out = drain(child.stdout.take().map(|s| Box::new(s) as _));
-    let err = drain(child.stderr.take().map(|s| Box::new(s) as _));
-    let status = match child.wait_timeout(Duration::from_secs(HANG_S)).unwrap() {
-        Some(s) => s,
-        None => {
-            let _ = child.kill();
-            let _ = child.wait();
-            panic!("{what}: still running after {HANG_S} s");
-        }
-    };
-    Output {
-        status,
-        stdout: out.join().unwrap(),
-        stderr: err.join().unwrap(),
-    }
 }
 
 fn run(cmd: &mut Command, what: &str) -> Output {

@@ -116,6 +116,18 @@ fn a_round_groups_the_slowest_rank_step_times_into_samples() {
     assert_eq!(mpi.per_rank.len(), 2);
 }
 
+/// The driver writes `rel_drift: null` when the initial energy is 0 (serde_json's NaN): the
+/// round is read, its drift not measured.
+#[test]
+fn a_null_drift_is_read_as_not_measured() {
+    let steps: Vec<u64> = (1..=4).map(|k| k * 1000).collect();
+    let text = run_json(steps).replace("\"rel_drift\":-1e-6", "\"rel_drift\":null");
+    assert!(text.contains("\"rel_drift\":null"), "{text}");
+    let round = round_from_json(&text, 2, 5).unwrap();
+    assert_eq!(round.energy_drift, None);
+    assert_eq!(round.samples_s.len(), 2);
+}
+
 #[test]
 fn a_round_needs_a_step_per_sample_and_a_complete_result() {
     let err = round_from_json(&run_json(vec![1, 2]), 3, 0).unwrap_err();

@@ -6,8 +6,11 @@ use crate::gate::baselines::{self, Fitness};
 use crate::gate::route::this_machine;
 use crate::kernels::KernelKind;
 use crate::records::config::SweepConfig;
+#[cfg(feature = "test-slowdown")]
 use crate::records::kernel_or_program::KernelOrProgram;
-use crate::records::results::{Metadata, ResultsFile, utc_now};
+use crate::records::results::ResultsFile;
+#[cfg(feature = "test-slowdown")]
+use crate::records::results::{Metadata, utc_now};
 use std::path::{Path, PathBuf};
 
 /// What to measure.

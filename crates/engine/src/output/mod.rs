@@ -281,6 +281,13 @@ pub fn check_derived(flag: &str, typed: &Path, derived: &[PathBuf]) -> Result<()
     check_outputs(&outputs, &[])
 }
 
+/// Checks that `path` can be written the way [`write_atomic`] writes it, before the work that
+/// makes its contents: the checks of [`check_outputs`], then an exclusive temporary created
+/// beside it and removed (a directory that cannot be written to fails here, not after).
+pub fn check_writable(path: &Path) -> Result<(), WriteError> {
+    AtomicFile::create(path).map(drop)
+}
+
 /// Writes `contents` to `path` atomically.
 pub fn write_atomic(path: &Path, contents: &[u8]) -> Result<(), WriteError> {
     let mut f = AtomicFile::create(path)?;
@@ -308,6 +315,19 @@ mod tests {
         assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
         write_atomic(&path, b"new").unwrap();
         assert_eq!(fs::read_to_string(&path).unwrap(), "new");
+    }
+
+    #[test]
+    fn a_writable_place_is_checked_without_leaving_anything() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("result.json");
+        check_writable(&path).unwrap();
+        assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 0);
+        fs::create_dir(&path).unwrap();
+        let e = check_writable(&path).unwrap_err();
+        assert!(e.to_string().contains("is a directory"), "{e}");
+        let e = check_writable(&dir.path().join("missing/result.json")).unwrap_err();
+        assert!(e.to_string().contains("does not exist"), "{e}");
     }
 
     /// A link planted beside the target, under any name the old scheme would have used, is

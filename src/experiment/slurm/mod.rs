@@ -1,14 +1,24 @@
 //! Case rounds and calibrations as Slurm jobs (a config's `[scheduler] kind = "slurm"`).
 //!
 //! Each piece of work gets a directory under the results, `jobs/<name>/`: the sweep writes
-//! what to do (`task.json`) and a job script (`job.sh`, which runs `nbody-bench job DIR`),
-//! submits it with `sbatch --parsable`, keeps the job id (`job-id`), and polls `squeue` until
-//! the job has left the queue. The job measures on its compute node and writes `result.json`
-//! (atomically) next to its output (`job.out`). A job that ends without a result (it failed,
-//! hit its time limit, was cancelled) gives a round without samples that keeps the job's state
-//! and last lines of output. The sweep waits for one job at a time, so the rounds interleave as
-//! they do on one machine; an interrupted sweep leaves its job queued, and `--resume` waits for
-//! that job (or reads its result) instead of submitting it again.
+//! what to do (`task.json`, with a random token) and a job script (`job.sh`, which runs
+//! `nbody-bench job DIR`), submits it with `sbatch --parsable`, keeps the job id (`job-id`),
+//! and polls `squeue` until the job has left the queue (`queue`). The job measures on its
+//! compute node and writes `result.json` (atomically, carrying the task's token) next to its
+//! output (`job.out`) (`job`). A result is taken only if it answers its task (`check`): the
+//! token, the case, the particles, samples and steps asked, counts that can be; anything else,
+//! and a job that ends without a result (it failed, hit its time limit, was cancelled), gives
+//! a round without samples that keeps the job's state, the reason and its last lines of output.
+//! The sweep waits for one job at a time, so the rounds interleave as they do on one machine;
+//! an interrupted sweep leaves its job queued, and `--resume` (only) waits for that job, or
+//! reads its result, instead of submitting it again.
+
+mod check;
+mod job;
+mod queue;
+
+pub use job::job_main;
+pub use queue::GRACE_ENV;
 
 use super::external::Context;
 use super::measure::RoundSpec;
@@ -47,11 +57,32 @@ pub enum SlurmError {
          {id} ({last}); the job is left as it is: run the sweep again with --resume to pick it up"
     )]
     Queue { id: String, last: String },
+    #[error(
+        "job {id} ({what}) {seen} for {waited} s, longer than its time limit ({limit}) plus a \
+         margin of {grace_s} s ({} sets it); the job is left as it is: check it with \
+         `squeue -j {id}`, then run the sweep again with --resume to wait for it again",
+        queue::GRACE_ENV
+    )]
+    Overdue {
+        id: String,
+        what: String,
+        /// What was seen of the job: that it ran, or no state at all.
+        seen: String,
+        waited: u64,
+        limit: String,
+        grace_s: u64,
+    },
+    #[error("{0}")]
+    Grace(String),
 }
 
 /// What a job does: one round of one case, or a calibration of the node.
 #[derive(Serialize, Deserialize)]
 pub(crate) struct Task {
+    /// Random, new for every submission: the job copies it into its result, so that a result
+    /// is known to be this submission's (not one left in the directory by an earlier sweep or
+    /// an earlier job of the same round).
+    pub token: String,
     pub config: SweepConfig,
     pub context: Context,
     pub work: Work,
@@ -66,6 +97,12 @@ pub(crate) enum Work {
 /// What a job leaves behind.
 #[derive(Serialize, Deserialize)]
 pub(crate) struct JobResult {
+    /// The token of the task the job did.
+    #[serde(default)]
+    pub token: String,
+    /// The key of the case whose round it measured.
+    #[serde(default)]
+    pub key: Option<String>,
     pub node: Option<String>,
     #[serde(default)]
     pub round: Option<RoundOutcome>,
@@ -83,24 +120,34 @@ pub(crate) struct Resources {
     pub cpus_per_task: usize,
 }
 
-/// A job that ended: its record, and its result if it wrote one.
+/// A job that ended: its record, and its result if it wrote one that answers its task.
 pub(crate) struct Ended {
     pub record: JobRecord,
     pub result: Option<JobResult>,
 }
 
 impl Task {
+    /// A task with a new random token.
     pub(crate) fn new(config: &SweepConfig, context: &Context, work: Work) -> Task {
         Task {
+            token: format!("{:032x}", rand::random::<u128>()),
             config: config.clone(),
             context: context.clone(),
             work,
         }
     }
+
+    /// Whether `other` asks for the same work (its token aside).
+    fn same_work(&self, other: &Task) -> bool {
+        let value =
+            |t: &Task| serde_json::to_value((&t.config, &t.context, &t.work)).unwrap_or_default();
+        value(self) == value(other)
+    }
 }
 
 /// Whether `sbatch` can be started here, before anything is submitted.
 pub(crate) fn check_available() -> Result<(), SlurmError> {
+    queue::check_grace()?;
     let mut sbatch = Command::new("sbatch");
     sbatch.arg("--version");
     match supervised::output(&mut sbatch, CALL_LIMIT, "`sbatch --version`", "") {
@@ -113,47 +160,56 @@ pub(crate) fn check_available() -> Result<(), SlurmError> {
     }
 }
 
-/// Runs `task` as a job in `dir` (submitting it unless an earlier sweep already did), waits
-/// until it has left the queue and reads what it left. `say` tells the user what is waited for.
+/// Runs `task` as a job in `dir`, waits until it has left the queue and reads what it left.
+/// With `resume`, a job an earlier sweep submitted for the same work is waited for instead of
+/// submitting it again; without, nothing found in `dir` is used. `say` tells the user what is
+/// waited for.
 pub(crate) fn run(
     scheduler: &Scheduler,
     dir: &Path,
     task: &Task,
     resources: Resources,
     what: &str,
+    resume: bool,
     say: &mut dyn FnMut(&str),
 ) -> Result<Ended, SlurmError> {
-    let id_file = dir.join("job-id");
-    let id = match std::fs::read_to_string(&id_file) {
-        Ok(id) if !id.trim().is_empty() => {
+    let adopted = if resume {
+        submitted_before(dir, task, what, say)
+    } else {
+        None
+    };
+    let (id, task) = match &adopted {
+        Some((id, old)) => {
             say(&format!(
-                "{what}: job {} was submitted before; waiting for it",
-                id.trim()
+                "{what}: job {id} was submitted before; waiting for it"
             ));
-            id.trim().to_string()
+            (id.clone(), old)
         }
-        _ => {
+        None => {
             let id = submit(scheduler, dir, task, resources, what)?;
-            write(&id_file, id.as_bytes())?;
             say(&format!("{what}: submitted job {id}"));
-            id
+            (id, task)
         }
     };
-    wait(scheduler, &id, what, say)?;
-    let state = final_state(&id);
-    let result = std::fs::read(dir.join("result.json"))
-        .ok()
-        .and_then(|bytes| serde_json::from_slice::<JobResult>(&bytes).ok());
-    let error = match &result {
-        Some(_) => None,
-        None => Some(JobError {
-            what: format!(
-                "job {id} ended {} without a result",
-                state.as_deref().unwrap_or("(state unknown)")
+    queue::wait(scheduler, &id, what, say)?;
+    let state = queue::final_state(&id);
+    let (result, why) = match read_result(&dir.join("result.json")) {
+        Ok(result) => match check::answers(task, &result) {
+            Ok(()) => (Some(result), None),
+            Err(reason) => (
+                None,
+                Some(format!("but its result.json is refused: {reason}")),
             ),
-            output_tail: super::external::process::last_lines_of(&dir.join("job.out")),
-        }),
+        },
+        Err(why) => (None, Some(why)),
     };
+    let error = why.map(|why| JobError {
+        what: format!(
+            "job {id} ended {} {why}",
+            state.as_deref().unwrap_or("(state unknown)")
+        ),
+        output_tail: job_output_tail(&dir.join("job.out")),
+    });
     Ok(Ended {
         record: JobRecord {
             id,
@@ -165,7 +221,60 @@ pub(crate) fn run(
     })
 }
 
-/// Writes the task and its script into `dir` and submits it; the job id.
+/// The job an earlier sweep submitted in `dir` for the same work as `task`, with the task it
+/// was given (whose token its result must carry); `None` if there is none, or it was given
+/// other work (then it is left alone and the round is submitted again).
+fn submitted_before(
+    dir: &Path,
+    task: &Task,
+    what: &str,
+    say: &mut dyn FnMut(&str),
+) -> Option<(String, Task)> {
+    let id = crate::input::read_text(&dir.join("job-id")).ok()?;
+    let id = id.trim();
+    if id.is_empty() || id.len() > 40 || !id.bytes().all(|b| b.is_ascii_digit()) {
+        return None;
+    }
+    let old = crate::input::read_text(&dir.join("task.json"))
+        .ok()
+        .and_then(|text| serde_json::from_str::<Task>(&text).ok());
+    match old {
+        Some(old) if old.same_work(task) => Some((id.to_string(), old)),
+        _ => {
+            say(&format!(
+                "{what}: job {id} was submitted before for other work (or its task.json is \
+                 gone); submitting the round again"
+            ));
+            None
+        }
+    }
+}
+
+/// The job's result, or why there is none to take ("without a result", "but its result.json
+/// cannot be read: ..."). Read with the limits of every input: a pipe or a device left in its
+/// place neither hangs the sweep nor fills its memory.
+fn read_result(path: &Path) -> Result<JobResult, String> {
+    if let Err(e) = std::fs::symlink_metadata(path)
+        && e.kind() == std::io::ErrorKind::NotFound
+    {
+        return Err("without a result".into());
+    }
+    let text = crate::input::read_text(path)
+        .map_err(|e| format!("but its result.json cannot be read: {e}"))?;
+    serde_json::from_str(&text)
+        .map_err(|e| format!("but its result.json is not a job's result: {e}"))
+}
+
+/// The last lines of the job's output, if it is a file (a pipe in its place would block).
+fn job_output_tail(path: &Path) -> Vec<String> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => super::external::process::last_lines_of(path),
+        _ => Vec::new(),
+    }
+}
+
+/// Writes the task and its script into `dir` and submits it; the job id. Whatever an earlier
+/// job left in `dir` is removed first, so nothing of it can pass for this job's.
 fn submit(
     scheduler: &Scheduler,
     dir: &Path,
@@ -177,7 +286,15 @@ fn submit(
         path: dir.into(),
         source,
     })?;
-    let _ = std::fs::remove_file(dir.join("result.json"));
+    for stale in ["job-id", "result.json", "job.out"] {
+        let path = dir.join(stale);
+        match std::fs::remove_file(&path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                return Err(SlurmError::Dir { path, source: e });
+            }
+            _ => {}
+        }
+    }
     let text = serde_json::to_vec_pretty(task).map_err(|e| SlurmError::Write {
         path: dir.join("task.json"),
         detail: e.to_string(),
@@ -211,6 +328,7 @@ fn submit(
             message: last_line(&out.stderr).unwrap_or_else(|| stdout.trim().to_string()),
         });
     }
+    write(&dir.join("job-id"), id.as_bytes())?;
     Ok(id.to_string())
 }
 
@@ -237,101 +355,6 @@ pub(crate) fn sbatch_args(
     }
     a.extend(scheduler.sbatch_args.iter().cloned());
     a
-}
-
-/// Polls the queue until job `id` is no longer in it.
-fn wait(
-    scheduler: &Scheduler,
-    id: &str,
-    what: &str,
-    say: &mut dyn FnMut(&str),
-) -> Result<(), SlurmError> {
-    let mut failures = 0;
-    let mut last_state = String::new();
-    loop {
-        let mut squeue = Command::new("squeue");
-        squeue.args(["-h", "-j", id, "-o", "%T"]);
-        let out = supervised::output(&mut squeue, CALL_LIMIT, "`squeue`", "")
-            .map_err(|e| SlurmError::Call(e.to_string()))?;
-        let stdout = String::from_utf8_lossy(&out.stdout);
-        let state = stdout.trim();
-        if out.status.success() {
-            failures = 0;
-            if state.is_empty() {
-                return Ok(());
-            }
-            if state != last_state {
-                if state == "PENDING" {
-                    say(&format!("{what}: job {id} is waiting in the queue"));
-                }
-                last_state = state.to_string();
-            }
-        } else {
-            let message = last_line(&out.stderr).unwrap_or_default();
-            // A job that ended long enough ago is forgotten by the controller.
-            if message.contains("Invalid job id") {
-                return Ok(());
-            }
-            failures += 1;
-            if failures >= QUEUE_FAILURES {
-                return Err(SlurmError::Queue {
-                    id: id.to_string(),
-                    last: message,
-                });
-            }
-        }
-        std::thread::sleep(Duration::from_secs_f64(scheduler.poll_s));
-    }
-}
-
-/// The job's final state from `scontrol` (kept by the controller for a while after the end).
-fn final_state(id: &str) -> Option<String> {
-    let mut scontrol = Command::new("scontrol");
-    scontrol.args(["show", "job", id, "-o"]);
-    let out = supervised::output(&mut scontrol, CALL_LIMIT, "`scontrol`", "").ok()?;
-    let text = String::from_utf8_lossy(&out.stdout);
-    text.split_whitespace()
-        .find_map(|field| field.strip_prefix("JobState="))
-        .map(str::to_string)
-}
-
-/// Inside the job: does the task in `dir` and writes `result.json`.
-pub fn job_main(dir: &Path) -> Result<(), Box<dyn std::error::Error + Send + Sync>> {
-    let bytes = std::fs::read(dir.join("task.json"))
-        .map_err(|e| format!("cannot read {}: {e}", dir.join("task.json").display()))?;
-    let task: Task = serde_json::from_slice(&bytes)
-        .map_err(|e| format!("{}: {e}", dir.join("task.json").display()))?;
-    let node = node_name();
-    let result = match &task.work {
-        Work::Round { case, spec } => {
-            let clock = crate::clock::WallClock::new();
-            let outcome =
-                super::case_round::measure_case(case, spec, &clock, &task.config, &task.context)?;
-            JobResult {
-                node,
-                step_ns: outcome.step_ns.clone(),
-                round: Some(outcome),
-                calibration: None,
-            }
-        }
-        Work::Calibrate { threads } => JobResult {
-            node,
-            round: None,
-            step_ns: Vec::new(),
-            calibration: Some(crate::calibrate::calibrate(threads)),
-        },
-    };
-    let text = serde_json::to_vec(&result)?;
-    crate::output::write_atomic(&dir.join("result.json"), &text)?;
-    Ok(())
-}
-
-/// The node a job runs on: Slurm's name for it, else the host name.
-fn node_name() -> Option<String> {
-    std::env::var("SLURMD_NODENAME")
-        .ok()
-        .filter(|s| !s.trim().is_empty())
-        .or_else(crate::records::results::host_name)
 }
 
 /// A round that no job measured: no samples, the job's record.
