@@ -34,6 +34,24 @@ pub(crate) struct RoundSpec {
     pub slowdown: Option<TestSlowdown>,
 }
 
+#[cfg(test)]
+impl RoundSpec {
+    /// `samples` samples and nothing else: no warm-up, no minimum length, steps chosen, no
+    /// force error or reference (the unit tests' round).
+    pub(crate) fn bare(samples: usize) -> RoundSpec {
+        RoundSpec {
+            samples,
+            warmup_s: 0.0,
+            min_sample_s: 0.0,
+            steps_per_sample: None,
+            force_error_sample: 0,
+            reference_s: 0.0,
+            #[cfg(feature = "test-slowdown")]
+            slowdown: None,
+        }
+    }
+}
+
 /// Measures one round of `case` (a built-in kernel's: external programs are measured by
 /// `experiment::external`) on the system of `setup`.
 pub(crate) fn measure_round<C: Clock>(

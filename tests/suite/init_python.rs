@@ -102,31 +102,27 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
 
     // The same bodies and steps as our symmetric kernel: the same energies, to rounding.
-    let out = run(&[
-        "export",
-        "--scenario",
-        "galaxy",
-        "-n",
-        "40",
-        "--format",
-        "text",
-        "--out",
-        "s.txt",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let out = std::process::Command::new("python3")
-        .current_dir(dir.path())
-        .args([
-            "pysim.py",
-            "--n",
+    // The driver on 40 exported bodies of `scenario`, for `steps` steps.
+    let driver = |scenario: &str, file: &str, steps: &str| {
+        let out = run(&[
+            "export",
+            "--scenario",
+            scenario,
+            "-n",
             "40",
-            "--steps",
-            "10",
-            "--initial",
-            "s.txt",
-        ])
-        .output()
-        .unwrap();
+            "--format",
+            "text",
+            "--out",
+            file,
+        ]);
+        assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+        std::process::Command::new("python3")
+            .current_dir(dir.path())
+            .args(["pysim.py", "--n", "40", "--steps", steps, "--initial", file])
+            .output()
+            .unwrap()
+    };
+    let out = driver("galaxy", "s.txt", "10");
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let (e0, e1) = driver_energies(&text(&out.stdout));
     let out = run(&[
@@ -160,31 +156,7 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
         );
     }
     // The same bodies with another law are refused, with what to do.
-    let out = run(&[
-        "export",
-        "--scenario",
-        "lj-box",
-        "-n",
-        "40",
-        "--format",
-        "text",
-        "--out",
-        "lj.txt",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let out = std::process::Command::new("python3")
-        .current_dir(dir.path())
-        .args([
-            "pysim.py",
-            "--n",
-            "40",
-            "--steps",
-            "1",
-            "--initial",
-            "lj.txt",
-        ])
-        .output()
-        .unwrap();
+    let out = driver("lj-box", "lj.txt", "1");
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("export the `galaxy` scenario"));
 

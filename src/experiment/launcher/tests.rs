@@ -165,16 +165,7 @@ d=$(dirname "$json"); stat -c %a "$d" > '{log}'; echo "$d" >> '{log}'; echo junk
         args: vec!["-c".into(), script, "sh".into()],
         ..launch()
     };
-    let spec = RoundSpec {
-        samples: 2,
-        warmup_s: 0.0,
-        min_sample_s: 0.0,
-        steps_per_sample: None,
-        force_error_sample: 0,
-        reference_s: 0.0,
-        #[cfg(feature = "test-slowdown")]
-        slowdown: None,
-    };
+    let spec = RoundSpec::bare(2);
     let err = measure_round(&launch, &case, &spec, None).unwrap_err();
     std::fs::remove_file(&planted).unwrap();
     assert!(matches!(err, LaunchError::Result { .. }), "{err}");

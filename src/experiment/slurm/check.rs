@@ -203,16 +203,7 @@ mod tests {
     }
 
     fn spec(samples: usize) -> RoundSpec {
-        RoundSpec {
-            samples,
-            warmup_s: 0.0,
-            min_sample_s: 0.0,
-            steps_per_sample: None,
-            force_error_sample: 0,
-            reference_s: 0.0,
-            #[cfg(feature = "test-slowdown")]
-            slowdown: None,
-        }
+        RoundSpec::bare(samples)
     }
 
     fn config() -> SweepConfig {
