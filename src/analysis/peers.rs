@@ -416,6 +416,19 @@ mod tests {
     }
 
     #[test]
+    fn the_octree_names_its_expansion_and_other_codes_none() {
+        let mut tree = point(ScenarioKind::Galaxy, "octree", 1000, 2, 1, 1e-3);
+        tree.theta = Some(0.5);
+        assert_eq!(case_label(&tree), "octree θ=0.5 monopole, 2 threads");
+        tree.case.multipole = Multipole::Quadrupole;
+        assert_eq!(case_label(&tree), "octree θ=0.5 quadrupole, 2 threads");
+        // An external program's expansion is its own: nothing is made up for it.
+        let mut peer = point(ScenarioKind::Galaxy, "pytreegrav", 1000, 1, 1, 1e-3);
+        peer.theta = Some(0.5);
+        assert_eq!(case_label(&peer), "pytreegrav θ=0.5");
+    }
+
+    #[test]
     fn ours_are_set_against_the_fastest_peer_variant_of_each_case() {
         use ScenarioKind::{LjBox, LjLiquid};
         let n = 100_000;

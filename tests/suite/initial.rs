@@ -151,6 +151,7 @@ fn a_bad_initial_file_is_refused_at_its_line() {
         .collect();
     let outside = outside.join("\n");
     // (scenario, file, where: what follows the path, what)
+    let second_columns_at = format!(" line {}:", lj_text.lines().count() + 1);
     let cases: Vec<(&str, String, &str, &str)> = vec![
         (
             "galaxy",
@@ -211,6 +212,13 @@ fn a_bad_initial_file_is_refused_at_its_line() {
             "# only a comment\n\n".to_string(),
             ": no bodies",
             "(2 lines of comments",
+        ),
+        // A second columns line would read the bodies after it in another dimension.
+        (
+            "lj-box",
+            format!("{lj_text}# columns: id x y z vx vy vz mass strength\n"),
+            &second_columns_at,
+            "a second `# columns:` line",
         ),
     ];
     for (i, (scenario, content, at, what)) in cases.into_iter().enumerate() {
