@@ -24,6 +24,7 @@ pub mod children;
 pub mod experiment;
 pub mod fit;
 pub mod gate;
+pub mod history;
 #[cfg(feature = "mpi")]
 pub use nbody_mpi::mpi;
 pub use nbody_mpi::ranks;
