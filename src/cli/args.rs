@@ -5,6 +5,7 @@ use nbody_bench::decomp::Decomposition;
 use nbody_bench::export::ExportFormat;
 use nbody_bench::kernels::{KernelKind, Multipole};
 use nbody_bench::output::nbview::NbviewFormat;
+use nbody_bench::records::tidy::TidyFormat;
 use nbody_bench::scenario::{Precision, ScenarioKind, lj};
 use std::path::PathBuf;
 
@@ -60,10 +61,17 @@ pub enum Command {
     /// Write a scenario's initial state for another code: a LAMMPS data file (reduced units),
     /// or a text / .npy table of positions, velocities, masses and strengths.
     Export(ExportArgs),
+    /// Write a results file as a tidy table for notebooks (pandas, polars, R): one row per
+    /// sample, each case field, round value and build field a column of its own; CSV or JSON
+    /// lines.
+    ExportResults(ExportResultsArgs),
     /// Write a commented sweep config for your own program, every key explained (NAME.toml;
     /// with `--lang python` also NAME.py, a driver to put your code in): edit it, then
     /// `nbody-bench sweep --config NAME.toml`.
     Init(InitArgs),
+    /// The performance history of a machine class: each case's series over the commits, with
+    /// the steps found in it; `history record RESULTS` appends a sweep's results to it.
+    History(crate::cli::history::HistoryArgs),
     /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
     /// every key of a sweep config.
     #[command(hide = true)]
@@ -535,6 +543,10 @@ pub struct SweepArgs {
     /// such a sweep needs this flag or a `measure.budget_s`.
     #[arg(long)]
     pub yes: bool,
+    /// Append the measured cases to the performance history of this machine class,
+    /// DIR/<class>.jsonl (default results/history); `nbody-bench history` shows the series.
+    #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "results/history")]
+    pub record: Option<PathBuf>,
 }
 
 /// A scaling model the `fit` command fits.
@@ -681,6 +693,11 @@ pub struct GateArgs {
     /// cannot be compared (a file without them) is then an error (exit 2), not a pass.
     #[arg(long)]
     pub fail_on_work_change: bool,
+    /// Append what the gate measured (this build, and the baseline's revision in an A/B run) to
+    /// the performance history of this machine class, DIR/<class>.jsonl (default
+    /// results/history).
+    #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "results/history")]
+    pub record: Option<PathBuf>,
 }
 
 #[derive(Debug, Args)]
@@ -752,4 +769,43 @@ pub struct ExportArgs {
     /// The file to write (atomically).
     #[arg(long, value_name = "FILE")]
     pub out: PathBuf,
+}
+
+#[derive(Debug, Args)]
+#[command(
+    after_long_help = export_results_help(),
+    after_help = "Examples:\n  nbody-bench export-results quick > quick.csv\n  \
+    nbody-bench export-results results/quick/results.json --format jsonl --out quick.jsonl"
+)]
+pub struct ExportResultsArgs {
+    /// The results of a sweep: a results.json, a run directory, or a config name (its latest
+    /// run under results/runs/, else its reference results results/<name>/).
+    #[arg(value_name = "RESULTS")]
+    pub results: PathBuf,
+    /// The table's format.
+    #[arg(long, value_enum, default_value = "csv")]
+    pub format: TidyFormat,
+    /// Write the table to FILE (atomically) instead of standard output; never the results
+    /// file itself.
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+}
+
+/// `export-results --help`: the columns, from the list the table is built with.
+fn export_results_help() -> String {
+    let mut help = String::from(
+        "Columns, one row per sample, in this order (an empty CSV cell or JSON null: not \
+         measured, never 0; the build's fields repeat on every row, so the tables of several \
+         sweeps can be concatenated):\n",
+    );
+    for (name, what) in nbody_bench::records::tidy::SAMPLE_COLUMNS {
+        help.push_str(&format!("  {name:<19} {what}\n"));
+    }
+    help.push_str(
+        "\npandas: pd.read_csv(FILE, float_precision=\"round_trip\") reads every number back \
+         to the bits written; pd.read_json(FILE, lines=True, precise_float=True) the JSON \
+         lines.\n\nExamples:\n  nbody-bench export-results quick > quick.csv\n  \
+         nbody-bench export-results results/quick/results.json --format jsonl --out quick.jsonl",
+    );
+    help
 }

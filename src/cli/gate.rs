@@ -20,7 +20,7 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     }
     let request = Request {
         baseline: args.baseline,
-        current: args.current,
+        current: args.current.clone(),
         against: args.against,
         config: args.config,
         rounds: args.rounds,
@@ -34,8 +34,43 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     };
     let outcome = drive::run(&request, &mut |line| eprintln!("gate: {line}"))?;
     out!("{}", render(&outcome.report, args.format));
+    if let Some(history) = &args.record {
+        record(history, &outcome, args.current.as_deref())?;
+    }
     if let Some(why) = outcome.incomplete() {
         eprintln!("error: {why}");
     }
     Ok(outcome.exit_code())
+}
+
+/// Appends what the gate measured to the history under `dir`: the A/B run's two sides (the
+/// baseline's revision and this build), the fast path's sweep, or the `--current` file.
+fn record(
+    dir: &std::path::Path,
+    outcome: &drive::Outcome,
+    current: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    let files: Vec<std::path::PathBuf> = match (&outcome.kept_in, current) {
+        (Some(kept), _) => ["base.json", "current.json", "results.json"]
+            .iter()
+            .map(|f| kept.join(f))
+            .filter(|p| p.is_file())
+            .collect(),
+        (None, Some(current)) => vec![nbody_bench::records::locate::find_results(
+            current,
+            std::path::Path::new("results"),
+        )?],
+        (None, None) => Vec::new(),
+    };
+    for path in files {
+        let file = nbody_bench::records::results::ResultsFile::load(&path)?;
+        for (to, count) in super::history::append_results(dir, &file, "gate")? {
+            eprintln!(
+                "gate: {count} records of {} appended to {}",
+                path.display(),
+                to.display()
+            );
+        }
+    }
+    Ok(())
 }

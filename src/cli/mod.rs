@@ -7,10 +7,12 @@ pub mod args;
 mod analyze;
 mod dry_run;
 mod export;
+mod export_results;
 mod fit;
 mod fit_tables;
 mod gate;
 mod gate_study;
+mod history;
 mod init;
 mod list;
 mod mpi;
@@ -40,7 +42,9 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::MpiBench(args) => mpi::bench(args),
         Command::MpiCheck(args) => mpi::check(args),
         Command::Export(args) => export::export(args),
+        Command::ExportResults(args) => export_results::export_results(args),
         Command::Init(args) => init::init(args),
+        Command::History(args) => history::history(args),
         Command::Reference(args) => reference::reference(args),
         Command::Job(args) => {
             nbody_bench::experiment::slurm::job_main(&args.dir)

@@ -97,6 +97,18 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
             report.path.display()
         ),
     }
+    if let Some(history) = &args.record {
+        let appended = super::history::append_results(history, &results, "sweep");
+        let appended = anyhow::Context::with_context(appended, || {
+            format!(
+                "the results are saved in {p}; record them with `nbody-bench history record {p}`",
+                p = report.path.display()
+            )
+        })?;
+        for (to, count) in appended {
+            eprintln!("{count} records appended to {}", to.display());
+        }
+    }
     let failed: Vec<_> = results.cases.iter().filter(|c| c.failed()).collect();
     for c in &failed {
         let reasons = c.failures();

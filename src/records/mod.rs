@@ -14,4 +14,5 @@ pub mod plan;
 pub mod results;
 pub mod round;
 pub mod scheduler;
+pub mod tidy;
 pub mod vet;

@@ -1,0 +1,218 @@
+//! `nbody-bench history`: the performance history of this machine class (or another), case by
+//! case, with the steps found in each series; `history record` appends a sweep's results.
+
+use anyhow::{Context, bail};
+use clap::{Args, Subcommand};
+use nbody_bench::history::series::{Metric, Series, series};
+use nbody_bench::history::store::{self, CommitFacts, History};
+use nbody_bench::records::results::ResultsFile;
+use nbody_bench::units::Duration;
+use std::path::{Path, PathBuf};
+
+/// Where the committed history lives.
+pub const DEFAULT_DIR: &str = "results/history";
+
+#[derive(Debug, Args)]
+#[command(
+    after_help = "Examples:\n  nbody-bench history                          # this machine class's cases and their steps\n  \
+    nbody-bench history --case 'lj-box/verlet/*'  # the cases whose key matches\n  \
+    nbody-bench history record runs/ci/2026-12-05T10-00-00Z/results.json\n\n\
+    A series is one case of one config on one machine class, one point per commit in commit \
+    order: the median time per step over the reference workload timed before each sample when \
+    every record has it, else in seconds. Records of a build with uncommitted changes are kept \
+    but left out of the series."
+)]
+pub struct HistoryArgs {
+    #[command(subcommand)]
+    pub action: Option<HistoryAction>,
+    /// The folder of history files, one per machine class.
+    #[arg(long, value_name = "DIR", default_value = DEFAULT_DIR, global = true)]
+    pub dir: PathBuf,
+    /// The machine class to show (a file name under --dir without `.jsonl`); default: this
+    /// machine's.
+    #[arg(long, value_name = "CLASS")]
+    pub class: Option<String>,
+    /// Only the cases whose key matches this pattern (`*` any text, `?` one character).
+    #[arg(long, value_name = "GLOB")]
+    pub case: Option<String>,
+    /// Print the series as JSON instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum HistoryAction {
+    /// Append every measured case of results files to the history of their machine class.
+    Record(RecordArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct RecordArgs {
+    /// Results files (a sweep's results.json, or its run directory).
+    #[arg(required = true, value_name = "RESULTS")]
+    pub results: Vec<PathBuf>,
+    /// What made the measurement, kept in each record.
+    #[arg(long, default_value = "sweep", value_parser = ["sweep", "gate", "backfill"])]
+    pub source: String,
+}
+
+pub fn history(args: HistoryArgs) -> anyhow::Result<i32> {
+    match &args.action {
+        Some(HistoryAction::Record(r)) => record(&args.dir, r),
+        None => show(&args),
+    }
+}
+
+fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
+    for path in &args.results {
+        let path = if path.is_dir() {
+            path.join("results.json")
+        } else {
+            path.clone()
+        };
+        let file = ResultsFile::load(&path)?;
+        let written = append_results(dir, &file, &args.source)?;
+        for (to, count) in written {
+            eprintln!(
+                "{}: {count} records appended to {}",
+                path.display(),
+                to.display()
+            );
+        }
+    }
+    Ok(0)
+}
+
+/// Appends the records of `file` (measured by `source`) to the history under `dir`; the files
+/// written and their record counts. `sweep --record` and `gate --record` come here too.
+pub fn append_results(
+    dir: &Path,
+    file: &ResultsFile,
+    source: &str,
+) -> anyhow::Result<Vec<(PathBuf, usize)>> {
+    let facts = CommitFacts::of(Path::new("."), &file.metadata.git_commit);
+    let machine = nbody_bench::gate::route::this_machine();
+    let records = store::records_of(file, source, &facts, &machine);
+    if records.is_empty() {
+        bail!("no case of the results has a successful sample: nothing to record");
+    }
+    Ok(store::append(dir, &records)?)
+}
+
+fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
+    let class = match &args.class {
+        Some(c) => c.clone(),
+        None => {
+            let m = nbody_bench::gate::route::this_machine();
+            nbody_bench::gate::baselines::class_name(m.cpu_signature.as_deref(), m.logical_cpus)
+        }
+    };
+    let path = store::file_of(&args.dir, &class);
+    if !path.exists() {
+        bail!(
+            "{} does not exist: no history of machine class {class} yet (record one with \
+             `nbody-bench history record RESULTS` or `sweep --record`; --class names another)",
+            path.display()
+        );
+    }
+    let History { records, bad } = store::read(&path)?;
+    for b in &bad {
+        eprintln!(
+            "warning: {} line {}: {}; the line is left out",
+            path.display(),
+            b.line,
+            b.problem
+        );
+    }
+    let pattern = args.case.as_deref().map(glob).transpose()?;
+    let all: Vec<Series> = series(&records)
+        .into_iter()
+        .filter(|s| pattern.as_ref().is_none_or(|p| p.is_match(&s.case)))
+        .collect();
+    if all.is_empty() {
+        bail!(
+            "no case of {} matches{}",
+            path.display(),
+            args.case
+                .as_deref()
+                .map(|c| format!(" `{c}`"))
+                .unwrap_or_default()
+        );
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string_pretty(&all).context("the series as JSON")?
+        );
+        return Ok(0);
+    }
+    println!(
+        "{}: {} records, {} series",
+        path.display(),
+        records.len(),
+        all.len()
+    );
+    for s in &all {
+        print_series(s);
+    }
+    Ok(0)
+}
+
+fn print_series(s: &Series) {
+    let unit = match s.metric {
+        Metric::Normalized => "× the reference",
+        Metric::Seconds => "per step",
+    };
+    let value = |v: f64| match s.metric {
+        Metric::Normalized => format!("{v:.4}"),
+        Metric::Seconds => Duration(v).to_string(),
+    };
+    let (Some(first), Some(last)) = (s.points.first(), s.points.last()) else {
+        println!("\n{} ({}): no commit measured", s.case, s.config);
+        return;
+    };
+    println!(
+        "\n{} ({}): {} commits, {} → {} {unit}{}",
+        s.case,
+        s.config,
+        s.points.len(),
+        value(first.value),
+        value(last.value),
+        if s.dirty > 0 {
+            format!(
+                " ({} records of builds with uncommitted changes left out)",
+                s.dirty
+            )
+        } else {
+            String::new()
+        }
+    );
+}
+
+/// A `*` / `?` pattern as an anchored regular expression.
+fn glob(pattern: &str) -> anyhow::Result<regex::Regex> {
+    let mut re = String::from("^");
+    for c in pattern.chars() {
+        match c {
+            '*' => re.push_str(".*"),
+            '?' => re.push('.'),
+            c => re.push_str(&regex::escape(&c.to_string())),
+        }
+    }
+    re.push('$');
+    regex::Regex::new(&re).with_context(|| format!("--case `{pattern}`"))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::glob;
+
+    #[test]
+    fn case_patterns_match_whole_keys() {
+        let p = glob("lj-box/verlet/*").unwrap();
+        assert!(p.is_match("lj-box/verlet/n=1000/p=1/r=1/seed=1"));
+        assert!(!p.is_match("lj-liquid/verlet/n=1000"));
+        assert!(glob("*n=1000?p=1*").unwrap().is_match("a/n=1000/p=1/r=1"));
+        assert!(!glob("a.b").unwrap().is_match("axb"));
+    }
+}

@@ -1,0 +1,143 @@
+//! The performance history through the binary: `history record` appends a results file's
+//! cases to its machine class's file (two at once keep both), `history` reads the series back,
+//! a damaged line is named by its number and the rest read, and `sweep --record` appends.
+
+use super::{bin, refused, text};
+use std::path::Path;
+
+const CLASS: &str = "AuthenticAMD-26-2-1-2cpu";
+
+/// A copy of a committed baseline (20 cases of the ci config, with reference timings).
+fn results(dir: &Path) -> std::path::PathBuf {
+    let from =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("results/baseline/ci-{CLASS}.json"));
+    let to = dir.join("results.json");
+    std::fs::copy(from, &to).unwrap();
+    to
+}
+
+fn history(dir: &Path, args: &[&str]) -> std::process::Output {
+    bin()
+        .current_dir(dir)
+        .arg("history")
+        .args(args)
+        .args(["--dir", "hist"])
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn records_appended_at_once_are_all_kept_and_read_back_as_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = results(dir.path());
+    // Two appenders at once.
+    let appenders: Vec<_> = (0..2)
+        .map(|_| {
+            bin()
+                .current_dir(dir.path())
+                .args(["history", "record", file.to_str().unwrap(), "--dir", "hist"])
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    for mut a in appenders {
+        assert!(a.wait().unwrap().success());
+    }
+    let jsonl = dir.path().join(format!("hist/{CLASS}.jsonl"));
+    let lines: Vec<serde_json::Value> = std::fs::read_to_string(&jsonl)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 40);
+    let first = &lines[0];
+    assert_eq!(first["class"], CLASS);
+    assert_eq!(first["config"], "ci");
+    assert!(first["commit"].as_str().unwrap().starts_with("0c85c98"));
+    assert!(first["normalized"]["median"].as_f64().unwrap() > 0.0);
+    // The series: one point for the one commit measured twice.
+    let o = history(dir.path(), &["--class", CLASS, "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let series: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let series = series.as_array().unwrap();
+    assert_eq!(series.len(), 20);
+    assert!(
+        series
+            .iter()
+            .all(|s| s["points"].as_array().unwrap().len() == 1
+                && s["points"][0]["records"] == 2
+                && s["metric"] == "normalized")
+    );
+    // A pattern picks cases; a damaged line is named and the rest still read.
+    let mut damaged = std::fs::read_to_string(&jsonl).unwrap();
+    damaged.insert_str(0, "{not json\n");
+    std::fs::write(&jsonl, damaged).unwrap();
+    let o = history(dir.path(), &["--class", CLASS, "--case", "*/verlet/*"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(text(&o.stderr).contains("line 1: not a history record"));
+    let shown = text(&o.stdout);
+    assert!(
+        shown.contains("40 records") && shown.contains("/verlet/"),
+        "{shown}"
+    );
+    assert!(!shown.contains("/naive/"), "{shown}");
+}
+
+#[test]
+fn what_cannot_be_shown_or_recorded_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    refused(
+        &history(dir.path(), &["--class", "Nope-1cpu"]),
+        "Nope-1cpu.jsonl does not exist",
+    );
+    refused(
+        &history(dir.path(), &["record", "missing.json"]),
+        "missing.json",
+    );
+    let file = results(dir.path());
+    let o = history(dir.path(), &["record", file.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    refused(
+        &history(dir.path(), &["--class", CLASS, "--case", "nothing/*"]),
+        "no case",
+    );
+}
+
+#[test]
+fn a_sweep_with_record_appends_its_cases() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("tiny.toml"),
+        "name = \"tiny\"\nstudy = \"cartesian\"\nscenarios = [\"lj-box\"]\n\
+         kernels = [\"naive\", \"cell-list\"]\nn = [100]\nthreads = [1]\n[measure]\n\
+         warmup_s = 0.001\nsamples = 2\nrounds = 1\nmin_sample_s = 0.001\nreference_s = 0.001\n",
+    )
+    .unwrap();
+    let o = bin()
+        .current_dir(dir.path())
+        .args([
+            "sweep",
+            "--config",
+            "tiny.toml",
+            "--out",
+            "out",
+            "--no-calibration",
+        ])
+        .args(["--yes", "--record", "hist"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(
+        text(&o.stderr).contains("2 records appended"),
+        "{}",
+        text(&o.stderr)
+    );
+    let files: Vec<_> = std::fs::read_dir(dir.path().join("hist"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(files.len(), 1);
+    let text = std::fs::read_to_string(&files[0]).unwrap();
+    assert_eq!(text.lines().count(), 2);
+    assert!(text.contains("\"source\":\"sweep\"") && text.contains("\"config\":\"tiny\""));
+}
