@@ -346,4 +346,26 @@ mod tests {
         assert_eq!(first[col("force_error_median")], Value::Null);
         assert_eq!(first[col("git_commit")], json!(file.metadata.git_commit));
     }
+
+    #[test]
+    fn an_external_programs_drift_and_pairs_are_not_measured() {
+        // Written when an external round's drift was stored as 0.
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/results/vs-lammps/results.json"
+        );
+        let t = samples(&ResultsFile::load(std::path::Path::new(path)).unwrap());
+        let col = |name: &str| t.columns.iter().position(|c| c == name).unwrap();
+        let external: Vec<_> = t
+            .rows
+            .iter()
+            .filter(|r| r[col("kernel")] == json!("lammps"))
+            .collect();
+        assert!(!external.is_empty());
+        for row in external {
+            assert_eq!(row[col("energy_drift")], Value::Null);
+            assert_eq!(row[col("pairs_interacting")], Value::Null);
+            assert!(row[col("seconds_per_step")].as_f64().unwrap() > 0.0);
+        }
+    }
 }

@@ -99,6 +99,9 @@ fn parse_csv(text: &str) -> Vec<Vec<Option<String>>> {
     rows
 }
 
+/// A value of one sample read from the raw results file: `f(case, round, sample)`.
+type Field<T> = fn(&Value, &Value, usize) -> Option<T>;
+
 /// One value per sample of the raw results file, in file order: `f(case, round, sample)`.
 fn per_sample<T>(raw: &Value, f: impl Fn(&Value, &Value, usize) -> T) -> Vec<T> {
     let mut out = Vec::new();
@@ -149,7 +152,7 @@ fn csv_rows_read_back_to_the_results_values_bit_for_bit() {
     assert_eq!(rows.len(), total);
     assert!(rows.iter().all(|r| r.len() == COLUMNS.len()));
     // Every number reads back to the bits of the file; null is an empty cell, never 0.
-    let checks: [(&str, fn(&Value, &Value, usize) -> Option<u64>); 5] = [
+    let checks: [(&str, Field<u64>); 5] = [
         ("seconds_per_step", |_, r, s| json_bits(&r["samples_s"][s])),
         ("reference_s", |_, r, s| json_bits(&r["reference_s"][s])),
         ("energy_drift", |_, r, _| json_bits(&r["energy_drift"])),
@@ -162,7 +165,7 @@ fn csv_rows_read_back_to_the_results_values_bit_for_bit() {
         let got: Vec<Option<u64>> = column(rows, name).into_iter().map(bits).collect();
         assert_eq!(got, per_sample(&raw, want), "{name}");
     }
-    let strings: [(&str, fn(&Value, &Value, usize) -> Option<String>); 6] = [
+    let strings: [(&str, Field<String>); 6] = [
         ("key", |c, _, _| c["key"].as_str().map(String::from)),
         ("n", |c, _, _| whole(&c["case"]["n"])),
         ("threads", |c, _, _| whole(&c["case"]["threads"])),
@@ -362,4 +365,27 @@ fn bad_input_and_outputs_are_refused_with_exit_2() {
     let o = export(dir.path(), &["truncated.json", "--out", "t.csv"]);
     refused(&o, "truncated.json is not a valid results file");
     assert!(!dir.path().join("t.csv").exists());
+}
+
+#[test]
+fn the_help_and_the_outputs_page_name_every_column() {
+    let o = bin().args(["export-results", "--help"]).output().unwrap();
+    succeeded(&o);
+    let help = text(&o.stdout);
+    let page = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/reference/outputs.md"),
+    )
+    .unwrap();
+    let section = page
+        .split("## `export-results`")
+        .nth(1)
+        .and_then(|s| s.split("\n## ").next())
+        .expect("docs/reference/outputs.md has a section on export-results");
+    for c in COLUMNS {
+        assert!(help.contains(&format!("  {c} ")), "--help: {c}");
+        assert!(
+            section.contains(&format!("`{c}`")),
+            "docs/reference/outputs.md's export-results section does not name `{c}`"
+        );
+    }
 }
