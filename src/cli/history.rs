@@ -44,6 +44,36 @@ pub struct HistoryArgs {
 pub enum HistoryAction {
     /// Append every measured case of results files to the history of their machine class.
     Record(RecordArgs),
+    /// Measure older commits into the history: every K-th commit of A..B along the first
+    /// parents, each built in the gate's cached worktree and measured side by side with this
+    /// build (the gate's interleaved A/B run); both sides are recorded, this build's as the
+    /// control of the machine's own drift. A commit that does not build or read the config is
+    /// skipped with its reason. Run it on a quiet machine.
+    Backfill(BackfillArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct BackfillArgs {
+    /// The commits after A up to B (`A..B`, as git rev-list reads it).
+    #[arg(value_name = "A..B")]
+    pub range: String,
+    /// Measure every K-th commit, counted back from B (B always measured).
+    #[arg(long, value_name = "K", default_value_t = 1)]
+    pub every: usize,
+    /// The config both sides sweep: one every commit of the range reads (configs/backfill.toml
+    /// holds kernels and keys the project has had since the CI config began).
+    #[arg(long, value_name = "FILE|NAME", default_value = "backfill")]
+    pub config: PathBuf,
+    /// Interleaved rounds per case and side.
+    #[arg(long, default_value_t = 4)]
+    pub rounds: usize,
+    /// Where each commit's A/B run is kept.
+    #[arg(long, value_name = "DIR", default_value = "runs/backfill")]
+    pub runs: PathBuf,
+    /// Only build (or find cached) every commit's binary: the builds need no quiet machine,
+    /// the measurements of a later run do.
+    #[arg(long)]
+    pub build_only: bool,
 }
 
 #[derive(Debug, Args)]
@@ -59,8 +89,41 @@ pub struct RecordArgs {
 pub fn history(args: HistoryArgs) -> anyhow::Result<i32> {
     match &args.action {
         Some(HistoryAction::Record(r)) => record(&args.dir, r),
+        Some(HistoryAction::Backfill(b)) => backfill(&args.dir, b),
         None => show(&args),
     }
+}
+
+fn backfill(dir: &Path, args: &BackfillArgs) -> anyhow::Result<i32> {
+    use nbody_bench::history::backfill::{self, Backfill, Done};
+    let config = nbody_bench::records::locate::find_config(&args.config)?;
+    let job = Backfill {
+        range: args.range.clone(),
+        every: args.every,
+        config,
+        rounds: args.rounds,
+        dir: dir.to_path_buf(),
+        runs: args.runs.clone(),
+        build_only: args.build_only,
+    };
+    let done = backfill::backfill(&job, &mut |line| eprintln!("backfill: {line}"))?;
+    let mut skipped = 0;
+    for d in &done {
+        match d {
+            Done::Recorded { commit, records } => {
+                outln!("{} {records} records", &commit[..commit.len().min(12)])
+            }
+            Done::Built { commit } => outln!("{} built", &commit[..commit.len().min(12)]),
+            Done::Skipped { commit, why } => {
+                skipped += 1;
+                outln!("{} skipped: {why}", &commit[..commit.len().min(12)])
+            }
+        }
+    }
+    if skipped == done.len() {
+        anyhow::bail!("no commit of {} was measured", args.range);
+    }
+    Ok(0)
 }
 
 fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
@@ -139,10 +202,11 @@ fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
                 .unwrap_or_default()
         );
     }
+    let found: Vec<Found> = all.iter().map(found).collect::<anyhow::Result<_>>()?;
     if args.json {
         println!(
             "{}",
-            serde_json::to_string_pretty(&all).context("the series as JSON")?
+            serde_json::to_string_pretty(&found).context("the series as JSON")?
         );
         return Ok(0);
     }
@@ -152,13 +216,53 @@ fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
         records.len(),
         all.len()
     );
-    for s in &all {
-        print_series(s);
+    for f in &found {
+        print_series(f);
     }
     Ok(0)
 }
 
-fn print_series(s: &Series) {
+/// A series and the steps found in it.
+#[derive(serde::Serialize)]
+struct Found<'a> {
+    #[serde(flatten)]
+    series: &'a Series,
+    changes: Vec<Step>,
+}
+
+/// One step, between two commits of the series.
+#[derive(serde::Serialize)]
+struct Step {
+    /// The last commit of the old level and the first of the new.
+    between: [String; 2],
+    before: f64,
+    after: f64,
+    ratio: f64,
+    ratio_ci95: [f64; 2],
+}
+
+fn found(s: &Series) -> anyhow::Result<Found<'_>> {
+    use nbody_bench::history::changes::{Detector, change_points};
+    let values: Vec<f64> = s.points.iter().map(|p| p.value).collect();
+    let changes = change_points(&values, &Detector::default())
+        .with_context(|| format!("the series of {}", s.case))?
+        .into_iter()
+        .map(|c| {
+            let [a, b] = c.between();
+            Step {
+                between: [s.points[a].commit.clone(), s.points[b].commit.clone()],
+                before: c.before,
+                after: c.after,
+                ratio: c.ratio,
+                ratio_ci95: c.ratio_ci95,
+            }
+        })
+        .collect();
+    Ok(Found { series: s, changes })
+}
+
+fn print_series(f: &Found) {
+    let s = f.series;
     let unit = match s.metric {
         Metric::Normalized => "× the reference",
         Metric::Seconds => "per step",
@@ -187,6 +291,25 @@ fn print_series(s: &Series) {
             String::new()
         }
     );
+    for c in &f.changes {
+        println!(
+            "  step between {} and {}: {} → {} ({:+.1}% [{:+.1}%, {:+.1}%])",
+            short(&c.between[0]),
+            short(&c.between[1]),
+            value(c.before),
+            value(c.after),
+            100.0 * (c.ratio - 1.0),
+            100.0 * (c.ratio_ci95[0] - 1.0),
+            100.0 * (c.ratio_ci95[1] - 1.0)
+        );
+    }
+    if f.changes.is_empty() && s.points.len() > 1 {
+        println!("  no step");
+    }
+}
+
+fn short(commit: &str) -> &str {
+    &commit[..commit.len().min(10)]
 }
 
 /// A `*` / `?` pattern as an anchored regular expression.

@@ -391,7 +391,13 @@ fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<S
         Some(theta) => t.insert("theta".into(), list(theta.into())),
         None => t.remove("theta"),
     };
-    t.insert("multipole".into(), list(case.multipole.name().into()));
+    // The expansion is the octree's alone: another kernel's config does not name it, so that
+    // a build older than the key (a backfilled commit) reads the config too.
+    if case.kernel == crate::kernels::KernelKind::Octree {
+        t.insert("multipole".into(), list(case.multipole.name().into()));
+    } else {
+        t.remove("multipole");
+    }
     match case.order {
         Some(p) => t.insert("order".into(), list((p as i64).into())),
         None => t.remove("order"),

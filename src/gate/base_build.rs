@@ -209,6 +209,22 @@ pub fn base_binary(
     })
 }
 
+/// Makes the worktree at `dir` a workspace of its own. The worktree lies inside the checkout
+/// (under its target folder), and cargo looks upwards for a workspace: a commit whose manifest
+/// has no `[workspace]` table (the project before it had member crates) would be taken for a
+/// stray member of the checkout's workspace and refused. The throwaway worktree's manifest gets
+/// an empty table.
+fn own_workspace(dir: &Path) -> Result<(), String> {
+    let manifest = dir.join("Cargo.toml");
+    let text = std::fs::read_to_string(&manifest)
+        .map_err(|e| format!("cannot read {}: {e}", manifest.display()))?;
+    if text.lines().any(|l| l.trim() == "[workspace]") {
+        return Ok(());
+    }
+    std::fs::write(&manifest, format!("{text}\n[workspace]\n"))
+        .map_err(|e| format!("cannot write {}: {e}", manifest.display()))
+}
+
 /// The cache directory name of `commit` built by the toolchain at hand.
 pub fn cache_key(commit: &str) -> String {
     format!("{commit}-{}", toolchain_key())
@@ -232,6 +248,7 @@ fn toolchain_key() -> String {
 /// `cargo build --release` of the checkout in `dir` into `target`, output to `log`; the
 /// binary's path, or the last lines of the log.
 fn build(dir: &Path, target: &Path, log: &Path) -> Result<PathBuf, String> {
+    own_workspace(dir)?;
     let file =
         std::fs::File::create(log).map_err(|e| format!("cannot create {}: {e}", log.display()))?;
     let err_file = file

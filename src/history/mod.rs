@@ -3,6 +3,7 @@
 //! ([`changes`], scored on a generated corpus in `corpus`), and the series themselves
 //! ([`series`]).
 
+pub mod backfill;
 pub mod changes;
 #[cfg(test)]
 mod corpus;

@@ -141,3 +141,47 @@ fn a_sweep_with_record_appends_its_cases() {
     assert_eq!(text.lines().count(), 2);
     assert!(text.contains("\"source\":\"sweep\"") && text.contains("\"config\":\"tiny\""));
 }
+
+/// A series that steps 10% slower at its 13th commit: the step is shown between the 12th and
+/// the 13th commit, with its size; the one spike in it is not a step.
+#[test]
+fn a_step_is_named_between_its_two_commits() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join("hist")).unwrap();
+    let mut lines = String::new();
+    for i in 0..24 {
+        // ±0.5% of alternating noise, a 30% spike at commit 5, a 10% step from commit 12.
+        let mut t = 1e-3 * if i % 2 == 0 { 1.005 } else { 0.995 };
+        if i == 5 {
+            t *= 1.3;
+        }
+        if i >= 12 {
+            t *= 1.1;
+        }
+        lines.push_str(&format!(
+            "{{\"schema\":\"nbody-bench-history/1\",\"commit\":\"c{i:02}\",\"parent\":null,\
+             \"commit_date\":\"2026-11-{:02}T00:00:00Z\",\"dirty\":false,\
+             \"measured\":\"2026-12-05T00:00:00Z\",\"class\":\"X-2cpu\",\"build\":{{\
+             \"tool_version\":\"0.1.0\",\"profile\":\"release\",\"simd\":\"avx2\",\
+             \"features\":[]}},\"config\":\"ci\",\"source\":\"backfill\",\"case\":\"k\",\
+             \"n\":1000,\"median_s\":{t},\"ci95_s\":[{t},{t}],\"normalized\":null,\
+             \"samples\":16,\"work\":null}}\n",
+            i + 1
+        ));
+    }
+    std::fs::write(dir.path().join("hist/X-2cpu.jsonl"), lines).unwrap();
+    let o = history(dir.path(), &["--class", "X-2cpu", "--json"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let found: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let changes = found[0]["changes"].as_array().unwrap();
+    assert_eq!(changes.len(), 1, "{changes:?}");
+    assert_eq!(changes[0]["between"], serde_json::json!(["c11", "c12"]));
+    let ratio = changes[0]["ratio"].as_f64().unwrap();
+    assert!((ratio - 1.1).abs() < 0.01, "{ratio}");
+    let o = history(dir.path(), &["--class", "X-2cpu"]);
+    assert!(
+        text(&o.stdout).contains("step between c11 and c12"),
+        "{}",
+        text(&o.stdout)
+    );
+}

@@ -289,6 +289,8 @@ const HARNESS_LAYERS: &[&[&str]] = &[
     &["render"],
     // The gate writes its Markdown through render's table builder.
     &["gate", "report"],
+    // The history records what sweeps and gates measured, and backfills through the gate.
+    &["history"],
 ];
 
 /// The MPI crate's modules (`crates/mpi`), bottom up, over the engine's.
