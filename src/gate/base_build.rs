@@ -276,3 +276,21 @@ fn build(dir: &Path, target: &Path, log: &Path) -> Result<PathBuf, String> {
         Err(lines[lines.len().saturating_sub(15)..].join("\n"))
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::own_workspace;
+
+    #[test]
+    fn a_manifest_without_a_workspace_gets_one_and_another_is_left_alone() {
+        let dir = tempfile::tempdir().unwrap();
+        let manifest = dir.path().join("Cargo.toml");
+        std::fs::write(&manifest, "[package]\nname = \"old\"\n").unwrap();
+        own_workspace(dir.path()).unwrap();
+        let once = std::fs::read_to_string(&manifest).unwrap();
+        assert_eq!(once, "[package]\nname = \"old\"\n\n[workspace]\n");
+        own_workspace(dir.path()).unwrap();
+        assert_eq!(std::fs::read_to_string(&manifest).unwrap(), once);
+        assert!(own_workspace(&dir.path().join("missing")).is_err());
+    }
+}
