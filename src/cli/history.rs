@@ -68,7 +68,7 @@ pub struct BackfillArgs {
     #[arg(long, default_value_t = 4)]
     pub rounds: usize,
     /// Where each commit's A/B run is kept.
-    #[arg(long, value_name = "DIR", default_value = "runs/backfill")]
+    #[arg(long, value_name = "DIR", default_value = "results/runs/backfill")]
     pub runs: PathBuf,
     /// Only build (or find cached) every commit's binary: the builds need no quiet machine,
     /// the measurements of a later run do.

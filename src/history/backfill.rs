@@ -111,6 +111,10 @@ pub fn backfill(job: &Backfill, say: &mut dyn FnMut(&str)) -> anyhow::Result<Vec
         return Ok(done);
     }
     let machine = this_machine();
+    // Each backfill keeps its runs apart: a commit measured again is a new run, not a refusal.
+    let runs = job
+        .runs
+        .join(crate::records::results::utc_now().replace(':', "-"));
     for (i, commit) in built.iter().enumerate() {
         say(&format!(
             "measure {}/{}: {}",
@@ -118,9 +122,9 @@ pub fn backfill(job: &Backfill, say: &mut dyn FnMut(&str)) -> anyhow::Result<Vec
             built.len(),
             crate::gate::prefix(commit, 12)
         ));
-        let out = job.runs.join(crate::gate::prefix(commit, 12));
+        let out = runs.join(crate::gate::prefix(commit, 12));
         let request = Request {
-            baseline: job.runs.join("no-baseline"),
+            baseline: runs.join("no-baseline"),
             current: None,
             against: Some(commit.clone()),
             config: Some(job.config.clone()),
