@@ -102,7 +102,7 @@ fn beta_quantile(q: f64, a: f64, b: f64) -> f64 {
 /// The regularised incomplete beta function I_x(a, b), from its continued fraction (Lentz's
 /// method), using the symmetry I_x(a, b) = 1 − I_{1−x}(b, a) where the fraction converges
 /// slowly.
-fn incomplete_beta(x: f64, a: f64, b: f64) -> f64 {
+pub(crate) fn incomplete_beta(x: f64, a: f64, b: f64) -> f64 {
     if x <= 0.0 {
         return 0.0;
     }

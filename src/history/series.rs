@@ -117,36 +117,17 @@ fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::history::store::{Build, HISTORY_SCHEMA, Normalized};
+    use crate::history::store::Normalized;
 
     fn record(case: &str, commit: &str, date: &str, median_s: f64, norm: bool) -> Record {
-        Record {
-            schema: HISTORY_SCHEMA.into(),
-            commit: commit.into(),
-            parent: None,
-            commit_date: Some(date.into()),
-            dirty: false,
-            measured: "2026-12-05T10:00:00Z".into(),
-            class: "X-2cpu".into(),
-            build: Build {
-                tool_version: "0.1.0".into(),
-                profile: "release".into(),
-                simd: "avx2".into(),
-                features: vec![],
-            },
-            config: "ci".into(),
-            source: "sweep".into(),
-            case: case.into(),
-            n: 1000,
-            median_s,
-            ci95_s: [median_s * 0.9, median_s * 1.1],
-            normalized: norm.then_some(Normalized {
-                median: median_s * 10.0,
-                ci95: [median_s * 9.0, median_s * 11.0],
-            }),
-            samples: 16,
-            work: None,
-        }
+        let mut r = crate::history::store::tests::record(case, commit, median_s);
+        r.commit_date = Some(date.into());
+        r.ci95_s = [median_s * 0.9, median_s * 1.1];
+        r.normalized = norm.then_some(Normalized {
+            median: median_s * 10.0,
+            ci95: [median_s * 9.0, median_s * 11.0],
+        });
+        r
     }
 
     #[test]

@@ -305,10 +305,12 @@ pub fn parse(text: &str) -> History {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
-    fn record(case: &str, commit: &str, median_s: f64) -> Record {
+    /// A record of `case` at `commit` (class `Test-1-2-3-2cpu`, config `ci`), for the tests of
+    /// the history's modules.
+    pub(crate) fn record(case: &str, commit: &str, median_s: f64) -> Record {
         Record {
             schema: HISTORY_SCHEMA.into(),
             commit: commit.into(),
