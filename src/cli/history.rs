@@ -111,12 +111,15 @@ fn backfill(dir: &Path, args: &BackfillArgs) -> anyhow::Result<i32> {
     for d in &done {
         match d {
             Done::Recorded { commit, records } => {
-                outln!("{} {records} records", &commit[..commit.len().min(12)])
+                outln!(
+                    "{} {records} records",
+                    nbody_bench::gate::prefix(commit, 12)
+                )
             }
-            Done::Built { commit } => outln!("{} built", &commit[..commit.len().min(12)]),
+            Done::Built { commit } => outln!("{} built", nbody_bench::gate::prefix(commit, 12)),
             Done::Skipped { commit, why } => {
                 skipped += 1;
-                outln!("{} skipped: {why}", &commit[..commit.len().min(12)])
+                outln!("{} skipped: {why}", nbody_bench::gate::prefix(commit, 12))
             }
         }
     }
@@ -308,8 +311,9 @@ fn print_series(f: &Found) {
     }
 }
 
+/// A commit as read from a history file, which may hold anything: cut by characters.
 fn short(commit: &str) -> &str {
-    &commit[..commit.len().min(10)]
+    nbody_bench::gate::prefix(commit, 10)
 }
 
 /// A `*` / `?` pattern as an anchored regular expression.

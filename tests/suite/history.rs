@@ -185,3 +185,20 @@ fn a_step_is_named_between_its_two_commits() {
         text(&o.stdout)
     );
 }
+
+/// A commit field of any text (a hand-edited file) is shown, never cut inside a character.
+#[test]
+fn a_commit_of_any_text_is_shown_whole_characters() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = results(dir.path());
+    let o = history(dir.path(), &["record", file.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let jsonl = dir.path().join(format!("hist/{CLASS}.jsonl"));
+    let edited = std::fs::read_to_string(&jsonl)
+        .unwrap()
+        .replace("0c85c98d046a77b9086f3179e7e47a98609f2842", "ééééééééééééé");
+    std::fs::write(&jsonl, edited).unwrap();
+    let o = history(dir.path(), &["--class", CLASS]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert!(!text(&o.stderr).contains("panicked"));
+}
