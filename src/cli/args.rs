@@ -72,6 +72,10 @@ pub enum Command {
     /// The performance history of a machine class: each case's series over the commits, with
     /// the steps found in it; `history record RESULTS` appends a sweep's results to it.
     History(crate::cli::history::HistoryArgs),
+    /// Name the commit between GOOD (fast) and BAD (slow) that made a case slower: midpoints
+    /// built (cached) and measured side by side with both ends, judged as the gate judges;
+    /// warns instead of guessing when the series is not monotone between the ends.
+    Bisect(crate::cli::bisect::BisectArgs),
     /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
     /// every key of a sweep config.
     #[command(hide = true)]
@@ -775,17 +779,19 @@ pub struct ExportArgs {
 #[command(
     after_long_help = export_results_help(),
     after_help = "Examples:\n  nbody-bench export-results quick > quick.csv\n  \
-    nbody-bench export-results results/quick/results.json --format jsonl --out quick.jsonl"
+    nbody-bench export-results results/quick/results.json --format jsonl --out quick.jsonl\n  \
+    nbody-bench export-results results/history > history.csv"
 )]
 pub struct ExportResultsArgs {
-    /// The results of a sweep: a results.json, a run directory, or a config name (its latest
-    /// run under results/runs/, else its reference results results/<name>/).
-    #[arg(value_name = "RESULTS")]
+    /// The results of a sweep (a results.json, a run directory, or a config name: its latest
+    /// run under results/runs/, else its reference results results/<name>/), or a performance
+    /// history (a history file, or the folder of them: every machine class).
+    #[arg(value_name = "RESULTS|HISTORY")]
     pub results: PathBuf,
     /// The table's format.
     #[arg(long, value_enum, default_value = "csv")]
     pub format: TidyFormat,
-    /// Write the table to FILE (atomically) instead of standard output; never the results
+    /// Write the table to FILE (atomically) instead of standard output; never an input
     /// file itself.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
@@ -802,10 +808,17 @@ fn export_results_help() -> String {
         help.push_str(&format!("  {name:<19} {what}\n"));
     }
     help.push_str(
+        "\nColumns of a history, one row per record (the case's fields taken from its key):\n",
+    );
+    for (name, what) in nbody_bench::history::tidy::HISTORY_COLUMNS {
+        help.push_str(&format!("  {name:<22} {what}\n"));
+    }
+    help.push_str(
         "\npandas: pd.read_csv(FILE, float_precision=\"round_trip\") reads every number back \
          to the bits written; pd.read_json(FILE, lines=True, precise_float=True) the JSON \
          lines.\n\nExamples:\n  nbody-bench export-results quick > quick.csv\n  \
-         nbody-bench export-results results/quick/results.json --format jsonl --out quick.jsonl",
+         nbody-bench export-results results/quick/results.json --format jsonl --out quick.jsonl\n  \
+         nbody-bench export-results results/history > history.csv",
     );
     help
 }

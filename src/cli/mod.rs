@@ -5,6 +5,7 @@
 pub mod args;
 
 mod analyze;
+mod bisect;
 mod dry_run;
 mod export;
 mod export_results;
@@ -45,6 +46,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::ExportResults(args) => export_results::export_results(args),
         Command::Init(args) => init::init(args),
         Command::History(args) => history::history(args),
+        Command::Bisect(args) => bisect::bisect(args),
         Command::Reference(args) => reference::reference(args),
         Command::Job(args) => {
             nbody_bench::experiment::slurm::job_main(&args.dir)

@@ -240,7 +240,11 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
         .cases
         .first()
         .map_or(CHILD_FLOOR, |c| (plan.limit)(&c.case));
-    let base_takes_yes = takes_yes(&plan.base.path, probe_limit)?;
+    // Either side may be an older build (a bisection measures two of them): each is asked.
+    let yes = [
+        takes_yes(&plan.base.path, probe_limit)?,
+        takes_yes(plan.current, probe_limit)?,
+    ];
     let planned: Vec<&Case> = plan.cases.iter().map(|c| &c.case).collect();
     let logical = crate::run::logical_cpus();
     let mut merged: [Vec<CaseRecord>; 2] = [Vec::new(), Vec::new()];
@@ -273,7 +277,15 @@ pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbRe
                     .work
                     .join(side.name())
                     .join(format!("case{i}-round{round}"));
-                let file = run_side(plan, side, text, &dir, planned[i], round, base_takes_yes)?;
+                let file = run_side(
+                    plan,
+                    side,
+                    text,
+                    &dir,
+                    planned[i],
+                    round,
+                    yes[side as usize],
+                )?;
                 let slot = side as usize;
                 metadata[slot].get_or_insert_with(|| file.metadata.clone());
                 let record = file
@@ -424,7 +436,7 @@ fn run_side(
     dir: &Path,
     case: &Case,
     round: usize,
-    base_takes_yes: bool,
+    takes_yes: bool,
 ) -> Result<ResultsFile, AbError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -446,7 +458,7 @@ fn run_side(
         .arg(dir)
         .arg("--no-calibration");
     // A one-case round needs no length estimate (older bases have no such step, nor the flag).
-    if side == Side::Current || base_takes_yes {
+    if takes_yes {
         command.arg("--yes");
     }
     if side == Side::Base {

@@ -148,6 +148,39 @@ fn compare_case(
     })
 }
 
+/// One pair of sample sets judged alone, as the gate judges one case: the ratio of the medians
+/// current / baseline, its bootstrap 95% interval, and the verdict at [`FAMILY_ALPHA`] against
+/// `1 ± threshold` (with a single hypothesis, Holm's rule is the plain test). For a caller that
+/// compares builds one pair at a time (the bisection) with the gate's statistics.
+pub fn judge_pair(
+    baseline: &[f64],
+    current: &[f64],
+    threshold: f64,
+    seed: u64,
+) -> (f64, [f64; 2], Verdict) {
+    let clean = |v: &[f64]| -> Vec<f64> {
+        v.iter()
+            .copied()
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .collect()
+    };
+    let (b, c) = (clean(baseline), clean(current));
+    let ratio = median_of(&c) / median_of(&b);
+    if b.len().min(c.len()) < MIN_CI_SAMPLES {
+        return (ratio, [f64::NAN; 2], Verdict::Unchanged);
+    }
+    let resamples = GateOptions::default().resamples;
+    let (ci, tails) = ratio_interval(&b, &c, resamples, seed, threshold);
+    let verdict = if tails.regressed <= FAMILY_ALPHA {
+        Verdict::Regressed
+    } else if tails.improved <= FAMILY_ALPHA {
+        Verdict::Improved
+    } else {
+        Verdict::Unchanged
+    };
+    (ratio, ci, verdict)
+}
+
 /// The bootstrap 95% interval of median(current) / median(baseline) and its one-sided
 /// p-values against the threshold's margins (NaN and no claim when a side is empty).
 pub(super) fn ratio_interval(

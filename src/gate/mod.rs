@@ -35,7 +35,7 @@ mod tests;
 pub use checks::{
     BUSY_BASELINE_CPUS, RATE_TOLERANCE, background_cpus, calibrated_rate, prefix, rates_differ,
 };
-pub use compare::{check_threshold, compare};
+pub use compare::{check_threshold, compare, judge_pair};
 pub use family::Tails;
 pub use render::{Format, render};
 

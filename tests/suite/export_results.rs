@@ -290,7 +290,7 @@ print(f"pandas {pd.__version__}: {len(tables['csv'])} rows read back")
 "#;
 
 /// A Python that imports pandas: the peers' venv (scripts/install-fmm3d.sh), else `python3`.
-fn python_with_pandas() -> Result<PathBuf, String> {
+pub fn python_with_pandas() -> Result<PathBuf, String> {
     let venv = Path::new(env!("CARGO_MANIFEST_DIR")).join(".peers/venv/bin/python");
     for python in [venv, PathBuf::from("python3")] {
         let imports = Command::new(&python)

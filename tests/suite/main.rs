@@ -9,6 +9,7 @@
 mod analyze;
 mod bad_input;
 mod bad_sizes;
+mod bisect;
 mod cli;
 mod config_corpus;
 mod conservation;
@@ -17,6 +18,7 @@ mod docs;
 mod dry_run;
 mod dry_run_checks;
 mod export;
+mod export_history;
 mod export_results;
 mod external;
 mod external_honesty;
