@@ -72,6 +72,10 @@ pub enum Command {
     /// The performance history of a machine class: each case's series over the commits, with
     /// the steps found in it; `history record RESULTS` appends a sweep's results to it.
     History(crate::cli::history::HistoryArgs),
+    /// The performance history as one self-contained HTML page (every case's series per
+    /// machine class, the steps found, the latest gate verdicts), or with `--markdown` a
+    /// summary of the changes since a base commit for a pull-request comment.
+    Publish(crate::cli::publish::PublishArgs),
     /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
     /// every key of a sweep config.
     #[command(hide = true)]

@@ -16,6 +16,7 @@ mod history;
 mod init;
 mod list;
 mod mpi;
+mod publish;
 mod reference;
 mod report;
 mod run;
@@ -45,6 +46,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::ExportResults(args) => export_results::export_results(args),
         Command::Init(args) => init::init(args),
         Command::History(args) => history::history(args),
+        Command::Publish(args) => publish::publish(args),
         Command::Reference(args) => reference::reference(args),
         Command::Job(args) => {
             nbody_bench::experiment::slurm::job_main(&args.dir)

@@ -7,5 +7,8 @@ pub mod backfill;
 pub mod changes;
 #[cfg(test)]
 mod corpus;
+pub mod publish;
 pub mod series;
+pub mod steps;
 pub mod store;
+pub mod verdicts;
