@@ -35,6 +35,12 @@ scripts/install-mpi.sh
 slurm_log=$(mktemp)
 scripts/slurm-local.sh --install >"$slurm_log" 2>&1 &
 slurm_install=$!
+# Chromium for the published page's browser test (tests/suite/publish.rs), installed the same
+# way once Slurm's install is done (apt takes one installer at a time).
+chromium_log=$(mktemp)
+(while kill -0 "$slurm_install" 2>/dev/null; do sleep 2; done
+ scripts/install-chromium.sh) >"$chromium_log" 2>&1 &
+chromium_install=$!
 cargo fmt --all -- --check
 
 step "the build, linted: tests, benches and binary, with the mpi feature"
@@ -63,6 +69,10 @@ cargo test --release --workspace --all-targets "${features[@]}" --no-run
 bin=target/release/nbody-bench
 if ! wait "$slurm_install"; then
     cat "$slurm_log" >&2
+    exit 1
+fi
+if ! wait "$chromium_install"; then
+    cat "$chromium_log" >&2
     exit 1
 fi
 

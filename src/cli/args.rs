@@ -76,6 +76,10 @@ pub enum Command {
     /// built (cached) and measured side by side with both ends, judged as the gate judges;
     /// warns instead of guessing when the series is not monotone between the ends.
     Bisect(crate::cli::bisect::BisectArgs),
+    /// The performance history as one self-contained HTML page (every case's series per
+    /// machine class, the steps found, the latest gate verdicts), or with `--markdown` a
+    /// summary of the changes since a base commit for a pull-request comment.
+    Publish(crate::cli::publish::PublishArgs),
     /// Print a generated page of docs/reference/ (Markdown): the help of every subcommand, or
     /// every key of a sweep config.
     #[command(hide = true)]

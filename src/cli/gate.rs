@@ -44,7 +44,8 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
 }
 
 /// Appends what the gate measured to the history under `dir`: the A/B run's two sides (the
-/// baseline's revision and this build), the fast path's sweep, or the `--current` file.
+/// baseline's revision and this build), the fast path's sweep, or the `--current` file; and
+/// the run's verdicts to the class's verdict file beside it.
 fn record(
     dir: &std::path::Path,
     outcome: &drive::Outcome,
@@ -62,6 +63,17 @@ fn record(
         )?],
         (None, None) => Vec::new(),
     };
+    // The verdicts beside the records: the page shows each class's latest gate run.
+    let run = nbody_bench::history::verdicts::GateRun::of(
+        &outcome.report,
+        &nbody_bench::gate::route::this_machine(),
+    );
+    for (to, count) in nbody_bench::history::verdicts::append(dir, &[run])? {
+        eprintln!(
+            "gate: the verdicts of {count} gate run(s) appended to {}",
+            to.display()
+        );
+    }
     for path in files {
         let file = nbody_bench::records::results::ResultsFile::load(&path)?;
         for (to, count) in super::history::append_results(dir, &file, "gate")? {

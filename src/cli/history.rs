@@ -4,7 +4,9 @@
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
 use nbody_bench::history::series::{Metric, Series, series};
+use nbody_bench::history::steps::{Step, steps};
 use nbody_bench::history::store::{self, CommitFacts, History};
+use nbody_bench::history::verdicts::{self, GateRun};
 use nbody_bench::records::results::ResultsFile;
 use nbody_bench::units::Duration;
 use std::path::{Path, PathBuf};
@@ -42,7 +44,8 @@ pub struct HistoryArgs {
 
 #[derive(Debug, Subcommand)]
 pub enum HistoryAction {
-    /// Append every measured case of results files to the history of their machine class.
+    /// Append every measured case of results files to the history of their machine class; a
+    /// gate report (a kept gate run's gate.json) appends its verdicts to <class>.gate.jsonl.
     Record(RecordArgs),
     /// Measure older commits into the history: every K-th commit of A..B along the first
     /// parents, each built in the gate's cached worktree and measured side by side with this
@@ -78,7 +81,8 @@ pub struct BackfillArgs {
 
 #[derive(Debug, Args)]
 pub struct RecordArgs {
-    /// Results files (a sweep's results.json, or its run directory).
+    /// Results files (a sweep's results.json, or its run directory), or gate reports
+    /// (gate.json).
     #[arg(required = true, value_name = "RESULTS")]
     pub results: Vec<PathBuf>,
     /// What made the measurement, kept in each record.
@@ -136,6 +140,16 @@ fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
         } else {
             path.clone()
         };
+        if let Some(run) = gate_report(&path)? {
+            for (to, count) in verdicts::append(dir, &[run])? {
+                eprintln!(
+                    "{}: the verdicts of {count} gate run(s) appended to {}",
+                    path.display(),
+                    to.display()
+                );
+            }
+            continue;
+        }
         let file = ResultsFile::load(&path)?;
         let written = append_results(dir, &file, &args.source)?;
         for (to, count) in written {
@@ -147,6 +161,27 @@ fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
         }
     }
     Ok(0)
+}
+
+/// The verdicts of `path` when it is a gate report (schema `nbody-bench/gate/v1`, a kept gate
+/// run's `gate.json`); `None` for any other file.
+fn gate_report(path: &Path) -> anyhow::Result<Option<GateRun>> {
+    if path.extension().is_none_or(|e| e != "json") {
+        return Ok(None);
+    }
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return Ok(None);
+    };
+    let schema = serde_json::from_str::<serde_json::Value>(&text)
+        .ok()
+        .and_then(|v| v["schema"].as_str().map(str::to_string));
+    if schema.as_deref() != Some(verdicts::GATE_REPORT_SCHEMA) {
+        return Ok(None);
+    }
+    let machine = nbody_bench::gate::route::this_machine();
+    GateRun::from_report_json(&text, &machine)
+        .map(Some)
+        .map_err(|why| anyhow::anyhow!("{}: a gate report, but {why}", path.display()))
 }
 
 /// Appends the records of `file` (measured by `source`) to the history under `dir`; the files
@@ -233,34 +268,8 @@ struct Found<'a> {
     changes: Vec<Step>,
 }
 
-/// One step, between two commits of the series.
-#[derive(serde::Serialize)]
-struct Step {
-    /// The last commit of the old level and the first of the new.
-    between: [String; 2],
-    before: f64,
-    after: f64,
-    ratio: f64,
-    ratio_ci95: [f64; 2],
-}
-
 fn found(s: &Series) -> anyhow::Result<Found<'_>> {
-    use nbody_bench::history::changes::{Detector, change_points};
-    let values: Vec<f64> = s.points.iter().map(|p| p.value).collect();
-    let changes = change_points(&values, &Detector::default())
-        .with_context(|| format!("the series of {}", s.case))?
-        .into_iter()
-        .map(|c| {
-            let [a, b] = c.between();
-            Step {
-                between: [s.points[a].commit.clone(), s.points[b].commit.clone()],
-                before: c.before,
-                after: c.after,
-                ratio: c.ratio,
-                ratio_ci95: c.ratio_ci95,
-            }
-        })
-        .collect();
+    let changes = steps(s).with_context(|| format!("the series of {}", s.case))?;
     Ok(Found { series: s, changes })
 }
 

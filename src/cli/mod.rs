@@ -17,6 +17,7 @@ mod history;
 mod init;
 mod list;
 mod mpi;
+mod publish;
 mod reference;
 mod report;
 mod run;
@@ -47,6 +48,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Init(args) => init::init(args),
         Command::History(args) => history::history(args),
         Command::Bisect(args) => bisect::bisect(args),
+        Command::Publish(args) => publish::publish(args),
         Command::Reference(args) => reference::reference(args),
         Command::Job(args) => {
             nbody_bench::experiment::slurm::job_main(&args.dir)

@@ -155,7 +155,7 @@ impl Normalization {
 }
 
 /// The verdict on one case.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Verdict {
     /// Slower by more than the threshold, with the family-wise error of [`family`]: the

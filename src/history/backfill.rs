@@ -4,6 +4,7 @@
 //! at every commit, is the control: a step in it is the machine's, not the code's.
 
 use super::store::{self, CommitFacts};
+use super::verdicts;
 use crate::gate::base_build;
 use crate::gate::drive::{self, Request};
 use crate::gate::route::this_machine;
@@ -137,15 +138,23 @@ pub fn backfill(job: &Backfill, say: &mut dyn FnMut(&str)) -> anyhow::Result<Vec
             force: true,
             fail_on_work_change: false,
         };
-        if let Err(e) = drive::run(&request, say) {
-            let why = format!("{e:#}");
-            say(&format!("skipped: {why}"));
-            done.push(Done::Skipped {
-                commit: commit.clone(),
-                why,
-            });
-            continue;
-        }
+        let outcome = match drive::run(&request, say) {
+            Ok(outcome) => outcome,
+            Err(e) => {
+                let why = format!("{e:#}");
+                say(&format!("skipped: {why}"));
+                done.push(Done::Skipped {
+                    commit: commit.clone(),
+                    why,
+                });
+                continue;
+            }
+        };
+        // The run's verdicts too: the page shows the latest of them beside the series.
+        verdicts::append(
+            &job.dir,
+            &[verdicts::GateRun::of(&outcome.report, &machine)],
+        )?;
         let mut records = 0;
         for side in ["base.json", "current.json"] {
             let file = ResultsFile::load(&out.join(side))?;

@@ -234,7 +234,7 @@ pub fn append(dir: &Path, records: &[Record]) -> Result<Vec<(PathBuf, usize)>, H
 /// Appends `text` (whole lines) to `path` in one write under an exclusive lock; a file that
 /// does not end with a newline (a writer stopped mid-line) gets one first, so that the damage
 /// stays on its own line.
-fn append_text(path: &Path, text: &str) -> std::io::Result<()> {
+pub(crate) fn append_text(path: &Path, text: &str) -> std::io::Result<()> {
     use std::io::{Read, Seek, SeekFrom};
     use std::os::unix::fs::OpenOptionsExt;
     let mut file = std::fs::OpenOptions::new()

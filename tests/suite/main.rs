@@ -40,6 +40,7 @@ mod mpi_cli;
 mod mpi_launch;
 mod parsers;
 mod peers;
+mod publish;
 mod report;
 mod runs;
 mod slurm;

@@ -103,7 +103,7 @@ pub struct Bisection {
     /// Commits built (or found built), in order, and the ones that failed with why.
     pub builds: Vec<String>,
     pub skipped: Vec<(String, String)>,
-    /// Every side-by-side measurement, in order.
+    /// Every side-by-side measurement, in order (judged on the pair's samples so far).
     pub comparisons: Vec<Comparison>,
     /// Steps seen beside the one followed (a midpoint between two steps).
     pub also: Vec<Comparison>,
@@ -387,7 +387,8 @@ impl Run<'_> {
     fn compare(&mut self, from: &str, to: &str, rounds: usize) -> anyhow::Result<Comparison> {
         let key = (from.to_string(), to.to_string());
         let have = self.samples.get(&key).map_or(0, |s| s[0].len());
-        if have == 0 || rounds > self.settings.rounds {
+        let measure = have == 0 || rounds > self.settings.rounds;
+        if measure {
             let [a, b] = self.probe.measure(from, to, rounds)?;
             let entry = self.samples.entry(key.clone()).or_default();
             entry[0].extend(a);
@@ -405,7 +406,9 @@ impl Run<'_> {
             verdict,
             samples: [a.len(), b.len()],
         };
-        self.comparisons.push(comparison.clone());
+        if measure {
+            self.comparisons.push(comparison.clone());
+        }
         Ok(comparison)
     }
 }
