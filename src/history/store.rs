@@ -263,45 +263,74 @@ pub(crate) fn append_text(path: &Path, text: &str) -> std::io::Result<()> {
     file.unlock()
 }
 
-/// Reads a history file: every record, and every line that is not one with its number (the
-/// rest stays readable). A missing file is an empty history.
-pub fn read(path: &Path) -> Result<History, HistoryError> {
-    let text = match crate::input::read_text(path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(History::default()),
-        Err(source) => {
-            return Err(HistoryError::Read {
-                path: path.into(),
-                source,
-            });
-        }
-    };
-    Ok(parse(&text))
+/// A line of a JSON Lines file of this project (a history record, a gate run's verdicts):
+/// the schema it carries, and what a line that is not one is called.
+pub(crate) trait Line: serde::de::DeserializeOwned {
+    const SCHEMA: &'static str;
+    /// "a history record", "a gate verdict line".
+    const WHAT: &'static str;
+    fn schema(&self) -> &str;
 }
 
-/// The records of a history's text (see [`read`]).
-pub fn parse(text: &str) -> History {
-    let mut history = History::default();
+impl Line for Record {
+    const SCHEMA: &'static str = HISTORY_SCHEMA;
+    const WHAT: &'static str = "a history record";
+    fn schema(&self) -> &str {
+        &self.schema
+    }
+}
+
+/// Every line of the file at `path` that is a `T`, and every one that is not with its number
+/// (the rest stays readable). A missing file holds none.
+pub(crate) fn read_lines<T: Line>(path: &Path) -> Result<(Vec<T>, Vec<BadLine>), HistoryError> {
+    match crate::input::read_text(path) {
+        Ok(text) => Ok(parse_lines(&text)),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok((Vec::new(), Vec::new())),
+        Err(source) => Err(HistoryError::Read {
+            path: path.into(),
+            source,
+        }),
+    }
+}
+
+/// The lines of a text that are `T`s, and the numbered ones that are not (see [`read_lines`]).
+pub(crate) fn parse_lines<T: Line>(text: &str) -> (Vec<T>, Vec<BadLine>) {
+    let (mut good, mut bad) = (Vec::new(), Vec::new());
     for (i, line) in text.lines().enumerate() {
         if line.trim().is_empty() {
             continue;
         }
-        match serde_json::from_str::<Record>(line) {
-            Ok(r) if r.schema == HISTORY_SCHEMA => history.records.push(r),
-            Ok(r) => history.bad.push(BadLine {
-                line: i + 1,
-                problem: format!(
-                    "schema `{}`, this version reads `{HISTORY_SCHEMA}`",
-                    r.schema
-                ),
-            }),
-            Err(e) => history.bad.push(BadLine {
-                line: i + 1,
-                problem: format!("not a history record ({e})"),
-            }),
-        }
+        let problem = match serde_json::from_str::<T>(line) {
+            Ok(r) if r.schema() == T::SCHEMA => {
+                good.push(r);
+                continue;
+            }
+            Ok(r) => format!(
+                "schema `{}`, this version reads `{}`",
+                r.schema(),
+                T::SCHEMA
+            ),
+            Err(e) => format!("not {} ({e})", T::WHAT),
+        };
+        bad.push(BadLine {
+            line: i + 1,
+            problem,
+        });
     }
-    history
+    (good, bad)
+}
+
+/// Reads a history file: every record, and every line that is not one with its number (the
+/// rest stays readable). A missing file is an empty history.
+pub fn read(path: &Path) -> Result<History, HistoryError> {
+    let (records, bad) = read_lines(path)?;
+    Ok(History { records, bad })
+}
+
+/// The records of a history's text (see [`read`]).
+pub fn parse(text: &str) -> History {
+    let (records, bad) = parse_lines(text);
+    History { records, bad }
 }
 
 #[cfg(test)]

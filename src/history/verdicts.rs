@@ -5,7 +5,7 @@
 //! the way the history is ([`super::store`]): appended whole lines under a lock, and read
 //! line by line, a bad line named by its number and the rest read.
 
-use super::store::{BadLine, HistoryError, append_text};
+use super::store::{BadLine, HistoryError, Line, append_text, parse_lines, read_lines};
 use crate::gate::baselines::class_name;
 use crate::gate::{GateReport, Judged, RunInfo, Verdict};
 use serde::{Deserialize, Serialize};
@@ -244,44 +244,24 @@ pub fn append(dir: &Path, runs: &[GateRun]) -> Result<Vec<(PathBuf, usize)>, His
     Ok(written)
 }
 
+impl Line for GateRun {
+    const SCHEMA: &'static str = VERDICTS_SCHEMA;
+    const WHAT: &'static str = "a gate verdict line";
+    fn schema(&self) -> &str {
+        &self.schema
+    }
+}
+
 /// Reads a verdict file (a missing file holds no run).
 pub fn read(path: &Path) -> Result<Verdicts, HistoryError> {
-    let text = match crate::input::read_text(path) {
-        Ok(text) => text,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Verdicts::default()),
-        Err(source) => {
-            return Err(HistoryError::Read {
-                path: path.into(),
-                source,
-            });
-        }
-    };
-    Ok(parse(&text))
+    let (runs, bad) = read_lines(path)?;
+    Ok(Verdicts { runs, bad })
 }
 
 /// The runs of a verdict file's text (see [`read`]).
 pub fn parse(text: &str) -> Verdicts {
-    let mut out = Verdicts::default();
-    for (i, line) in text.lines().enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        match serde_json::from_str::<GateRun>(line) {
-            Ok(r) if r.schema == VERDICTS_SCHEMA => out.runs.push(r),
-            Ok(r) => out.bad.push(BadLine {
-                line: i + 1,
-                problem: format!(
-                    "schema `{}`, this version reads `{VERDICTS_SCHEMA}`",
-                    r.schema
-                ),
-            }),
-            Err(e) => out.bad.push(BadLine {
-                line: i + 1,
-                problem: format!("not a gate verdict line ({e})"),
-            }),
-        }
-    }
-    out
+    let (runs, bad) = parse_lines(text);
+    Verdicts { runs, bad }
 }
 
 #[cfg(test)]
