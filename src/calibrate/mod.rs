@@ -8,7 +8,9 @@
 //!   as a throughput ratio against one thread. On 2-vCPU cloud machines the two vCPUs are often
 //!   SMT siblings of one core that share its FMA pipes, so this can be ~1.0 rather than 2.0;
 //!   speedups of compute-bound kernels are reported relative to it.
-//! - **Fork/join cost** of one rayon region in which every pool thread takes part.
+//! - **Fork/join cost** of one rayon region in which every pool thread takes part, and beside
+//!   it the **team's costs**: one barrier crossing of the engine's worker team, and one of its
+//!   regions started after serial work.
 //! - **Streaming read bandwidth** of one thread over a buffer much larger than the L3 cache.
 //!
 //! Nothing here panics on a hostile environment: a missing `/proc/cpuinfo` gives "unknown", a
@@ -52,6 +54,15 @@ pub struct Calibration {
     pub(crate) fork_join_hot_us: f64,
     /// Pool size the fork/join costs were measured with.
     pub(crate) fork_join_threads: usize,
+    /// Median wall time of one barrier crossing of the engine's worker team (as many workers
+    /// as the fork/join's pool), back to back inside one region, in µs; `None` when not
+    /// measured (and in files written before it was).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) team_barrier_us: Option<f64>,
+    /// Median wall time of one team region (one barrier in it) started after 1 ms of serial
+    /// work, the workers parked, in µs: the team's counterpart of `fork_join_us`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub(crate) team_region_us: Option<f64>,
     /// Single-thread streaming read bandwidth from memory, in GB/s (10⁹ bytes per second);
     /// 0 if the buffer could not be allocated (see `warnings`).
     pub(crate) memory_bandwidth_gbs: f64,
@@ -126,6 +137,9 @@ impl Calibration {
             self.fork_join_threads,
             self.memory_bandwidth_gbs
         );
+        if let (Some(barrier), Some(region)) = (self.team_barrier_us, self.team_region_us) {
+            s += &format!(", team barrier {barrier:.2} us (region {region:.0} us)");
+        }
         if !self.warnings.is_empty() {
             s += &format!("\nwarnings: {}", self.warnings.join("; "));
         }
@@ -167,6 +181,9 @@ trait Meter {
     fn ceiling(&mut self, threads: usize) -> Result<f64, String>;
     /// Fork/join cost `(cold, hot)` in µs on a `threads`-thread pool.
     fn fork_join_us(&mut self, threads: usize, warnings: &mut Vec<String>) -> (f64, f64);
+    /// The worker team's `(barrier, region)` costs in µs with `threads` workers.
+    fn team_us(&mut self, threads: usize, warnings: &mut Vec<String>)
+    -> (Option<f64>, Option<f64>);
     /// Streaming read bandwidth, GB/s (0 with a warning when it cannot be measured).
     fn bandwidth_gbs(&mut self, warnings: &mut Vec<String>) -> f64;
 }
@@ -195,6 +212,7 @@ fn assemble(meter: &mut impl Meter, threads: &[usize], logical_cpus: usize) -> C
     }
     let fork_join_threads = threads.iter().copied().max().unwrap_or(2).max(2);
     let (fork_join_us, fork_join_hot_us) = meter.fork_join_us(fork_join_threads, &mut warnings);
+    let (team_barrier_us, team_region_us) = meter.team_us(fork_join_threads, &mut warnings);
     let memory_bandwidth_gbs = meter.bandwidth_gbs(&mut warnings);
     Calibration {
         cpu_model: cpu_model(),
@@ -206,6 +224,8 @@ fn assemble(meter: &mut impl Meter, threads: &[usize], logical_cpus: usize) -> C
         fork_join_us,
         fork_join_hot_us,
         fork_join_threads,
+        team_barrier_us,
+        team_region_us,
         memory_bandwidth_gbs,
         duration_s: 0.0,
         background_cpus: None,
@@ -257,6 +277,14 @@ impl Meter for Machine {
         measure_fork_join(threads, self.budget_s, warnings)
     }
 
+    fn team_us(
+        &mut self,
+        threads: usize,
+        warnings: &mut Vec<String>,
+    ) -> (Option<f64>, Option<f64>) {
+        measure_team(threads, self.budget_s, warnings)
+    }
+
     fn bandwidth_gbs(&mut self, warnings: &mut Vec<String>) -> f64 {
         measure_bandwidth(self.memory_bytes, self.budget_s, warnings)
     }
@@ -304,11 +332,13 @@ mod compute;
 mod fork_join;
 mod load;
 mod memory;
+mod team;
 
 use compute::*;
 use fork_join::*;
 use load::*;
 use memory::*;
+use team::*;
 
 // ---------------------------------------------------------------------------------------------
 // Timing helpers
@@ -376,6 +406,9 @@ mod tests {
         fn fork_join_us(&mut self, threads: usize, _: &mut Vec<String>) -> (f64, f64) {
             (10.0 * threads as f64, 1.0)
         }
+        fn team_us(&mut self, threads: usize, _: &mut Vec<String>) -> (Option<f64>, Option<f64>) {
+            (Some(0.5 * threads as f64), Some(4.0))
+        }
         fn bandwidth_gbs(&mut self, warnings: &mut Vec<String>) -> f64 {
             warnings.push("bandwidth: fixed".to_string());
             12.5
@@ -400,6 +433,11 @@ mod tests {
         assert_eq!(
             (c.fork_join_threads, c.fork_join_us, c.fork_join_hot_us),
             (16, 160.0, 1.0)
+        );
+        // The team beside it, with as many workers.
+        assert_eq!(
+            (c.team_barrier_us, c.team_region_us),
+            (Some(8.0), Some(4.0))
         );
         assert_eq!(c.memory_bandwidth_gbs, 12.5);
         assert_eq!(
@@ -440,6 +478,8 @@ mod tests {
             fork_join_us: 19.2,
             fork_join_hot_us: 3.1,
             fork_join_threads: 4,
+            team_barrier_us: Some(0.4),
+            team_region_us: Some(6.5),
             memory_bandwidth_gbs: 20.1,
             duration_s: 2.4,
             background_cpus: Some(0.03),

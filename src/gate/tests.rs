@@ -60,6 +60,8 @@ fn calibration(gflops: f64) -> Calibration {
         fork_join_us: 20.0,
         fork_join_hot_us: 3.0,
         fork_join_threads: 2,
+        team_barrier_us: None,
+        team_region_us: None,
         memory_bandwidth_gbs: 20.0,
         duration_s: 1.0,
         background_cpus: None,

@@ -84,6 +84,15 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
                 format!("{:.1} µs / {:.1} µs", c.fork_join_us, c.fork_join_hot_us),
             ),
             (
+                "worker team: region after idle / one barrier",
+                match (c.team_region_us, c.team_barrier_us) {
+                    (Some(region), Some(barrier)) => {
+                        format!("{region:.1} µs / {barrier:.2} µs")
+                    }
+                    _ => "– (not measured by this version)".into(),
+                },
+            ),
+            (
                 "streaming read bandwidth, one thread",
                 format!("{:.1} GB/s", c.memory_bandwidth_gbs),
             ),

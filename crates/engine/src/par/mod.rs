@@ -1,5 +1,8 @@
 //! Per-particle work on the rayon pool: disjoint chunks of a field, when a pass is worth a fork,
-//! gathers by a permutation, and writes at distinct places from several threads.
+//! gathers by a permutation, and writes at distinct places from several threads; and a
+//! [`team`] of workers that lives for a whole run and meets at barriers.
+
+pub mod team;
 
 use rayon::join;
 
