@@ -72,9 +72,10 @@ pub enum Command {
     /// The performance history of a machine class: each case's series over the commits, with
     /// the steps found in it; `history record RESULTS` appends a sweep's results to it.
     History(crate::cli::history::HistoryArgs),
-    /// Name the commit between GOOD (fast) and BAD (slow) that made a case slower: midpoints
-    /// built (cached) and measured side by side with both ends, judged as the gate judges;
-    /// warns instead of guessing when the series is not monotone between the ends.
+    /// Name the commit between GOOD (fast) and BAD (slow) that made a case slower (with
+    /// `--faster`, faster): midpoints built (cached) and measured side by side with both ends,
+    /// judged as the gate judges; warns instead of guessing when the series is not monotone
+    /// between the ends.
     Bisect(crate::cli::bisect::BisectArgs),
     /// The performance history as one self-contained HTML page (every case's series per
     /// machine class, the steps found, the latest gate verdicts), or with `--markdown` a

@@ -1,10 +1,11 @@
-//! `nbody-bench bisect`: the commit between a fast and a slow one that made a case slower,
-//! found by building midpoints and measuring each side by side with both ends in doubt.
+//! `nbody-bench bisect`: the commit between a fast and a slow one that made a case slower (or,
+//! with `--faster`, faster), found by building midpoints and measuring each side by side with
+//! both ends in doubt.
 
 use clap::Args;
 use nbody_bench::gate::{AB_ROUNDS, AB_THRESHOLD, prefix};
 use nbody_bench::history::bisect::probe::GateProbe;
-use nbody_bench::history::bisect::{self, Bisection, Finding, Settings};
+use nbody_bench::history::bisect::{self, Bisection, Direction, Finding, Settings};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -18,6 +19,8 @@ use std::path::PathBuf;
     and its parent differ at the gate's confidence; otherwise the answer says why not: the \
     slowdown is spread over several commits, lies among commits that do not build, or the \
     series is not monotone between the ends (two opposite steps).\n\n\
+    With --faster it names the commit that made the case faster instead (BAD the newer, faster \
+    end).\n\n\
     Exit codes: 0 a commit named, 1 none named (the answer says why), 2 bad input.")]
 pub struct BisectArgs {
     /// The last commit known fast (an ancestor of BAD).
@@ -43,6 +46,9 @@ pub struct BisectArgs {
     /// their own per bisection.
     #[arg(long, value_name = "DIR", default_value = "results/runs/bisect")]
     pub runs: PathBuf,
+    /// Find the commit that made the case faster (BAD is then the faster, newer end).
+    #[arg(long)]
+    pub faster: bool,
     /// Print the answer as JSON instead of text.
     #[arg(long)]
     pub json: bool,
@@ -67,6 +73,11 @@ pub fn bisect(args: BisectArgs) -> anyhow::Result<i32> {
         Box::new(|line: &str| eprintln!("bisect: {line}")),
     )?;
     let settings = Settings {
+        direction: if args.faster {
+            Direction::Faster
+        } else {
+            Direction::Slower
+        },
         threshold: args.threshold,
         rounds: args.rounds,
         seed: 0xb15ec7,
@@ -89,9 +100,14 @@ pub fn bisect(args: BisectArgs) -> anyhow::Result<i32> {
 /// The answer in words.
 fn describe(found: &Bisection, case: &str) -> String {
     let p = |c: &str| prefix(c, 12).to_string();
+    let way = found.direction.name();
+    let (good, bad) = match found.direction {
+        Direction::Slower => ("fast", "slow"),
+        Direction::Faster => ("slow", "fast"),
+    };
     let mut text = match &found.finding {
         Finding::Named { culprit, step } => format!(
-            "{case}: {} made it slower: {} against its parent {}",
+            "{case}: {} made it {way}: {} against its parent {}",
             p(culprit),
             step.size(),
             p(&step.from)
@@ -104,8 +120,8 @@ fn describe(found: &Bisection, case: &str) -> String {
             unbuilt.iter().map(|c| p(c)).collect::<Vec<_>>().join(", ")
         ),
         Finding::Spread { step } => format!(
-            "{case}: no single commit: {} (fast) and {} (slow) differ by {}, less than the \
-             gate can tell; the slowdown is spread over several commits (a drift)",
+            "{case}: no single commit: {} ({good}) and {} ({bad}) differ by {}, less than the \
+             gate can tell; the change is spread over several commits (a drift)",
             p(&step.from),
             p(&step.to),
             step.size()
@@ -120,10 +136,14 @@ fn describe(found: &Bisection, case: &str) -> String {
             ) + &format!(" (at {})", p(commit))
         }
         Finding::NoStep { ends } => format!(
-            "{case}: {} is not slower than {} at the gate's confidence ({}): nothing to bisect",
+            "{case}: {} is not {way} than {} at the gate's confidence ({}): nothing to bisect{}",
             p(&ends.to),
             p(&ends.from),
-            ends.size()
+            ends.size(),
+            match found.direction {
+                Direction::Slower => " (--faster looks for a speed-up)",
+                Direction::Faster => "",
+            }
         ),
     };
     for other in &found.also {

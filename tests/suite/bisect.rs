@@ -166,6 +166,7 @@ fn the_commit_is_named_in_19_of_20_seeded_trials_within_the_build_budget() {
             builds: 0,
         };
         let settings = Settings {
+            direction: bisect::Direction::Slower,
             threshold: nbody_bench::gate::AB_THRESHOLD,
             rounds: nbody_bench::gate::AB_ROUNDS,
             seed: trial,

@@ -1,7 +1,8 @@
-//! Naming the commit that made a case slower: a bisection of the first-parent commits between a
-//! fast commit (GOOD) and a slow one (BAD), each midpoint built and measured side by side with
-//! both ends of the interval still in doubt, judged with the gate's statistics
-//! ([`crate::gate::judge_pair`]).
+//! Naming the commit that made a case slower (or faster): a bisection of the first-parent
+//! commits between an older commit (GOOD) and a newer one (BAD) that differs from it, each
+//! midpoint built and measured side by side with both ends of the interval still in doubt,
+//! judged with the gate's statistics ([`crate::gate::judge_pair`]). Below, "slow" and "fast"
+//! are for the usual [`Direction::Slower`]; [`Direction::Faster`] swaps them.
 //!
 //! What can go wrong in a plain bisection, and what this one does instead:
 //! - a midpoint that does not build (or cannot run the case) is skipped, and its neighbour
@@ -36,9 +37,58 @@ pub trait Probe {
     fn measure(&mut self, a: &str, b: &str, rounds: usize) -> anyhow::Result<[Vec<f64>; 2]>;
 }
 
+/// What changed between GOOD and BAD.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// BAD is slower: find the commit that made the case slower.
+    Slower,
+    /// BAD is faster: find the commit that made it faster.
+    Faster,
+}
+
+impl Direction {
+    /// The gate's verdict on a change toward BAD.
+    fn toward_bad(self) -> Verdict {
+        match self {
+            Direction::Slower => Verdict::Regressed,
+            Direction::Faster => Verdict::Improved,
+        }
+    }
+
+    /// Where a change of this verdict goes.
+    fn way(self, verdict: Verdict) -> Way {
+        if verdict == Verdict::Unchanged {
+            Way::Level
+        } else if verdict == self.toward_bad() {
+            Way::TowardBad
+        } else {
+            Way::Back
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Direction::Slower => "slower",
+            Direction::Faster => "faster",
+        }
+    }
+}
+
+/// A change between two commits, seen from the bisection's direction.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Way {
+    TowardBad,
+    Level,
+    /// Against the direction: faster while looking for a slowdown, or the other way round.
+    Back,
+}
+
 /// How a bisection judges.
 #[derive(Clone, Copy, Debug)]
 pub struct Settings {
+    /// Whether BAD is the slower or the faster end.
+    pub direction: Direction,
     /// A step smaller than this fraction is not one (the gate's A/B threshold by default).
     pub threshold: f64,
     /// Interleaved rounds of each side-by-side measurement.
@@ -97,6 +147,8 @@ pub enum Finding {
 pub struct Bisection {
     pub good: String,
     pub bad: String,
+    /// Whether BAD was the slower or the faster end.
+    pub direction: Direction,
     /// The commits after GOOD up to BAD along the first parents.
     pub commits: usize,
     pub finding: Finding,
@@ -215,7 +267,8 @@ pub fn bisect(
     ));
     let ends = run.compare(&path[0], &path[path.len() - 1], settings.rounds)?;
     say(&format!("  {}", ends.size()));
-    if ends.verdict != Verdict::Regressed {
+    let dir = settings.direction;
+    if dir.way(ends.verdict) != Way::TowardBad {
         return Ok(run.finish(path, Finding::NoStep { ends }));
     }
     let (mut lo, mut hi) = (0, path.len() - 1);
@@ -245,10 +298,10 @@ pub fn bisect(
                 continue;
             }
         };
-        use Verdict::{Improved, Regressed, Unchanged};
-        match (left.verdict, right.verdict) {
-            (Improved, _) | (_, Improved) => {
-                let against = if left.verdict == Improved {
+        use Way::{Back, Level, TowardBad};
+        match (dir.way(left.verdict), dir.way(right.verdict)) {
+            (Back, _) | (_, Back) => {
+                let against = if dir.way(left.verdict) == Back {
                     left
                 } else {
                     right
@@ -259,11 +312,11 @@ pub fn bisect(
                 };
                 return Ok(run.finish(path, finding));
             }
-            (Unchanged, Regressed) => lo = mid,
-            (Regressed, Unchanged) => hi = mid,
-            (Regressed, Regressed) => {
+            (Level, TowardBad) => lo = mid,
+            (TowardBad, Level) => hi = mid,
+            (TowardBad, TowardBad) => {
                 // Two steps: follow the larger, keep the other in the answer.
-                if left.ratio >= right.ratio {
+                if left.ratio.ln().abs() >= right.ratio.ln().abs() {
                     run.also.push(right);
                     hi = mid;
                 } else {
@@ -271,7 +324,7 @@ pub fn bisect(
                     lo = mid;
                 }
             }
-            (Unchanged, Unchanged) => {
+            (Level, Level) => {
                 // Twice the rounds could not tell either: the nearer end decides.
                 if left.ratio.ln().abs() <= right.ratio.ln().abs() {
                     lo = mid;
@@ -283,7 +336,7 @@ pub fn bisect(
     }
     let step = run.compare(&path[lo], &path[hi], settings.rounds)?;
     let between: Vec<String> = (lo + 1..hi).map(|i| path[i].clone()).collect();
-    let finding = if step.verdict != Verdict::Regressed {
+    let finding = if dir.way(step.verdict) != Way::TowardBad {
         Finding::Spread { step }
     } else if between.is_empty() {
         Finding::Named {
@@ -326,6 +379,7 @@ impl Run<'_> {
         Bisection {
             good: path[0].clone(),
             bad: path[path.len() - 1].clone(),
+            direction: self.settings.direction,
             commits: path.len() - 1,
             finding,
             builds: self.builds,

@@ -59,6 +59,7 @@ impl Probe for Made {
 
 fn settings() -> Settings {
     Settings {
+        direction: Direction::Slower,
         threshold: crate::gate::AB_THRESHOLD,
         rounds: 4,
         seed: 7,
@@ -192,4 +193,23 @@ fn the_next_midpoint_avoids_failed_commits() {
     assert_eq!(midpoint(0, 16, &failed), Some(7));
     let failed: BTreeSet<usize> = [1, 2].into();
     assert_eq!(midpoint(0, 3, &failed), None);
+}
+
+#[test]
+fn a_speedup_is_named_when_looking_for_one_and_is_no_step_otherwise() {
+    let cost = step(17, 6, 0.80);
+    let path = Made::new(cost.clone(), 8).path();
+    let faster = Settings {
+        direction: Direction::Faster,
+        ..settings()
+    };
+    let found = bisect(&path, &mut Made::new(cost.clone(), 8), faster, &mut |_| {}).unwrap();
+    assert!(
+        matches!(&found.finding, Finding::Named { culprit, .. } if culprit == "c6"),
+        "{:?}",
+        found.finding
+    );
+    assert_eq!(found.direction, Direction::Faster);
+    let found = bisect(&path, &mut Made::new(cost, 8), settings(), &mut |_| {}).unwrap();
+    assert!(matches!(found.finding, Finding::NoStep { .. }));
 }
