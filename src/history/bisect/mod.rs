@@ -419,7 +419,7 @@ impl Run<'_> {
         let mut left = self.compare(lo, mid, rounds)?;
         let mut right = self.compare(mid, hi, rounds)?;
         say(&format!(
-            "  from the fast end {}, to the slow end {}",
+            "  from GOOD's side {}, to BAD's side {}",
             left.size(),
             right.size()
         ));
@@ -428,7 +428,7 @@ impl Run<'_> {
             left = self.compare(lo, mid, 2 * rounds)?;
             right = self.compare(mid, hi, 2 * rounds)?;
             say(&format!(
-                "  from the fast end {}, to the slow end {}",
+                "  from GOOD's side {}, to BAD's side {}",
                 left.size(),
                 right.size()
             ));
