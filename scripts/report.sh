@@ -16,7 +16,7 @@ cd "$(dirname "$0")/.."
 source scripts/lib/sweep.sh
 
 CONFIGS=(complexity complexity-large strong strong-long-range weak weak-time octree-accuracy
-    vs-lammps vs-lammps-liquid vs-pytreegrav vs-fmm3d
+    vs-lammps vs-lammps-liquid lammps-skin lammps-skin-liquid vs-pytreegrav vs-fmm3d
     seeds seeds-weak seeds-weak-time course-codes)
 mode="${1:-}"
 cargo build --release --quiet
