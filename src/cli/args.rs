@@ -264,9 +264,11 @@ pub struct KernelArgs {
     pub leaf_size: Option<usize>,
     /// Verlet list skin, in the scenario's length unit (verlet and cluster-pair only): pairs
     /// within the cutoff plus the skin are listed, and the list is rebuilt once a particle has
-    /// moved half the skin [default: 0.003, 0.3 sigma].
-    #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
-    pub skin: Option<f64>,
+    /// moved half the skin [default: 0.003, 0.3 sigma]. `auto` (run only): the default and up
+    /// to six times it are timed on this system and these threads first, and the fastest is
+    /// used and reported.
+    #[arg(long, value_parser = parse_skin, allow_hyphen_values = true)]
+    pub skin: Option<SkinArg>,
     /// Threads in the rayon pool for this run, at most 1024 (the environment's
     /// RAYON_NUM_THREADS is not used).
     #[arg(long, default_value_t = 1, value_parser = parse_threads)]
@@ -472,6 +474,22 @@ fn parse_float(s: &str) -> Result<f64, String> {
     } else {
         Err("must be finite".into())
     }
+}
+
+/// A Verlet skin: a length, or `auto`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SkinArg {
+    Auto,
+    Length(f64),
+}
+
+fn parse_skin(s: &str) -> Result<SkinArg, String> {
+    if s == "auto" {
+        return Ok(SkinArg::Auto);
+    }
+    parse_positive(s)
+        .map(SkinArg::Length)
+        .map_err(|e| format!("{e}; or `auto`"))
 }
 
 fn parse_positive(s: &str) -> Result<f64, String> {

@@ -25,7 +25,7 @@ mod summary;
 mod sweep;
 mod validate;
 
-use crate::cli::args::{Cli, Command, KernelArgs, StartArgs, SystemArgs};
+use crate::cli::args::{Cli, Command, KernelArgs, SkinArg, StartArgs, SystemArgs};
 use nbody_bench::kernels::{KernelKind, KernelParams};
 use nbody_bench::scenario::{ScenarioKind, Setup};
 
@@ -134,6 +134,14 @@ fn start_setup(
 /// for a scenario without a box), so that nobody believes a setting that changed nothing.
 /// `--leaf-size` sets the leaf size of the kernel run (the octree's or the fmm's, which
 /// default differently), and of both trees when no kernel is named (`validate`).
+/// Refuses `--skin auto` outside `run`, which alone times the candidates.
+fn no_auto_skin(args: &KernelArgs, command: &str) -> anyhow::Result<()> {
+    if args.skin == Some(SkinArg::Auto) {
+        anyhow::bail!("--skin auto is for `run` only; {command} needs a skin length (or none)");
+    }
+    Ok(())
+}
+
 fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Result<KernelParams> {
     if let Some(kernel) =
         kernel.filter(|&k| !matches!(k, KernelKind::Verlet | KernelKind::ClusterPair))
@@ -175,7 +183,11 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
             .leaf_size
             .filter(|_| !fmm_only)
             .unwrap_or(defaults.leaf_size),
-        skin: args.skin.unwrap_or(defaults.skin),
+        skin: match args.skin {
+            Some(SkinArg::Length(skin)) => skin,
+            // `run` times the candidates around the default before it starts.
+            Some(SkinArg::Auto) | None => defaults.skin,
+        },
         multipole: args.multipole.unwrap_or(defaults.multipole),
         order: args.order.unwrap_or(defaults.order),
         fmm_leaf_size: args

@@ -81,6 +81,8 @@ mod with_mpi {
         dump_state: Option<PathBuf>,
         check: bool,
     ) -> Result<MpiSpec, MpiError> {
+        crate::cli::no_auto_skin(kernel_args, "an MPI run")
+            .map_err(|e| MpiError::Usage(e.to_string()))?;
         let params =
             kernel_params(kernel_args, Some(kernel)).map_err(|e| MpiError::Usage(e.to_string()))?;
         Ok(MpiSpec {

@@ -1,7 +1,7 @@
 use super::dry_run::refuse_long_run;
 use super::summary::print_summary;
 use super::{kernel_params, start_setup};
-use crate::cli::args::RunArgs;
+use crate::cli::args::{RunArgs, SkinArg};
 use anyhow::Context;
 use nbody_bench::run::{RunSpec, TrajectorySpec, logical_cpus, run_setup};
 
@@ -16,7 +16,14 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     .filter_map(|(flag, path)| Some((flag, path?)))
     .collect();
     nbody_bench::output::check_outputs(&outputs, &super::initial_input(&args.start))?;
+    let auto_skin = args.kernel_args.skin == Some(SkinArg::Auto);
     if let Some(decomp) = args.decomp {
+        if auto_skin {
+            anyhow::bail!(
+                "--skin auto times candidate skins on one process; with --decomp give the skin \
+                 (find it with `run --skin auto` on the same system first)"
+            );
+        }
         return super::mpi::run(args, decomp);
     }
     let setup = start_setup(args.scenario, &args.system, &args.start)?;
@@ -25,7 +32,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     if !args.yes {
         refuse_long_run(&setup, args.kernel, &args.kernel_args, args.steps as u64)?;
     }
-    let spec = RunSpec {
+    let mut spec = RunSpec {
         kernel: args.kernel,
         params,
         steps: args.steps as u64,
@@ -44,6 +51,9 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
             logical_cpus()
         );
     }
+    if auto_skin {
+        spec.params.skin = choose_skin(&setup, &spec)?;
+    }
     let outcome = run_setup(&setup, &spec)??;
     print_summary(&outcome);
     if let Some(path) = &args.json {
@@ -52,4 +62,33 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
         outln!("result written to {}", path.display());
     }
     Ok(0)
+}
+
+/// `--skin auto`: every candidate skin timed on the run's system and threads, the table on the
+/// error stream, the fastest returned.
+fn choose_skin(setup: &nbody_bench::scenario::Setup, spec: &RunSpec) -> anyhow::Result<f64> {
+    use nbody_bench::experiment::skin::{TRIAL_STEPS, fastest, tune};
+    eprintln!(
+        "--skin auto: timing {} skins, {TRIAL_STEPS} steps each on {} thread(s)",
+        nbody_bench::experiment::skin::SKIN_FACTORS.len(),
+        spec.threads
+    );
+    let trials = tune(setup, spec.kernel, &spec.params, spec.threads, TRIAL_STEPS)?;
+    for t in &trials {
+        eprintln!(
+            "  skin {:<8} {:>8.2} ns per particle-step, {}",
+            t.skin,
+            t.ns_per_particle_step,
+            t.steps_per_rebuild
+                .map_or("no rebuild".to_string(), |s| format!(
+                    "a rebuild every {s:.1} steps"
+                ))
+        );
+    }
+    let best = fastest(&trials).context("no skin could be timed")?;
+    eprintln!(
+        "  chosen: skin {} (recorded in the run's kernel parameters)",
+        best.skin
+    );
+    Ok(best.skin)
 }

@@ -18,6 +18,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
             .collect();
         nbody_bench::output::check_derived("--dump", dump, &paths)?;
     }
+    super::no_auto_skin(&args.kernel_args, "validate")?;
     let params = kernel_params(&args.kernel_args, None)?;
     let mut results: Vec<ScenarioCheck> = Vec::new();
     for &scenario in &scenarios {

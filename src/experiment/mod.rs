@@ -13,6 +13,7 @@ pub mod measure;
 pub mod progress;
 pub mod reference;
 pub mod runner;
+pub mod skin;
 #[cfg(feature = "test-slowdown")]
 pub mod slowdown;
 pub mod slurm;

@@ -43,6 +43,7 @@ mod peers;
 mod publish;
 mod report;
 mod runs;
+mod skin_auto;
 mod slurm;
 mod slurm_stand_ins;
 mod supervision;
