@@ -145,6 +145,9 @@ pub struct SeriesKey {
     /// The fmm's expansion order.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub order: Option<usize>,
+    /// The neighbour-list skin, when the config set one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub skin: Option<f64>,
     pub n: Option<usize>,
     pub threads: Option<usize>,
     pub ranks: Option<usize>,
@@ -164,6 +167,9 @@ impl SeriesKey {
         // "order", not "p=": the case keys' p= is the threads.
         if let Some(p) = self.order {
             s.push_str(&format!(" order {p}"));
+        }
+        if let Some(skin) = self.skin {
+            s.push_str(&format!(" skin {skin}"));
         }
         if let Some(d) = self.decomp {
             s.push_str(&format!(" ({})", d.name()));
@@ -244,6 +250,7 @@ pub fn group(results: &ResultsFile) -> Groups {
         theta: c.theta,
         multipole: r.case.multipole,
         order: r.case.order,
+        skin: r.case.skin,
         n: Some(c.n),
         threads: Some(c.threads),
         ranks: Some(c.ranks),
@@ -425,6 +432,7 @@ mod tests {
             theta: Some(0.5),
             multipole: Multipole::Monopole,
             order: Some(4),
+            skin: None,
             n: None,
             threads: Some(2),
             ranks: Some(1),

@@ -103,6 +103,9 @@ pub(crate) fn case_label(p: &Point) -> String {
     if let Some(order) = p.case.order {
         s.push_str(&format!(" order {order}"));
     }
+    if let Some(skin) = p.case.skin {
+        s.push_str(&format!(" skin {skin}"));
+    }
     s.push_str(&workers_suffix(p.threads, p.ranks));
     s
 }
@@ -296,6 +299,9 @@ fn setting(p: &Point, code: &str) -> String {
     if let Some(order) = p.case.order {
         parts.push(format!("order {order}"));
     }
+    if let Some(skin) = p.case.skin {
+        parts.push(format!("skin {skin}"));
+    }
     parts.join(" ")
 }
 
@@ -382,6 +388,7 @@ mod tests {
             theta: None,
             multipole: Multipole::Monopole,
             order: None,
+            skin: None,
             seed: 1,
             precision: None,
             time_factor: 1,
@@ -530,6 +537,7 @@ mod tests {
                 theta: None,
                 multipole: Multipole::Monopole,
                 order: None,
+                skin: None,
                 n: Some(1000),
                 threads: Some(1),
                 ranks: Some(1),

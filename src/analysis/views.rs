@@ -71,6 +71,7 @@ impl Analysis {
                     && o.theta == c.theta
                     && o.case.multipole == c.case.multipole
                     && o.case.order == c.case.order
+                    && o.case.skin == c.case.skin
                     && o.decomp == c.decomp
             };
             match out.iter().position(same) {

@@ -265,6 +265,10 @@ pub fn refuse_long_run(
                 .order
                 .unwrap_or(nbody_bench::kernels::KernelParams::default().order)
         }),
+        skin: match kernel_args.skin {
+            Some(crate::cli::args::SkinArg::Length(s)) => Some(s),
+            _ => None,
+        },
         seed: setup.seed,
         precision: setup.precision,
         time_factor: 1,

@@ -85,6 +85,7 @@ seeds = [2]
 theta = [0.7]
 multipole = ["monopole"]
 order = [6]
+skin = [0.004]
 precision = "f64"
 initial = "bodies.txt"
 out = "elsewhere"
@@ -160,6 +161,9 @@ fn meaning(key: &str) -> Option<&'static str> {
         "theta" => "opening angles, octree and fmm cases only (the fmm takes those below 1)",
         "multipole" => "expansion orders of the octree's nodes, octree cases only",
         "order" => "expansion orders of the fmm's cells, fmm cases only",
+        "skin" => {
+            "neighbour-list skins in the scenario's length unit, verlet and cluster-pair cases only (left out: each kernel's default, 0.3 sigma of the LJ scenarios; `run --skin auto` finds the fastest)"
+        }
         "precision" => "overrides each scenario's precision (when left out: each scenario's own)",
         "out" => "the results directory",
         "initial" => {

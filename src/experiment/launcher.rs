@@ -107,6 +107,9 @@ pub(crate) fn launch_args(launch: &MpiLaunch, case: &Case, exe: &Path, json: &Pa
     if let Some(p) = case.order {
         a.extend(["--order".to_string(), p.to_string()]);
     }
+    if let Some(s) = case.skin {
+        a.extend(["--skin".to_string(), s.to_string()]);
+    }
     if let Some(p) = case.precision {
         a.extend(["--precision".to_string(), p.name().to_string()]);
     }

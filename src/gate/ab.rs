@@ -403,6 +403,11 @@ fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<S
         Some(theta) => t.insert("theta".into(), list(theta.into())),
         None => t.remove("theta"),
     };
+    // A skin only where the case has one, so that a build older than the key reads the rest.
+    match case.skin {
+        Some(skin) => t.insert("skin".into(), list(skin.into())),
+        None => t.remove("skin"),
+    };
     // The expansion is the octree's alone: another kernel's config does not name it, so that
     // a build older than the key (a backfilled commit) reads the config too.
     if case.kernel == crate::kernels::KernelKind::Octree {

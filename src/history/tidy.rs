@@ -10,7 +10,7 @@ use serde_json::Value;
 
 /// The columns of [`records`] and what each holds; `export-results --help` and
 /// docs/reference/outputs.md list them from here.
-pub const HISTORY_COLUMNS: [(&str, &str); 39] = [
+pub const HISTORY_COLUMNS: [(&str, &str); 40] = [
     ("case", "the case key"),
     ("scenario", "the scenario simulated (from the key)"),
     (
@@ -27,6 +27,10 @@ pub const HISTORY_COLUMNS: [(&str, &str); 39] = [
         "the octree's expansion when not the monopole (else empty)",
     ),
     ("order", "the fmm's expansion order p (else empty)"),
+    (
+        "skin",
+        "the neighbour-list skin when the config set one (else empty)",
+    ),
     (
         "precision",
         "f32 or f64 when the config set it (else empty)",
@@ -155,11 +159,19 @@ fn work_fields(work: Option<&WorkCounters>) -> [Value; 7] {
 
 /// The case's fields from its key (`scenario/kernel/n=../p=../r=../seed=..` and the optional
 /// parts [`crate::records::plan::Case::key`] appends); a part the key lacks is null.
-fn case_fields(key: &str) -> [Value; 13] {
+fn case_fields(key: &str) -> [Value; 14] {
     let mut parts = key.split('/');
     let scenario = Value::from(parts.next());
     let kernel = Value::from(parts.next());
-    let [mut n, mut p, mut r, mut seed, mut theta, mut order] = [(); 6].map(|_| Value::Null);
+    let [
+        mut n,
+        mut p,
+        mut r,
+        mut seed,
+        mut theta,
+        mut order,
+        mut skin,
+    ] = [(); 7].map(|_| Value::Null);
     let [mut multipole, mut precision, mut decomp] = [(); 3].map(|_| Value::Null);
     let mut time_factor = Value::from(1);
     let number = |v: &str| {
@@ -177,6 +189,7 @@ fn case_fields(key: &str) -> [Value; 13] {
                 "seed" => &mut seed,
                 "theta" => &mut theta,
                 "order" => &mut order,
+                "skin" => &mut skin,
                 _ => continue,
             };
             *slot = number(value);
@@ -201,6 +214,7 @@ fn case_fields(key: &str) -> [Value; 13] {
         theta,
         multipole,
         order,
+        skin,
         precision,
         time_factor,
         decomp,

@@ -176,6 +176,10 @@ pub struct SweepConfig {
     /// Expansion orders p of the fmm's cells (fmm cases only).
     #[serde(default = "default_order")]
     pub order: Vec<usize>,
+    /// Neighbour-list skins in the scenario's length unit (verlet and cluster-pair cases only;
+    /// empty: each kernel's default, left out of the case keys).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub skin: Vec<f64>,
     #[serde(default)]
     pub precision: Option<Precision>,
     /// Every case starts from the bodies in this file (`export --format text`, or a body file
@@ -406,6 +410,22 @@ impl SweepConfig {
                     .into(),
             ));
         }
+        if self.skin.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+            return Err(bad("skin", "must list finite lengths above 0".into()));
+        }
+        if !self.skin.is_empty()
+            && !self
+                .kernels
+                .iter()
+                .any(|k| matches!(k, KernelKind::Verlet | KernelKind::ClusterPair))
+        {
+            return Err(bad(
+                "skin",
+                "applies to the verlet and cluster-pair kernels, and the config runs neither: \
+                 remove it, or add one of them to kernels"
+                    .into(),
+            ));
+        }
         let max_order = crate::kernels::MAX_FMM_ORDER;
         if self.order.is_empty() || self.order.iter().any(|p| !(1..=max_order).contains(p)) {
             return Err(bad(
@@ -528,6 +548,7 @@ impl SweepConfig {
             ("theta", twice(&self.theta)),
             ("multipole", twice(&self.multipole)),
             ("order", twice(&self.order)),
+            ("skin", twice(&self.skin)),
             ("mpi.ranks", twice(&ranks)),
             ("mpi.decomp", decomp),
             ("external.name", twice(&names)),

@@ -77,6 +77,7 @@ pub fn allowed(key: &str) -> Option<&'static str> {
             "a list of expansion orders, such as multipole = [\"monopole\", \"quadrupole\"]"
         }
         "order" => "a list of fmm expansion orders from 1 to 8, such as order = [3, 4, 6]",
+        "skin" => "a list of lengths above 0 in the scenario's unit, such as skin = [0.003, 0.012]",
         "precision" => "\"f32\" or \"f64\"",
         "out" => "a directory, as a string, such as out = \"results\"",
         "initial" => {

@@ -25,6 +25,10 @@ pub struct Case {
     /// Expansion order p of the fmm's cells, for the fmm only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub order: Option<usize>,
+    /// Neighbour-list skin, for verlet and cluster-pair when the config names one (else the
+    /// kernel's default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub skin: Option<f64>,
     pub seed: u64,
     pub precision: Option<Precision>,
     /// Simulated-time factor of a weak-by-time study (the run stands for this many times the
@@ -57,6 +61,9 @@ impl Case {
         if let Some(p) = self.order {
             k.push_str(&format!("/order={p}"));
         }
+        if let Some(s) = self.skin {
+            k.push_str(&format!("/skin={s}"));
+        }
         if let Some(p) = self.precision {
             k.push_str(&format!("/{}", p.name()));
         }
@@ -77,6 +84,7 @@ impl Case {
             theta: self.theta.unwrap_or(defaults.theta),
             multipole: self.multipole,
             order: self.order.unwrap_or(defaults.order),
+            skin: self.skin.unwrap_or(defaults.skin),
             ..defaults
         }
     }
@@ -131,6 +139,12 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                     .collect(),
                 _ => vec![(Multipole::Monopole, None)],
             };
+            let skins: Vec<Option<f64>> = match kernel {
+                KernelKind::Verlet | KernelKind::ClusterPair if !config.skin.is_empty() => {
+                    config.skin.iter().map(|&s| Some(s)).collect()
+                }
+                _ => vec![None],
+            };
             // Without MPI one launch of one rank; under a launcher, every rank count with
             // every decomposition that runs this kernel.
             let launches: Vec<(usize, Option<Decomposition>)> = match &config.mpi {
@@ -162,20 +176,23 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                     for &seed in &config.seeds {
                         for &theta in &thetas {
                             for &(multipole, order) in &orders {
-                                out.push(Case {
-                                    scenario,
-                                    kernel: KernelOrProgram::Kernel(kernel),
-                                    n,
-                                    threads,
-                                    ranks,
-                                    theta,
-                                    multipole,
-                                    order,
-                                    seed,
-                                    precision: config.precision,
-                                    time_factor,
-                                    decomp,
-                                });
+                                for &skin in &skins {
+                                    out.push(Case {
+                                        scenario,
+                                        kernel: KernelOrProgram::Kernel(kernel),
+                                        n,
+                                        threads,
+                                        ranks,
+                                        theta,
+                                        multipole,
+                                        order,
+                                        skin,
+                                        seed,
+                                        precision: config.precision,
+                                        time_factor,
+                                        decomp,
+                                    });
+                                }
                             }
                         }
                     }
@@ -247,6 +264,7 @@ fn external_cases(config: &SweepConfig, out: &mut Vec<Case>) {
                                     theta,
                                     multipole: Multipole::Monopole,
                                     order: None,
+                                    skin: None,
                                     seed,
                                     precision: config.precision,
                                     time_factor,
@@ -352,6 +370,47 @@ mod tests {
         assert!(
             keys.contains(&"galaxy/octree/n=100/p=2/r=1/seed=1/theta=0.3/quadrupole".to_string())
         );
+    }
+
+    /// Skins multiply the verlet and cluster-pair cases only; their keys name the skin, and a
+    /// config without the key plans the keys it always did.
+    #[test]
+    fn skin_is_a_dimension_of_the_list_kernels() {
+        let text = r#"
+            name = "t"
+            study = "cartesian"
+            scenarios = ["lj-box"]
+            kernels = ["cell-list", "verlet"]
+            n = [100]
+            skin = [0.003, 0.012]
+        "#;
+        let c = SweepConfig::parse(text, std::path::Path::new("t.toml")).unwrap();
+        let keys: Vec<String> = cases(&c).iter().map(Case::key).collect();
+        assert_eq!(
+            keys,
+            [
+                "lj-box/cell-list/n=100/p=1/r=1/seed=1",
+                "lj-box/verlet/n=100/p=1/r=1/seed=1/skin=0.003",
+                "lj-box/verlet/n=100/p=1/r=1/seed=1/skin=0.012",
+            ]
+        );
+        let verlet = cases(&c)
+            .into_iter()
+            .find(|c| c.skin == Some(0.012))
+            .unwrap();
+        assert_eq!(verlet.kernel_params().skin, 0.012);
+        let without = SweepConfig::parse(
+            &text.replace("skin = [0.003, 0.012]", ""),
+            std::path::Path::new("t.toml"),
+        )
+        .unwrap();
+        assert!(
+            cases(&without)
+                .iter()
+                .all(|c| !c.key().contains("skin") && c.skin.is_none())
+        );
+        let wrong = text.replace(r#"["cell-list", "verlet"]"#, r#"["cell-list"]"#);
+        assert!(SweepConfig::parse(&wrong, std::path::Path::new("t.toml")).is_err());
     }
 
     /// The expansion order multiplies the octree cases only, and only the quadrupole's keys

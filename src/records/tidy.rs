@@ -128,7 +128,7 @@ fn quote(field: &str) -> Cow<'_, str> {
 
 /// The columns of [`samples`] and what each holds; `export-results --help` and
 /// docs/reference/outputs.md list them from here.
-pub const SAMPLE_COLUMNS: [(&str, &str); 30] = [
+pub const SAMPLE_COLUMNS: [(&str, &str); 31] = [
     ("key", "the case key, unique in the file"),
     ("scenario", "the scenario simulated"),
     (
@@ -144,6 +144,10 @@ pub const SAMPLE_COLUMNS: [(&str, &str); 30] = [
         "the octree's expansion order, monopole or quadrupole (else empty)",
     ),
     ("order", "the fmm's expansion order p (else empty)"),
+    (
+        "skin",
+        "the neighbour-list skin when the config set one (else empty: the kernel's default)",
+    ),
     ("seed", "seed of the initial state"),
     (
         "precision",
@@ -228,6 +232,7 @@ pub fn samples(results: &ResultsFile) -> TidyTable {
             Value::from(case.theta),
             Value::from(multipole),
             Value::from(case.order),
+            Value::from(case.skin),
             Value::from(case.seed),
             Value::from(precision.name()),
             Value::from(case.decomp.map(|d| d.name())),

@@ -9,7 +9,7 @@ use std::process::{Command, Output};
 
 /// The columns in their order: a change here is a change every notebook reading the tables
 /// sees.
-const COLUMNS: [&str; 30] = [
+const COLUMNS: [&str; 31] = [
     "key",
     "scenario",
     "kernel",
@@ -19,6 +19,7 @@ const COLUMNS: [&str; 30] = [
     "theta",
     "multipole",
     "order",
+    "skin",
     "seed",
     "precision",
     "decomp",

@@ -26,6 +26,7 @@ fn case() -> Case {
         theta: None,
         multipole: Default::default(),
         order: None,
+        skin: None,
         seed: 3,
         precision: Some(Precision::F64),
         time_factor: 1,

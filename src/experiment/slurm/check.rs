@@ -195,6 +195,7 @@ mod tests {
             theta: None,
             multipole: Default::default(),
             order: None,
+            skin: None,
             seed: 1,
             precision: None,
             time_factor: 1,
