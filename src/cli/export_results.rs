@@ -11,6 +11,13 @@ use std::path::{Path, PathBuf};
 
 pub fn export_results(args: ExportResultsArgs) -> anyhow::Result<i32> {
     let history = history_files(&args.results)?;
+    if history.is_none() && args.results.is_dir() && !args.results.join("results.json").exists() {
+        anyhow::bail!(
+            "{} holds neither a results.json nor a history file (<class>.jsonl): pass a run \
+             directory, a results.json, a history file or the folder of them (results/history)",
+            args.results.display()
+        );
+    }
     let path = match &history {
         Some(_) => args.results.clone(),
         None => locate::find_results(&args.results, Path::new("results"))?,
