@@ -90,12 +90,19 @@ pub fn print_summary(r: &RunOutcome) {
             0 => "no rebuild".to_string(),
             k => format!("{k} rebuilds, one per {:.1} steps", steps / k as f64),
         };
+        let pairs = c.pairs_interacting_final as f64 / entries.max(1.0);
+        // A Verlet list's entry is one pair; a cluster list's is a run of particles against a
+        // cluster, many pairs.
+        let inside = if r.kernel == "verlet" {
+            format!("{:.1}% of the entries", 100.0 * pairs)
+        } else {
+            format!("{pairs:.1} per entry")
+        };
         // The median step is one between rebuilds: the mean carries their cost.
         outln!(
             "neighbour list    {entries:.4e} entries per step, {every} (mean {} per \
-             particle-step); pairs inside the cutoff at the end: {:.1}% of the entries",
+             particle-step); pairs inside the cutoff at the end: {inside}",
             Duration::from_ns(t.per_step_ns.mean / r.n.max(1) as f64),
-            100.0 * c.pairs_interacting_final as f64 / entries.max(1.0)
         );
     }
     outln!(
