@@ -245,20 +245,21 @@ fn changes(o: &mut String, page: &Page) {
     for c in all {
         let s = &c.series;
         for st in &c.steps {
+            let t = StepText::of(s.metric, st);
             let _ = writeln!(
                 o,
                 "<tr><td class=\"key\">{}</td><td>{}</td><td><code>{}..{}</code></td><td>{} → {}</td>\
                  <td class=\"num {}\">{}</td><td class=\"num\">[{}, {}]</td></tr>",
                 esc(&s.case),
                 esc(&s.class),
-                esc(short(&st.between[0])),
-                esc(short(&st.between[1])),
-                esc(&value(s.metric, st.before)),
-                esc(&value(s.metric, st.after)),
-                if st.ratio > 1.0 { "slower" } else { "faster" },
-                percent(st.ratio),
-                percent(st.ratio_ci95[0]),
-                percent(st.ratio_ci95[1]),
+                t.from,
+                t.to,
+                t.before,
+                t.after,
+                t.way,
+                t.size,
+                t.low,
+                t.high,
             );
         }
     }
@@ -318,18 +319,12 @@ fn case(o: &mut String, c: &CaseView) {
         } else {
             o.push_str("<ul class=\"steps\">");
             for st in &ch.steps {
+                let t = StepText::of(s.metric, st);
                 let _ = write!(
                     o,
                     "<li>step between <code>{}</code> and <code>{}</code>: {} → {} \
                      (<span class=\"{}\">{}</span>, 95% interval [{}, {}])</li>",
-                    esc(short(&st.between[0])),
-                    esc(short(&st.between[1])),
-                    esc(&value(s.metric, st.before)),
-                    esc(&value(s.metric, st.after)),
-                    if st.ratio > 1.0 { "slower" } else { "faster" },
-                    percent(st.ratio),
-                    percent(st.ratio_ci95[0]),
-                    percent(st.ratio_ci95[1]),
+                    t.from, t.to, t.before, t.after, t.way, t.size, t.low, t.high,
                 );
             }
             o.push_str("</ul>\n");
@@ -345,4 +340,32 @@ fn case(o: &mut String, c: &CaseView) {
         );
     }
     o.push_str("</div>\n</section>\n");
+}
+
+/// A step's parts as the page writes them (escaped): the commits between which it happened,
+/// the levels, its direction as a CSS class, its size and interval.
+struct StepText {
+    from: String,
+    to: String,
+    before: String,
+    after: String,
+    way: &'static str,
+    size: String,
+    low: String,
+    high: String,
+}
+
+impl StepText {
+    fn of(metric: Metric, st: &crate::history::steps::Step) -> StepText {
+        StepText {
+            from: esc(short(&st.between[0])),
+            to: esc(short(&st.between[1])),
+            before: esc(&value(metric, st.before)),
+            after: esc(&value(metric, st.after)),
+            way: if st.ratio > 1.0 { "slower" } else { "faster" },
+            size: percent(st.ratio),
+            low: percent(st.ratio_ci95[0]),
+            high: percent(st.ratio_ci95[1]),
+        }
+    }
 }
