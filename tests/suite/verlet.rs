@@ -112,10 +112,10 @@ fn liquid_with_walls_at_every_step_on_one_and_split_over_two_threads() {
     let steps = 300;
     run(ScenarioKind::LjLiquid, 2000, steps, 1);
     let ran = run(ScenarioKind::LjLiquid, 2000, steps, 2);
-    // The work estimate splits this list over 2 threads: the parts and their buffers ran.
+    // The work estimate cuts this list into parts: the colours ran on two threads.
     let per_step = ran.entries / steps;
     assert!(
-        parts_for(2, step_work(ran.n, per_step)) > 1,
+        parts_for(ran.n, step_work(ran.n, per_step)) > 1,
         "{per_step} entries"
     );
 }

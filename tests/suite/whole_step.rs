@@ -1,8 +1,9 @@
 //! The whole step on the pool's threads: sizes at which every pass forks (binning, the
 //! re-ordering, kick and drift, walls, the field), and the results those passes must keep.
-//! The cell list gathers each target's force in a fixed order, so a run with it is bitwise the
-//! same at any thread count, re-orderings included; the Verlet list's forces are summed in
-//! per-thread buffers and agree to rounding.
+//! The cell list gathers each target's force in a fixed order; the lists add their parts'
+//! forces in an order fixed by the list (the team step and the rayon passes alike): a run is
+//! bitwise the same at any thread count, re-orderings and rebuilds included. An error in one
+//! worker's block ends the step with that error on every thread count, without a hang.
 
 use nbody_bench::engine::Simulation;
 use nbody_bench::kernels::CompiledKernels;
@@ -30,7 +31,8 @@ fn pool(threads: usize) -> rayon::ThreadPool {
         .unwrap()
 }
 
-/// Positions, velocities and ids (as bits) after `steps` steps of `kernel` on `threads`.
+/// Positions, velocities and ids (as bits) after `steps` steps of `kernel` on `threads`, and
+/// the rebuilds of its list.
 struct Trajectory {
     kernel: KernelKind,
     threads: usize,
@@ -38,11 +40,11 @@ struct Trajectory {
 }
 
 impl SystemJob for Trajectory {
-    type Output = Vec<u64>;
+    type Output = (Vec<u64>, u64);
     fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
         self,
         sys: System<T, L, D>,
-    ) -> Vec<u64> {
+    ) -> (Vec<u64>, u64) {
         let kernel = self
             .kernel
             .build::<T, L, D>(sys.law, &KernelParams::default())
@@ -62,7 +64,7 @@ impl SystemJob for Trajectory {
                         .map(|x| x.as_f64().to_bits()),
                 );
             }
-            bits
+            (bits, sim.work.rebuilds)
         })
     }
 }
@@ -90,6 +92,95 @@ fn a_cell_list_run_is_bitwise_the_same_at_any_thread_count() {
                 "{scenario:?}: the state after 25 steps differs at {threads} threads"
             );
         }
+    }
+}
+
+#[test]
+fn a_list_run_is_bitwise_the_same_on_one_two_and_three_workers() {
+    for kernel in [KernelKind::Verlet, KernelKind::ClusterPair] {
+        for scenario in [ScenarioKind::LjBox, ScenarioKind::LjLiquid] {
+            for precision in [Precision::F32, Precision::F64] {
+                let run = |threads| {
+                    setup(scenario, precision)
+                        .dispatch(Trajectory {
+                            kernel,
+                            threads,
+                            steps: 30,
+                        })
+                        .unwrap()
+                };
+                let (one, rebuilds) = run(1);
+                // Rebuilds (outside the team region) and kept lists (inside it) both ran.
+                assert!(
+                    (2..=20).contains(&rebuilds),
+                    "{kernel:?} {scenario:?}: {rebuilds} rebuilds in 30 steps"
+                );
+                for threads in [2, 3] {
+                    assert!(
+                        run(threads).0 == one,
+                        "{kernel:?} {scenario:?} {precision:?}: the state after 30 steps \
+                         differs at {threads} workers"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// The step's error when one particle, in the last worker's block, is thrown through a wall
+/// at a speed that takes it past the opposite one.
+struct ThrownOut {
+    kernel: KernelKind,
+    threads: usize,
+}
+
+impl SystemJob for ThrownOut {
+    type Output = String;
+    fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
+        self,
+        sys: System<T, L, D>,
+    ) -> String {
+        let kernel = self
+            .kernel
+            .build::<T, L, D>(sys.law, &KernelParams::default())
+            .unwrap();
+        pool(self.threads).install(|| {
+            let mut sim = Simulation::new(sys, kernel);
+            sim.step().unwrap();
+            let last = sim.state.len() - 1;
+            sim.state.vel[0][last] = T::of(1e9);
+            let id = sim.state.id[last];
+            let err = sim.step().expect_err("a particle beyond both walls");
+            format!("{id}: {err}")
+        })
+    }
+}
+
+#[test]
+fn an_error_in_one_block_ends_the_step_on_every_worker() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let mut said = Vec::new();
+        for kernel in [KernelKind::Verlet, KernelKind::ClusterPair] {
+            for threads in [1, 2, 3] {
+                said.push(
+                    setup(ScenarioKind::LjLiquid, Precision::F64)
+                        .dispatch(ThrownOut { kernel, threads })
+                        .unwrap(),
+                );
+            }
+        }
+        let _ = tx.send(said);
+    });
+    let said = rx
+        .recv_timeout(std::time::Duration::from_secs(120))
+        .expect("the step hung after an error in one block");
+    for s in &said {
+        let (id, err) = s.split_once(": ").unwrap();
+        assert!(
+            err.contains("still outside the box") && err.contains(&format!("particle {id} ")),
+            "{s}"
+        );
     }
 }
 

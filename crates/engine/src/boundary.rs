@@ -46,27 +46,56 @@ impl<T: Real, const D: usize> Boundary<T, D> {
         } else {
             n.max(1)
         };
+        let pos = state.pos.each_mut().map(|x| &mut x[..n]);
+        let vel = state.vel.each_mut().map(|v| &mut v[..n]);
+        let (xs, vs) = (chunks_of(pos, c), chunks_of(vel, c));
+        let pass = |(x, v)| self.apply_block(x, v);
+        let found = if xs.len() > 1 {
+            xs.into_par_iter()
+                .zip(vs)
+                .map(pass)
+                .reduce(BlockCheck::empty, BlockCheck::join)
+        } else {
+            xs.into_iter()
+                .zip(vs)
+                .map(pass)
+                .fold(BlockCheck::empty(), BlockCheck::join)
+        };
+        self.conclude(state, step, found)
+    }
+
+    /// The boundary on one block of particles (positions `x`, velocities `v`): what
+    /// [`Boundary::conclude`] needs of it, joined over the blocks with [`BlockCheck::join`].
+    pub(crate) fn apply_block(&self, x: [&mut [T]; D], v: [&mut [T]; D]) -> BlockCheck<T, D> {
+        match *self {
+            Boundary::Reflecting { lo, hi } => BlockCheck {
+                outside: simd::dispatch(
+                    #[inline(always)]
+                    || reflect(x, v, lo, hi),
+                ),
+                extent: Extent::empty(),
+            },
+            Boundary::Open => BlockCheck {
+                outside: [false; D],
+                extent: simd::dispatch(
+                    #[inline(always)]
+                    || extent(x.each_ref().map(|x| &**x)),
+                ),
+            },
+        }
+    }
+
+    /// The bounding box after the boundary, from what every block found, or the first
+    /// particle at fault.
+    pub(crate) fn conclude(
+        &self,
+        state: &State<T, D>,
+        step: u64,
+        found: BlockCheck<T, D>,
+    ) -> Result<Bounds<T, D>, BoundaryError> {
         match *self {
             Boundary::Reflecting { lo, hi } => {
-                let pos = state.pos.each_mut().map(|x| &mut x[..n]);
-                let vel = state.vel.each_mut().map(|v| &mut v[..n]);
-                let pass = |(x, v): ([&mut [T]; D], [&mut [T]; D])| {
-                    simd::dispatch(
-                        #[inline(always)]
-                        || reflect(x, v, lo, hi),
-                    )
-                };
-                let either = |a: [bool; D], b: [bool; D]| std::array::from_fn(|d| a[d] | b[d]);
-                let (xs, vs) = (chunks_of(pos, c), chunks_of(vel, c));
-                let bad = if xs.len() > 1 {
-                    xs.into_par_iter()
-                        .zip(vs)
-                        .map(pass)
-                        .reduce(|| [false; D], either)
-                } else {
-                    xs.into_iter().zip(vs).map(pass).fold([false; D], either)
-                };
-                if let Some(d) = (0..D).find(|&d| bad[d]) {
+                if let Some(d) = (0..D).find(|&d| found.outside[d]) {
                     let (lo, hi) = (lo[d], hi[d]);
                     return Err(first_offender(state, step, d, |x| !(x >= lo && x <= hi)));
                 }
@@ -77,23 +106,7 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                 if state.is_empty() {
                     return Ok(state.bounding_box());
                 }
-                let pos = state.pos.each_ref().map(|x| &x[..n]);
-                let part = |k: usize| {
-                    let r = k * c..((k + 1) * c).min(n);
-                    simd::dispatch(
-                        #[inline(always)]
-                        || extent(pos.each_ref().map(|x| &x[r.clone()])),
-                    )
-                };
-                let chunks = n.div_ceil(c);
-                let (Bounds { lo, hi }, poison) = if chunks > 1 {
-                    (0..chunks)
-                        .into_par_iter()
-                        .map(part)
-                        .reduce(Extent::empty, Extent::join)
-                } else {
-                    part(0)
-                };
+                let (Bounds { lo, hi }, poison) = found.extent;
                 for d in 0..D {
                     if !(lo[d].is_finite() && hi[d].is_finite() && poison[d].is_finite()) {
                         return Err(first_offender(state, step, d, |x| !x.is_finite()));
@@ -102,6 +115,38 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                 Ok(Bounds { lo, hi })
             }
         }
+    }
+}
+
+/// What the boundary found on some blocks of particles: per dimension whether a particle is
+/// still outside a wall after one reflection, and (open space) their extent.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BlockCheck<T, const D: usize> {
+    outside: [bool; D],
+    extent: Extent<T, D>,
+}
+
+impl<T: Real, const D: usize> BlockCheck<T, D> {
+    /// What no block found.
+    pub fn empty() -> Self {
+        BlockCheck {
+            outside: [false; D],
+            extent: Extent::empty(),
+        }
+    }
+
+    /// What either found.
+    pub fn join(a: Self, b: Self) -> Self {
+        BlockCheck {
+            outside: std::array::from_fn(|d| a.outside[d] | b.outside[d]),
+            extent: Extent::join(a.extent, b.extent),
+        }
+    }
+
+    /// Whether [`Boundary::conclude`] will name a particle at fault: one outside a wall, or a
+    /// coordinate that is not finite.
+    pub fn fails(&self) -> bool {
+        self.outside.iter().any(|&o| o) || self.extent.1.iter().any(|p| !p.is_finite())
     }
 }
 

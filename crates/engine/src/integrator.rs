@@ -22,9 +22,10 @@ pub fn kick<T: Real, const D: usize>(
     let mass = &state.mass[..n];
     let vel = state.vel.each_mut().map(|v| &mut v[..n]);
     let pass = |offset: usize, v: [&mut [T]; D]| {
+        let f = forces.each_ref().map(|f| &f[offset..offset + v[0].len()]);
         simd::dispatch(
             #[inline(always)]
-            || kick_chunk(v, forces, &mass[offset..], external, half_dt, offset),
+            || kick_chunk(v, f, &mass[offset..], external, half_dt),
         )
     };
     if worth_forking(n * D) {
@@ -51,21 +52,8 @@ pub fn kick_drift<T: Real, const D: usize>(
     let vel = state.vel.each_mut().map(|v| &mut v[..n]);
     let pos = state.pos.each_mut().map(|x| &mut x[..n]);
     let pass = |offset: usize, v: [&mut [T]; D], x: [&mut [T]; D]| {
-        simd::dispatch(
-            #[inline(always)]
-            || {
-                let mut v = v;
-                kick_chunk(
-                    v.each_mut().map(|v| &mut **v),
-                    forces,
-                    &mass[offset..],
-                    external,
-                    half_dt,
-                    offset,
-                );
-                drift_chunk(x, v.each_ref().map(|v| &**v), dt);
-            },
-        )
+        let f = forces.each_ref().map(|f| &f[offset..offset + v[0].len()]);
+        kick_drift_block(x, v, f, &mass[offset..], external, half_dt, dt);
     };
     if worth_forking(n * D) {
         let c = pass_chunk(n);
@@ -79,6 +67,41 @@ pub fn kick_drift<T: Real, const D: usize>(
     }
 }
 
+/// The fused half kick and drift of one block of particles: `x`, `v`, `f` its positions,
+/// velocities and forces, `mass` starting with its masses.
+pub(crate) fn kick_drift_block<T: Real, const D: usize>(
+    x: [&mut [T]; D],
+    v: [&mut [T]; D],
+    f: [&[T]; D],
+    mass: &[T],
+    external: [T; D],
+    half_dt: T,
+    dt: T,
+) {
+    simd::dispatch(
+        #[inline(always)]
+        || {
+            let mut v = v;
+            kick_chunk(v.each_mut().map(|v| &mut **v), f, mass, external, half_dt);
+            drift_chunk(x, v.each_ref().map(|v| &**v), dt);
+        },
+    )
+}
+
+/// The half kick of one block of particles (see [`kick_drift_block`]).
+pub(crate) fn kick_block<T: Real, const D: usize>(
+    v: [&mut [T]; D],
+    f: [&[T]; D],
+    mass: &[T],
+    external: [T; D],
+    half_dt: T,
+) {
+    simd::dispatch(
+        #[inline(always)]
+        || kick_chunk(v, f, mass, external, half_dt),
+    )
+}
+
 /// Drift: `x += v·dt` (the fused pass's reference in tests).
 #[cfg(test)]
 fn drift<T: Real, const D: usize>(state: &mut State<T, D>, dt: T) {
@@ -86,18 +109,18 @@ fn drift<T: Real, const D: usize>(state: &mut State<T, D>, dt: T) {
     drift_chunk(state.pos.each_mut().map(|x| x.as_mut_slice()), vel, dt);
 }
 
-/// The kick of the particles `offset..offset + v[0].len()`.
+/// The kick of a block of particles: `v`, `f` their velocities and forces, `mass` starting
+/// with their masses.
 #[inline(always)]
 fn kick_chunk<T: Real, const D: usize>(
     v: [&mut [T]; D],
-    forces: &Field<T, D>,
+    f: [&[T]; D],
     mass: &[T],
     external: [T; D],
     half_dt: T,
-    offset: usize,
 ) {
     for (d, v) in v.into_iter().enumerate() {
-        let (g, f) = (external[d], &forces[d][offset..offset + v.len()]);
+        let (g, f) = (external[d], &f[d][..v.len()]);
         for ((v, &f), &m) in v.iter_mut().zip(f).zip(mass) {
             *v += (f / m + g) * half_dt;
         }

@@ -21,6 +21,7 @@ pub mod repeated;
 pub mod rows;
 mod share;
 mod symmetric;
+pub mod teamed;
 pub mod verlet;
 
 pub use cell_list::CellList;
@@ -33,6 +34,7 @@ pub use octree::{Multipole, Octree, TreeView};
 pub use per_thread::PerThread;
 pub use share::Share;
 pub use symmetric::Symmetric;
+pub use teamed::{StateView, TeamPlan};
 pub use verlet::Verlet;
 
 use crate::physics::{LawKind, PairLaw};
@@ -462,6 +464,13 @@ pub trait ForceKernel<T: Real, const D: usize>: Send {
     /// step and answers `None` in between.
     fn sort_every(&self) -> u64 {
         SORT_EVERY
+    }
+
+    /// The kernel's step as the phases of a team region ([`teamed`]), when its structure
+    /// (a list) exists for `n` particles; `None` when it does not or the kernel has no such
+    /// plan, and the engine calls [`ForceKernel::compute`] instead.
+    fn team_plan(&mut self, _n: usize) -> Option<Box<dyn TeamPlan<T, D> + '_>> {
+        None
     }
 
     /// The forces on the particles in slots `targets` only, from every particle of `state`:

@@ -122,35 +122,3 @@ pub(crate) fn chunks_of<T, const D: usize>(parts: [&mut [T]; D], len: usize) -> 
 pub(crate) fn pass_chunk(n: usize) -> usize {
     chunk_len(n).max(4096)
 }
-
-/// Overwrites `out` with the sum of `buffers`, buffer `k` holding the values of the slots
-/// `spans[k]` (from `spans[k].start`): the reduction of force buffers that each cover a part
-/// of the slots, on the pool's threads over chunks of slots.
-pub(crate) fn sum_spans<T: crate::real::Real, const D: usize>(
-    out: [&mut [T]; D],
-    spans: &[std::ops::Range<usize>],
-    buffers: &[[Vec<T>; D]],
-) {
-    let len = out[0].len();
-    for_chunks(out, 0, chunk_len(len).max(4096), &|offset, chunk| {
-        let here = offset..offset + chunk[0].len();
-        for d in 0..D {
-            chunk[d].fill(T::zero());
-        }
-        for (span, buf) in spans.iter().zip(buffers) {
-            let (lo, hi) = (here.start.max(span.start), here.end.min(span.end));
-            if lo >= hi {
-                continue;
-            }
-            for d in 0..D {
-                let dst = &mut chunk[d][lo - offset..hi - offset];
-                for (x, y) in dst
-                    .iter_mut()
-                    .zip(&buf[d][lo - span.start..hi - span.start])
-                {
-                    *x += *y;
-                }
-            }
-        }
-    });
-}

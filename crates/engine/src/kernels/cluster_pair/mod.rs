@@ -14,8 +14,10 @@
 //!
 //! - Half list: each cluster pair once (j at or after i), both ends updated; within the
 //!   cluster itself only the pairs `j > i` act (lane masks, see [`list`]).
-//! - On several threads each part of the list (a range of i-clusters, several per thread)
-//!   adds into a buffer over the clusters it touches, and the buffers are summed.
+//! - A long list is cut into parts (ranges of i-clusters, as many whatever the threads) of
+//!   two colours whose runs touch disjoint clusters ([`crate::kernels::teamed`]): the threads
+//!   run one colour's parts at a time, adding straight into the forces, and every thread count
+//!   adds the same contributions in the same order.
 //! - At a rebuild the particles are re-sorted into cluster order ([`ForceKernel::sort_every`]
 //!   is 1, [`ForceKernel::spatial_order`] answers exactly when a rebuild is due), so the copy of
 //!   the positions into the padded slots reads the state in order.
@@ -30,9 +32,11 @@ mod list;
 mod tests;
 mod tile;
 
+use super::teamed::{Colors, StateView, TeamPlan};
 use super::verlet::{list_cutoff, moved_too_far};
-use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters, worth_parallel};
-use crate::par::{gather, sum_spans};
+use super::{ForceKernel, ForceReport, KernelError, KernelKind, MIN_PARALLEL_PAIRS, WorkCounters};
+use crate::par::gather;
+use crate::par::team::{SharedSlice, Worker, shared};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -42,6 +46,7 @@ use layout::CLUSTER;
 use layout::Layout;
 use list::Part;
 use rayon::prelude::*;
+use std::ops::Range;
 use std::time::Instant;
 use tile::{Clusters, TileSum, part_forces};
 
@@ -49,8 +54,11 @@ use tile::{Clusters, TileSum, part_forces};
 /// the build and pairs rounded in `T` at every step.
 const LIST_MARGIN: f64 = 1e-5;
 
-/// Parts per thread of a split list, so that work stealing evens out parts of unequal density.
-const PARTS_PER_THREAD: usize = 4;
+/// Most parts of a split list, and fewest i-clusters in one: enough parts that the workers
+/// of a colour even out parts of unequal density, wide enough that a part's runs reach no
+/// further than the next part's clusters (the colouring of [`crate::kernels::teamed`]).
+const PARTS: usize = 16;
+const MIN_PART_CLUSTERS: usize = 128;
 
 /// Cost of one run (`CLUSTER × LANES` pair evaluations and the reactions) in naive pair
 /// evaluations, the unit of `worth_parallel`.
@@ -70,9 +78,10 @@ pub struct ClusterPair<L, T, const D: usize> {
     handed_out: bool,
     /// Each state slot's position at the last build.
     at_build: [Vec<T>; D],
-    /// Forces per padded slot, and the buffers of the parallel parts.
+    /// Forces per padded slot.
     force: [Vec<T>; D],
-    buffers: Vec<[Vec<T>; D]>,
+    /// The colours of the parts.
+    colors: Colors,
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
@@ -90,7 +99,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
             handed_out: false,
             at_build: std::array::from_fn(|_| Vec::new()),
             force: std::array::from_fn(|_| Vec::new()),
-            buffers: Vec::new(),
+            colors: Colors::default(),
         })
     }
 
@@ -133,8 +142,9 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
             4 * m as u64
         };
         let work = runs * RUN_COST + state.len() as u64;
-        let count = if worth_parallel(work) {
-            PARTS_PER_THREAD * rayon::current_num_threads()
+        // Never a function of the threads: the parts fix the order in which forces are added.
+        let count = if work >= MIN_PARALLEL_PAIRS {
+            (m / MIN_PART_CLUSTERS).clamp(1, PARTS)
         } else {
             1
         };
@@ -149,6 +159,11 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         } else {
             build((0, &mut self.parts[0]))
         };
+        self.colors = Colors::of(
+            self.parts
+                .iter()
+                .map(|p| p.clusters.start * CLUSTER..p.end * CLUSTER),
+        );
         for d in 0..D {
             self.at_build[d].clear();
             self.at_build[d].extend_from_slice(&state.pos[d]);
@@ -168,7 +183,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         let mut out = force.each_mut().map(|f| f.as_mut_slice());
         let (law, clusters) = (&self.law, Clusters::of(&self.layout));
         let mut sum = TileSum::default();
-        for part in &self.parts {
+        for k in self.colors.order() {
+            let part = &self.parts[k];
             // Probe steps are not timed: their loop is compiled once, for the baseline
             // instruction set, rather than once per set (less to compile).
             let s = if PROBE {
@@ -186,38 +202,148 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         sum
     }
 
-    /// The forces per padded slot, each part adding into its own buffer on the pool's threads,
-    /// then the buffers summed.
+    /// The forces per padded slot, one colour at a time, its parts on the pool's threads: the
+    /// serial loop's additions in the serial loop's order.
     fn parallel(&mut self) {
-        self.buffers
-            .resize_with(self.parts.len(), || std::array::from_fn(|_| Vec::new()));
-        let (law, clusters) = (&self.law, Clusters::of(&self.layout));
-        self.parts
-            .par_iter()
-            .zip(self.buffers.par_iter_mut())
-            .for_each(|(part, buf)| {
-                let base = part.clusters.start * CLUSTER;
-                for b in buf.iter_mut() {
-                    b.clear();
-                    b.resize(part.end * CLUSTER - base, T::zero());
-                }
-                let mut out = buf.each_mut().map(|b| b.as_mut_slice());
-                simd::dispatch(
-                    #[inline(always)]
-                    || part_forces::<T, L, D, false>(law, &clusters, part, &mut out, base),
-                );
-            });
         let slots = self.layout.clusters() * CLUSTER;
         for f in self.force.iter_mut() {
+            f.clear();
             f.resize(slots, T::zero());
         }
-        let spans: Vec<_> = self
-            .parts
-            .iter()
-            .map(|p| p.clusters.start * CLUSTER..p.end * CLUSTER)
-            .collect();
-        let out = self.force.each_mut().map(|f| &mut f[..slots]);
-        sum_spans(out, &spans, &self.buffers);
+        let (law, clusters) = (&self.law, Clusters::of(&self.layout));
+        let out = SharedSlice::each(self.force.each_mut().map(|f| f.as_mut_slice()));
+        for c in 0..2 {
+            let parts: Vec<usize> = self.colors.of_color(c).collect();
+            parts.par_iter().for_each(|&k| {
+                // SAFETY: the parts of one colour touch disjoint slots (the caller checked
+                // `colors.disjoint()`), and nothing else uses `out` until the colour is done.
+                unsafe { add_part(law, &clusters, &self.parts[k], &out) }
+            });
+        }
+    }
+}
+
+/// Adds the forces of `part` to the padded slots of `out` its runs touch.
+///
+/// # Safety
+/// No other thread touches those slots of `out` meanwhile.
+unsafe fn add_part<T: Real, L: PairLaw<T>, const D: usize>(
+    law: &L,
+    clusters: &Clusters<'_, T, D>,
+    part: &Part,
+    out: &[SharedSlice<'_, T>; D],
+) {
+    let span = part.clusters.start * CLUSTER..part.end * CLUSTER;
+    let base = span.start;
+    // SAFETY: the caller's promise.
+    let mut out = unsafe { shared::ranges_mut(out, span) };
+    simd::dispatch(
+        #[inline(always)]
+        || part_forces::<T, L, D, false>(law, clusters, part, &mut out, base),
+    );
+}
+
+/// The cluster list's step in a team region: the displacement test on each worker's block,
+/// the padded copy and forces by blocks of padded slots, the parts colour by colour, the
+/// forces gathered back by blocks of state slots.
+struct Plan<'k, L, T, const D: usize> {
+    law: &'k L,
+    parts: &'k [Part],
+    colors: &'k Colors,
+    at_build: [&'k [T]; D],
+    limit: f64,
+    runs: u64,
+    slot_of: &'k [u32],
+    padded_of: &'k [u32],
+    pos: [SharedSlice<'k, T>; D],
+    src: SharedSlice<'k, T>,
+    force: [SharedSlice<'k, T>; D],
+}
+
+impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
+    fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
+        let then = self.at_build.map(|x| &x[block.clone()]);
+        !simd::dispatch(
+            #[inline(always)]
+            || super::verlet::moved_beyond(pos, then, self.limit),
+        )
+    }
+
+    fn colors(&self) -> &Colors {
+        self.colors
+    }
+
+    unsafe fn prepare(
+        &self,
+        worker: &Worker,
+        state: StateView<'_, T, D>,
+        _forces: &[SharedSlice<'_, T>; D],
+    ) {
+        let block = worker.block(self.slot_of.len());
+        let from = &self.slot_of[block.clone()];
+        // SAFETY: each worker writes its own block of padded slots, and nobody reads them
+        // before the next barrier (the caller's promise for this phase).
+        let (pos, src, force) = unsafe {
+            (
+                shared::ranges_mut(&self.pos, block.clone()),
+                self.src.range_mut(block.clone()),
+                shared::ranges_mut(&self.force, block),
+            )
+        };
+        for (d, x) in pos.into_iter().enumerate() {
+            for (x, &i) in x.iter_mut().zip(from) {
+                *x = state.pos[d][i as usize];
+            }
+        }
+        for (s, &i) in src.iter_mut().zip(from) {
+            *s = state.source[i as usize];
+        }
+        for f in force {
+            f.fill(T::zero());
+        }
+    }
+
+    unsafe fn interact(
+        &self,
+        part: usize,
+        _state: StateView<'_, T, D>,
+        _forces: &[SharedSlice<'_, T>; D],
+    ) {
+        // SAFETY: the padded copy is written only before the previous barrier; no other part
+        // running now touches this part's slots (the caller's promise).
+        unsafe {
+            let clusters = Clusters {
+                pos: shared::wholes(&self.pos),
+                src: self.src.whole(),
+            };
+            add_part(self.law, &clusters, &self.parts[part], &self.force);
+        }
+    }
+
+    unsafe fn finish(&self, worker: &Worker, forces: &[SharedSlice<'_, T>; D]) {
+        let block = worker.block(self.padded_of.len());
+        let from = &self.padded_of[block.clone()];
+        // SAFETY: the padded forces are final (every part ran before the last barrier); each
+        // worker writes its own block of the output.
+        let (force, out) = unsafe {
+            (
+                shared::wholes(&self.force),
+                shared::ranges_mut(forces, block),
+            )
+        };
+        for (d, out) in out.into_iter().enumerate() {
+            for (o, &k) in out.iter_mut().zip(from) {
+                *o = force[d][k as usize];
+            }
+        }
+    }
+
+    fn work(&self) -> WorkCounters {
+        WorkCounters {
+            pair_checks: self.runs * RUN_COST,
+            list_entries: self.runs,
+            ..Default::default()
+        }
     }
 }
 
@@ -243,7 +369,10 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
         let compared = self.refresh(state);
         let build_s = clock.elapsed().as_secs_f64();
         let runs = self.runs();
-        let parallel = !probe && self.parts.len() > 1 && rayon::current_num_threads() > 1;
+        let parallel = !probe
+            && self.parts.len() > 1
+            && self.colors.disjoint()
+            && rayon::current_num_threads() > 1;
         let sum = if parallel {
             self.parallel();
             TileSum::default()
@@ -281,5 +410,33 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
 
     fn sort_every(&self) -> u64 {
         1
+    }
+
+    fn team_plan(&mut self, n: usize) -> Option<Box<dyn TeamPlan<T, D> + '_>> {
+        if !self.built || self.handed_out || self.at_build[0].len() != n {
+            return None;
+        }
+        let slots = self.layout.clusters() * CLUSTER;
+        if self.layout.slot_of.len() != slots || self.layout.pos[0].len() != slots {
+            return None;
+        }
+        for f in self.force.iter_mut() {
+            f.resize(slots, T::zero());
+        }
+        let runs = self.runs();
+        let layout = &mut self.layout;
+        Some(Box::new(Plan {
+            law: &self.law,
+            parts: &self.parts,
+            colors: &self.colors,
+            at_build: self.at_build.each_ref().map(|x| x.as_slice()),
+            limit: 0.25 * self.skin * self.skin,
+            runs,
+            slot_of: &layout.slot_of,
+            padded_of: &layout.padded_of,
+            pos: SharedSlice::each(layout.pos.each_mut().map(|x| x.as_mut_slice())),
+            src: SharedSlice::new(&mut layout.src),
+            force: SharedSlice::each(self.force.each_mut().map(|f| f.as_mut_slice())),
+        }))
     }
 }

@@ -126,8 +126,8 @@ fn one_dimension_and_lines() {
     agrees_with(&mut kernel, &s, law);
 }
 
-/// A list long enough to be split over threads at 2 threads; the parts hold the runs of the
-/// list in one part.
+/// A list long enough to be cut into parts: the same parts, runs and force bits on one
+/// thread and on two.
 #[test]
 fn split_over_threads() {
     let law = lj::<f32>(2.5 * SIGMA);
@@ -138,13 +138,17 @@ fn split_over_threads() {
     let mut f = zero_field::<f32, 2>(n);
     serial.compute(&state, &mut f, false);
     let mut split = ClusterPair::<_, f32, 2>::new(law, SKIN).unwrap();
+    let mut g = zero_field::<f32, 2>(n);
     on_threads(2, || {
-        split.compute(&state, &mut f, false);
+        split.compute(&state, &mut g, false);
         split.built = false;
-        split.compute(&state, &mut f, false)
+        split.compute(&state, &mut g, false)
     });
-    assert_eq!(split.parts.len(), 2 * PARTS_PER_THREAD);
+    assert!(split.parts.len() > 1);
+    assert!(split.colors.disjoint());
+    assert_eq!(split.parts.len(), serial.parts.len());
     assert_eq!(split.runs(), serial.runs());
+    assert!(f == g, "the same bits on one thread and on two");
     agrees_with(&mut split, &state, law);
 }
 

@@ -29,14 +29,16 @@ pub(crate) struct Slots<'a, T, const D: usize> {
 impl<'a, T: Real, const D: usize> Slots<'a, T, D> {
     #[inline(always)]
     pub fn of(state: &'a State<T, D>) -> Self {
-        let n = state.len();
-        let mut pos: [&[T]; D] = [&[]; D];
-        for d in 0..D {
-            pos[d] = &state.pos[d][..n];
-        }
+        Slots::new(state.pos.each_ref().map(|x| x.as_slice()), &state.source)
+    }
+
+    /// Slots from their positions and strengths (as many of each).
+    #[inline(always)]
+    pub fn new(pos: [&'a [T]; D], src: &'a [T]) -> Self {
+        let n = src.len();
         Slots {
-            pos,
-            src: &state.source[..n],
+            pos: pos.map(|x| &x[..n]),
+            src,
         }
     }
 

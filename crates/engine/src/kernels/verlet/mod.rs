@@ -4,14 +4,15 @@
 //! within the cutoff plus the skin at the build and is in the list: the forces are exact at
 //! every step, not approximately so.
 //!
-//! - The list is a half list (each pair once) evaluated with Newton's third law. On one thread
-//!   the forces go straight into the output. On several, each part of the list (a range of
-//!   rows, four per thread) scatters into a buffer over the slots it touches, and the buffers
-//!   are added up; after a re-sort the parts are bands of space, so a buffer covers little
-//!   more than its own rows. Measured against a full list (every pair from both ends, gathered
-//!   without reactions or buffers) at 2 threads, n = 1e5, mean step of `run` on the 2-vCPU AMD
-//!   EPYC under load: 20–26 against 54–64 ns per particle-step on the gas, 79–124 against
-//!   139–220 on the liquid; the full list pays twice the entries in every step and rebuild.
+//! - The list is a half list (each pair once) evaluated with Newton's third law, its forces
+//!   added straight into the output. A long list is cut into parts (bands of rows, as many
+//!   whatever the threads) of two colours whose pairs touch disjoint slots
+//!   ([`crate::kernels::teamed`]): the threads run one colour's parts at a time, and every
+//!   thread count adds the same contributions in the same order. Measured against a full list
+//!   (every pair from both ends, gathered without reactions) at 2 threads, n = 1e5, mean step
+//!   of `run` on the 2-vCPU AMD EPYC under load: 20–26 against 54–64 ns per particle-step on
+//!   the gas, 79–124 against 139–220 on the liquid; the full list pays twice the entries in
+//!   every step and rebuild.
 //! - At a rebuild the particles are re-sorted by bin: [`ForceKernel::sort_every`] is 1, and
 //!   [`ForceKernel::spatial_order`] answers with the bin order exactly when a rebuild is due,
 //!   so the engine permutes the state right before the list is rebuilt (and the bins of that
@@ -34,8 +35,10 @@ mod loops;
 mod tests;
 mod work;
 
+use super::teamed::{Colors, StateView, TeamPlan};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters};
-use crate::par::{pass_chunk, sum_spans, worth_forking};
+use crate::par::team::{SharedSlice, Worker, shared};
+use crate::par::{pass_chunk, worth_forking};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
@@ -46,6 +49,7 @@ use loops::Slots;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
+pub(crate) use work::moved_beyond;
 pub use work::{parts_for, step_work};
 
 /// Relative margin of the list radius: pair distances are rounded in `T` at every step and
@@ -67,8 +71,8 @@ pub struct Verlet<L, T, const D: usize> {
     at_build: [Vec<T>; D],
     /// `spatial_order` handed out the order of `bins`: the next build starts from it.
     handed_out: bool,
-    /// Force buffers of the parallel half list, one per part, each over its part's span.
-    buffers: Vec<Field<T, D>>,
+    /// The colours of the half list's parts.
+    colors: Colors,
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
@@ -85,7 +89,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             cover: None,
             at_build: std::array::from_fn(|_| Vec::new()),
             handed_out: false,
-            buffers: Vec::new(),
+            colors: Colors::default(),
         })
     }
 
@@ -130,7 +134,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         } else {
             work::expected_entries(&self.bins, &cover)
         };
-        let count = parts_for(rayon::current_num_threads(), step_work(rows, entries));
+        let count = parts_for(rows, step_work(rows, entries));
         self.parts.resize_with(count, Part::default);
         let (bins, radius2) = (&self.bins, self.radius2);
         let build = |(k, part): (usize, &mut Part)| {
@@ -152,6 +156,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             build((0, &mut self.parts[0]))
         };
         work.rebuilds = 1;
+        self.colors = Colors::of(self.parts.iter().map(|p| p.span.clone()));
         for d in 0..D {
             self.at_build[d].clear();
             self.at_build[d].extend_from_slice(&state.pos[d]);
@@ -160,7 +165,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         work
     }
 
-    /// Adds the forces of the half list to `forces` (zeroed), on one thread.
+    /// Adds the forces of the half list to `forces` (zeroed), on one thread, part by part in
+    /// the colours' order.
     fn serial<const PROBE: bool>(
         &self,
         state: &State<T, D>,
@@ -169,7 +175,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         let (law, slots) = (&self.law, Slots::of(state));
         let mut out = forces.each_mut().map(|f| f.as_mut_slice());
         let (mut energy, mut interacting) = (0.0, 0);
-        for part in &self.parts {
+        for k in self.colors.order() {
+            let part = &self.parts[k];
             let sum = simd::dispatch(
                 #[inline(always)]
                 || loops::half_pairs::<T, L, D, PROBE>(law, &slots, part, &mut out, 0),
@@ -180,30 +187,95 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         (energy, interacting)
     }
 
-    /// Overwrites `forces` with the forces of the half list, each part scattering into its own
-    /// buffer on the pool's threads, then the buffers summed over the slots.
-    fn parallel(&mut self, state: &State<T, D>, forces: &mut Field<T, D>) {
-        let (law, slots) = (&self.law, Slots::of(state));
-        self.buffers
-            .resize_with(self.parts.len(), || std::array::from_fn(|_| Vec::new()));
-        self.parts
-            .par_iter()
-            .zip(self.buffers.par_iter_mut())
-            .for_each(|(part, buf)| {
-                for b in buf.iter_mut() {
-                    b.clear();
-                    b.resize(part.span.len(), T::zero());
-                }
-                let mut out = buf.each_mut().map(|b| b.as_mut_slice());
-                let base = part.span.start;
-                simd::dispatch(
-                    #[inline(always)]
-                    || loops::half_pairs::<T, L, D, false>(law, &slots, part, &mut out, base),
-                );
+    /// Adds the forces of the half list to `forces` (zeroed), one colour at a time, its parts
+    /// on the pool's threads: the serial loop's additions in the serial loop's order.
+    fn parallel(&self, state: &State<T, D>, forces: &mut Field<T, D>) {
+        let plan = self.plan();
+        let view = StateView {
+            pos: state.pos.each_ref().map(|x| x.as_slice()),
+            source: &state.source,
+        };
+        let out = SharedSlice::each(forces.each_mut().map(|f| f.as_mut_slice()));
+        for c in 0..2 {
+            let parts: Vec<usize> = self.colors.of_color(c).collect();
+            parts.par_iter().for_each(|&k| {
+                // SAFETY: the parts of one colour touch disjoint slots (the caller checked
+                // `colors.disjoint()`), and nothing else uses `out` until the colour is done.
+                unsafe { plan.interact(k, view, &out) }
             });
-        let spans: Vec<_> = self.parts.iter().map(|p| p.span.clone()).collect();
-        let out = forces.each_mut().map(|f| f.as_mut_slice());
-        sum_spans(out, &spans, &self.buffers);
+        }
+    }
+
+    fn plan(&self) -> Plan<'_, L, T, D> {
+        Plan {
+            law: &self.law,
+            parts: &self.parts,
+            colors: &self.colors,
+            at_build: self.at_build.each_ref().map(|x| x.as_slice()),
+            limit: 0.25 * self.skin * self.skin,
+            entries: self.entries(),
+        }
+    }
+}
+
+/// The half list's step in a team region: the displacement test on each worker's block, the
+/// forces zeroed by blocks, the parts colour by colour.
+struct Plan<'k, L, T, const D: usize> {
+    law: &'k L,
+    parts: &'k [Part],
+    colors: &'k Colors,
+    at_build: [&'k [T]; D],
+    limit: f64,
+    entries: u64,
+}
+
+impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
+    fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
+        let then = self.at_build.map(|x| &x[block.clone()]);
+        !simd::dispatch(
+            #[inline(always)]
+            || work::moved_beyond(pos, then, self.limit),
+        )
+    }
+
+    fn colors(&self) -> &Colors {
+        self.colors
+    }
+
+    unsafe fn prepare(
+        &self,
+        worker: &Worker,
+        _state: StateView<'_, T, D>,
+        forces: &[SharedSlice<'_, T>; D],
+    ) {
+        // SAFETY: each worker zeroes its own block (the caller's promise on `forces`).
+        let out = unsafe { shared::ranges_mut(forces, worker.block(forces[0].len())) };
+        for f in out {
+            f.fill(T::zero());
+        }
+    }
+
+    unsafe fn interact(
+        &self,
+        part: usize,
+        state: StateView<'_, T, D>,
+        forces: &[SharedSlice<'_, T>; D],
+    ) {
+        let part = &self.parts[part];
+        let slots = Slots::new(state.pos, state.source);
+        // SAFETY: no other part running now touches the part's span (the caller's promise).
+        let mut out = unsafe { shared::ranges_mut(forces, part.span.clone()) };
+        let base = part.span.start;
+        simd::dispatch(
+            #[inline(always)]
+            || loops::half_pairs::<T, L, D, false>(self.law, &slots, part, &mut out, base),
+        );
+    }
+
+    unsafe fn finish(&self, _worker: &Worker, _forces: &[SharedSlice<'_, T>; D]) {}
+
+    fn work(&self) -> WorkCounters {
+        report(0.0, BuildWork::default(), self.entries, None, 0).work
     }
 }
 
@@ -230,10 +302,11 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
         let build_s = clock.elapsed().as_secs_f64();
         let mut energy = None;
         let mut interacting = 0;
-        if probe || self.parts.len() < 2 || rayon::current_num_threads() < 2 {
-            for f in forces.iter_mut() {
-                f.fill(T::zero());
-            }
+        for f in forces.iter_mut() {
+            f.fill(T::zero());
+        }
+        let split = self.colors.disjoint() && self.parts.len() > 1;
+        if probe || !split || rayon::current_num_threads() < 2 {
             if probe {
                 let (e, count) = self.serial::<true>(state, forces);
                 (energy, interacting) = (Some(e), count);
@@ -302,6 +375,12 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
 
     fn sort_every(&self) -> u64 {
         1
+    }
+
+    fn team_plan(&mut self, n: usize) -> Option<Box<dyn TeamPlan<T, D> + '_>> {
+        let ready =
+            self.cover == Some(Cover::Half) && !self.handed_out && self.at_build[0].len() == n;
+        ready.then(|| Box::new(self.plan()) as Box<dyn TeamPlan<T, D> + '_>)
     }
 }
 

@@ -143,8 +143,8 @@ fn one_dimension_and_lines() {
     agrees_with(&mut kernel, &s, law);
 }
 
-/// A list long enough that the step is split over threads at 2 threads (the parts and their
-/// buffers) and that rows span several SIMD blocks.
+/// A list long enough to be cut into parts, whose rows span several SIMD blocks: the same
+/// parts and the same force bits on one thread and on two.
 #[test]
 fn split_over_threads() {
     let law = lj::<f64>(8.0 * SIGMA);
@@ -155,10 +155,15 @@ fn split_over_threads() {
     let mut f = zero_field::<f64, 2>(n);
     kernel.compute(&state, &mut f, false);
     assert!(step_work(n, kernel.entries()) >= MIN_PARALLEL_PAIRS);
-    on_threads(2, || kernel.compute(&state, &mut f, false));
-    // Rebuilt on the 2-thread pool: now in parts.
+    let parts = kernel.parts.len();
+    assert_eq!(parts, parts_for(n, step_work(n, kernel.entries())));
+    assert!(parts > 1);
+    let mut g = zero_field::<f64, 2>(n);
+    on_threads(2, || kernel.compute(&state, &mut g, false));
+    assert!(f == g, "the same bits on one thread and on two");
+    // Rebuilt on the 2-thread pool: the same parts.
     on_threads(2, || kernel.build(&state));
-    assert_eq!(kernel.parts.len(), 2 * work::PARTS_PER_THREAD);
+    assert_eq!(kernel.parts.len(), parts);
     agrees_with(&mut kernel, &state, law);
     // The split list holds the same pairs as the list in one part.
     on_threads(2, || kernel.build(&state));
@@ -341,21 +346,22 @@ fn work_estimate_decides_the_split() {
         1000 * work::ROW_COST + 500 * work::ENTRY_COST
     );
     assert_eq!(step_work(usize::MAX, u64::MAX), u64::MAX, "saturates");
-    // One thread never splits; two split exactly from the fork/join threshold on.
-    for work in [0, MIN_PARALLEL_PAIRS, u64::MAX] {
-        assert_eq!(parts_for(1, work), 1);
+    // A list splits exactly from the fork/join threshold on, into parts of at least
+    // MIN_PART_ROWS rows, at most PARTS of them.
+    for work in [0, MIN_PARALLEL_PAIRS - 1] {
+        assert_eq!(parts_for(100_000, work), 1);
     }
-    assert_eq!(parts_for(2, MIN_PARALLEL_PAIRS - 1), 1);
-    assert_eq!(parts_for(2, MIN_PARALLEL_PAIRS), 2 * work::PARTS_PER_THREAD);
-    assert_eq!(parts_for(3, MIN_PARALLEL_PAIRS), 3 * work::PARTS_PER_THREAD);
+    assert_eq!(parts_for(100_000, MIN_PARALLEL_PAIRS), work::PARTS);
+    assert_eq!(parts_for(4 * work::MIN_PART_ROWS, u64::MAX), 4);
+    assert_eq!(parts_for(work::MIN_PART_ROWS - 1, u64::MAX), 1);
     // The scenarios at default skin: the gas (0.6 entries per particle) splits from about
     // 6000 particles, the liquid (10) from about 1300.
     let gas = |n: usize| step_work(n, 6 * n as u64 / 10);
     let liquid = |n: usize| step_work(n, 10 * n as u64);
-    assert_eq!(parts_for(2, gas(2000)), 1);
-    assert!(parts_for(2, gas(20_000)) > 1);
-    assert_eq!(parts_for(2, liquid(1000)), 1);
-    assert!(parts_for(2, liquid(2000)) > 1);
+    assert_eq!(parts_for(2000, gas(2000)), 1);
+    assert!(parts_for(20_000, gas(20_000)) > 1);
+    assert_eq!(parts_for(1000, liquid(1000)), 1);
+    assert!(parts_for(2000, liquid(2000)) > 1);
     assert!(gas(10_000) < liquid(10_000));
 }
 

@@ -6,9 +6,12 @@ use super::list::Cover;
 use crate::kernels::MIN_PARALLEL_PAIRS;
 use crate::real::Real;
 
-/// Parts per thread of a split list: several, so that work stealing evens out parts of unequal
-/// density (the gas of lj-box settles under gravity).
-pub(crate) const PARTS_PER_THREAD: usize = 4;
+/// Most parts of a split list, and fewest rows in one: enough parts that the workers of a
+/// colour even out parts of unequal density (the gas of lj-box settles under gravity), wide
+/// enough that a part's pairs reach no further than the next part's rows (the colouring of
+/// [`crate::kernels::teamed`]).
+pub(crate) const PARTS: usize = 16;
+pub(crate) const MIN_PART_ROWS: usize = 512;
 
 /// Cost of one list entry and of one row (particle) of a step, the rebuild included (spread
 /// over the four steps or so it serves at the default skin), in the naive kernel's pair
@@ -27,11 +30,12 @@ pub fn step_work(rows: usize, entries: u64) -> u64 {
         .saturating_add(entries.saturating_mul(ENTRY_COST))
 }
 
-/// Parts to build a list of `work` in, on a pool of `threads`: one (the serial loop) unless
-/// the step pays for a fork/join (the rule of `worth_parallel`).
-pub fn parts_for(threads: usize, work: u64) -> usize {
-    if threads > 1 && work >= MIN_PARALLEL_PAIRS {
-        PARTS_PER_THREAD * threads
+/// Parts to build a list of `rows` rows and `work` in: one (the serial loop) unless the step
+/// pays for a split (the rule of `worth_parallel`), else up to [`PARTS`]. Never a function of
+/// the threads: the parts fix the order in which forces are added, and so their bits.
+pub fn parts_for(rows: usize, work: u64) -> usize {
+    if work >= MIN_PARALLEL_PAIRS {
+        (rows / MIN_PART_ROWS).clamp(1, PARTS)
     } else {
         1
     }

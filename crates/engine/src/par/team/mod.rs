@@ -12,6 +12,9 @@
 //! next (or current) barrier returns [`Stopped`] at once, so nobody waits for a worker that
 //! will never come, and `run` returns the first failure.
 
+pub mod shared;
+
+pub use shared::SharedSlice;
 use std::ops::Range;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::sync::atomic::{AtomicBool, AtomicU64, AtomicUsize, Ordering};
@@ -57,6 +60,9 @@ struct Shared {
     stopped: AtomicBool,
     failure: Mutex<Option<TeamError>>,
     shutdown: AtomicBool,
+    /// Helpers park at once after this region instead of spinning for the next one
+    /// ([`Worker::rest_after`]).
+    rest: AtomicBool,
     /// Parked workers sleep on `wake` under `lock`; whoever moves a counter they wait on
     /// takes the lock before notifying, so that no wake-up is lost.
     lock: Mutex<()>,
@@ -78,7 +84,12 @@ impl Shared {
 
     /// Spins, then parks, until `done()`.
     fn wait_until(&self, done: impl Fn() -> bool) {
-        for _ in 0..SPINS {
+        self.wait_spinning(SPINS, done)
+    }
+
+    /// Spins `spins` times, then parks, until `done()`.
+    fn wait_spinning(&self, spins: u32, done: impl Fn() -> bool) {
+        for _ in 0..spins {
             if done() {
                 return;
             }
@@ -121,6 +132,13 @@ impl Worker {
     /// it, their lengths differing by at most one.
     pub fn block(&self, len: usize) -> Range<usize> {
         block(len, self.shared.size, self.index)
+    }
+
+    /// Asks the helpers to park as soon as this region ends rather than spin for the next
+    /// one: the caller has other parallel work to do first (a rayon pass would share the
+    /// CPUs with spinning helpers).
+    pub fn rest_after(&self) {
+        self.shared.rest.store(true, Ordering::Relaxed);
     }
 
     /// Waits until every worker has arrived here; `Err(Stopped)` at once when another worker
@@ -176,6 +194,7 @@ impl Team {
             stopped: AtomicBool::new(false),
             failure: Mutex::new(None),
             shutdown: AtomicBool::new(false),
+            rest: AtomicBool::new(false),
             lock: Mutex::new(()),
             wake: Condvar::new(),
         });
@@ -210,6 +229,7 @@ impl Team {
     {
         let s = &*self.shared;
         s.stopped.store(false, Ordering::Relaxed);
+        s.rest.store(false, Ordering::Relaxed);
         s.arrived.store(0, Ordering::Relaxed);
         *s.failure.lock().unwrap_or_else(|p| p.into_inner()) = None;
         s.finished.store(0, Ordering::Relaxed);
@@ -279,7 +299,12 @@ fn helper(worker: Worker) {
     let s = worker.shared.clone();
     let mut seen = 0;
     loop {
-        s.wait_until(|| s.region.load(Ordering::Acquire) != seen);
+        let spins = if s.rest.load(Ordering::Relaxed) {
+            0
+        } else {
+            SPINS
+        };
+        s.wait_spinning(spins, || s.region.load(Ordering::Acquire) != seen);
         seen = s.region.load(Ordering::Acquire);
         if s.shutdown.load(Ordering::Acquire) {
             return;

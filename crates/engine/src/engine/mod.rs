@@ -1,9 +1,16 @@
 //! The simulation loop: one kernel, one system, velocity Verlet, phase timers and counters.
+//!
+//! A step whose kernel keeps a structure between steps (a neighbour list) runs as one region
+//! of a worker team ([`team_step`]); any other step, and a step that rebuilds the structure,
+//! runs its passes one after another, each on the rayon pool when worth it.
+
+mod team_step;
 
 use crate::boundary::{Boundary, BoundaryError};
 use crate::geometry::Bounds;
 use crate::integrator::{kick, kick_drift};
 use crate::kernels::{ForceKernel, WorkCounters};
+use crate::par::team::Team;
 use crate::real::Real;
 use crate::scenario::System;
 use crate::state::{Field, State, zero_field};
@@ -113,6 +120,9 @@ pub struct Simulation<T: Real, const D: usize> {
     pub bounds: Bounds<T, D>,
     /// Energy and work of the last probe.
     last_probe: (f64, WorkCounters),
+    /// The workers of the team steps, as many as the rayon pool the steps run in (made at the
+    /// first team step; `None` before, or when its threads could not be started).
+    team: Option<Team>,
 }
 
 impl<T: Real, const D: usize> Simulation<T, D> {
@@ -132,6 +142,7 @@ impl<T: Real, const D: usize> Simulation<T, D> {
             work: WorkCounters::default(),
             bounds,
             last_probe: (0.0, WorkCounters::default()),
+            team: None,
         };
         if let Some(order) = sim.kernel.spatial_order(&sim.state) {
             sim.state.permute(&order, &mut [&mut sim.forces]);
@@ -176,11 +187,25 @@ impl<T: Real, const D: usize> Simulation<T, D> {
 
     /// One velocity-Verlet step.
     pub fn step(&mut self) -> Result<(), BoundaryError> {
+        if let Some(done) = self.step_on_team() {
+            return done;
+        }
         let half = self.dt * T::of(0.5);
         let t0 = Instant::now();
         kick_drift(&mut self.state, &self.forces, self.external, half, self.dt);
         let t1 = Instant::now();
         self.bounds = self.boundary.apply(&mut self.state, self.step + 1)?;
+        let t2 = Instant::now();
+        self.phases.integrate += (t1 - t0).as_secs_f64();
+        self.phases.boundary += (t2 - t1).as_secs_f64();
+        self.forces_and_kick();
+        Ok(())
+    }
+
+    /// The rest of a step after the drift and the walls: the re-ordering when the kernel asks
+    /// for one, the forces, the second half kick.
+    fn forces_and_kick(&mut self) {
+        let half = self.dt * T::of(0.5);
         let t2 = Instant::now();
         let mut reorder_s = 0.0;
         if (self.step + 1).is_multiple_of(self.kernel.sort_every()) {
@@ -197,10 +222,8 @@ impl<T: Real, const D: usize> Simulation<T, D> {
         self.step += 1;
         self.work += report.work;
         let force = (t4 - t3).as_secs_f64();
-        self.phases.integrate += (t1 - t0).as_secs_f64() + (t5 - t4).as_secs_f64();
-        self.phases.boundary += (t2 - t1).as_secs_f64();
+        self.phases.integrate += (t5 - t4).as_secs_f64();
         self.phases.force_build += reorder_s + report.build_s;
         self.phases.force_interact += (force - report.build_s).max(0.0);
-        Ok(())
     }
 }
