@@ -25,6 +25,11 @@ use std::thread::JoinHandle;
 /// usual skew between workers at a barrier and far shorter than a time slice.
 const SPINS: u32 = 4000;
 
+/// Yields of a waiting worker before it parks when the team has more workers than the machine
+/// has CPUs: the worker it waits for may be the one that is not running, and spinning would
+/// keep it off the CPU (as an OpenMP runtime turns to passive waiting when oversubscribed).
+const YIELDS: u32 = 64;
+
 /// The region was stopped by another worker's failure: return, nothing else is worth doing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Stopped;
@@ -49,6 +54,8 @@ type Job<'a> = dyn Fn(&Worker) -> Result<(), String> + Sync + 'a;
 
 struct Shared {
     size: usize,
+    /// More workers than CPUs: waiting workers yield instead of spinning.
+    oversubscribed: bool,
     /// Counts the regions started; a helper runs the job when it sees it move.
     region: AtomicU64,
     job: Mutex<Option<&'static Job<'static>>>,
@@ -87,13 +94,22 @@ impl Shared {
         self.wait_spinning(SPINS, done)
     }
 
-    /// Spins `spins` times, then parks, until `done()`.
+    /// Spins `spins` times (yields, when oversubscribed), then parks, until `done()`.
     fn wait_spinning(&self, spins: u32, done: impl Fn() -> bool) {
-        for _ in 0..spins {
-            if done() {
-                return;
+        if self.oversubscribed {
+            for _ in 0..spins.min(YIELDS) {
+                if done() {
+                    return;
+                }
+                std::thread::yield_now();
             }
-            std::hint::spin_loop();
+        } else {
+            for _ in 0..spins {
+                if done() {
+                    return;
+                }
+                std::hint::spin_loop();
+            }
         }
         let mut g = self.guard();
         while !done() {
@@ -184,8 +200,10 @@ impl Team {
     /// A team of `size` workers: the caller of [`Team::run`] and `size − 1` threads started now.
     pub fn new(size: usize) -> Result<Team, TeamError> {
         let size = size.max(1);
+        let cpus = std::thread::available_parallelism().map_or(1, |c| c.get());
         let shared = Arc::new(Shared {
             size,
+            oversubscribed: size > cpus,
             region: AtomicU64::new(0),
             job: Mutex::new(None),
             finished: AtomicUsize::new(0),
