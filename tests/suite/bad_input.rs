@@ -415,7 +415,7 @@ fn an_interrupt_leaves_no_temporary_file() {
         &config,
         "name = \"long\"\nstudy = \"cartesian\"\nscenarios = [\"lj-box\"]\n\
          kernels = [\"naive\", \"symmetric\"]\nn = [400, 800]\n[measure]\nsamples = 40\n\
-         rounds = 20\nmin_sample_s = 0.01\nwarmup_s = 0.0\n",
+         rounds = 20\nmin_sample_s = 0.05\nwarmup_s = 0.0\n",
     )
     .unwrap();
     let out = dir.path().join("out");

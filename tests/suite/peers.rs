@@ -25,6 +25,7 @@ fn a_small_lammps_case_runs_through_the_harness() {
             "kernels = [\"cell-list\"]",
         )
         .replace("threads = [1, 2]", "threads = [1]")
+        .replace("skin = [0.003, 0.012]\n", "")
         .replace(
             "command = [\"mpirun\", \"-n\", \"{ranks}\", \"--bind-to\", \"none\", \"lmp\"",
             "command = [\"lmp\"",
