@@ -33,7 +33,7 @@ mod tests;
 mod tile;
 
 use super::teamed::{Colors, StateView, TeamPlan};
-use super::verlet::{list_cutoff, moved_too_far};
+use super::verlet::{block_kept, list_cutoff, moved_too_far};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, MIN_PARALLEL_PAIRS, WorkCounters};
 use crate::par::gather;
 use crate::par::team::{SharedSlice, Worker, shared};
@@ -251,7 +251,7 @@ struct Plan<'k, L, T, const D: usize> {
     parts: &'k [Part],
     colors: &'k Colors,
     at_build: [&'k [T]; D],
-    limit: f64,
+    skin: f64,
     runs: u64,
     slot_of: &'k [u32],
     padded_of: &'k [u32],
@@ -262,11 +262,7 @@ struct Plan<'k, L, T, const D: usize> {
 
 impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
     fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
-        let then = self.at_build.map(|x| &x[block.clone()]);
-        !simd::dispatch(
-            #[inline(always)]
-            || super::verlet::moved_beyond(pos, then, self.limit),
-        )
+        block_kept(pos, self.at_build, block, self.skin)
     }
 
     fn colors(&self) -> &Colors {
@@ -430,7 +426,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
             parts: &self.parts,
             colors: &self.colors,
             at_build: self.at_build.each_ref().map(|x| x.as_slice()),
-            limit: 0.25 * self.skin * self.skin,
+            skin: self.skin,
             runs,
             slot_of: &layout.slot_of,
             padded_of: &layout.padded_of,

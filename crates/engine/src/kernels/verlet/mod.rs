@@ -49,7 +49,6 @@ use loops::Slots;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
-pub(crate) use work::moved_beyond;
 pub use work::{parts_for, step_work};
 
 /// Relative margin of the list radius: pair distances are rounded in `T` at every step and
@@ -212,7 +211,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             parts: &self.parts,
             colors: &self.colors,
             at_build: self.at_build.each_ref().map(|x| x.as_slice()),
-            limit: 0.25 * self.skin * self.skin,
+            skin: self.skin,
             entries: self.entries(),
         }
     }
@@ -225,17 +224,13 @@ struct Plan<'k, L, T, const D: usize> {
     parts: &'k [Part],
     colors: &'k Colors,
     at_build: [&'k [T]; D],
-    limit: f64,
+    skin: f64,
     entries: u64,
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
     fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
-        let then = self.at_build.map(|x| &x[block.clone()]);
-        !simd::dispatch(
-            #[inline(always)]
-            || work::moved_beyond(pos, then, self.limit),
-        )
+        block_kept(pos, self.at_build, block, self.skin)
     }
 
     fn colors(&self) -> &Colors {
@@ -430,15 +425,10 @@ pub(crate) fn moved_too_far<T: Real, const D: usize>(
     if at_build[0].len() != n {
         return true;
     }
-    let limit = 0.25 * skin * skin;
-    let (now, then) = (&state.pos, at_build);
+    let at_build = at_build.each_ref().map(|x| x.as_slice());
     let part = |r: Range<usize>| {
-        let now: [&[T]; D] = std::array::from_fn(|d| &now[d][r.clone()]);
-        let then: [&[T]; D] = std::array::from_fn(|d| &then[d][r.clone()]);
-        simd::dispatch(
-            #[inline(always)]
-            || work::moved_beyond(now, then, limit),
-        )
+        let now: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][r.clone()]);
+        !block_kept(now, at_build, r, skin)
     };
     if worth_forking(n * D) {
         let c = pass_chunk(n);
@@ -448,6 +438,21 @@ pub(crate) fn moved_too_far<T: Real, const D: usize>(
     } else {
         part(0..n)
     }
+}
+
+/// Whether every slot of `block`, now at `pos` (the block's positions), is within half the
+/// skin of its place in `at_build` (all slots), in f64: the displacement test of one block.
+pub(crate) fn block_kept<T: Real, const D: usize>(
+    pos: [&[T]; D],
+    at_build: [&[T]; D],
+    block: Range<usize>,
+    skin: f64,
+) -> bool {
+    let then = at_build.map(|x| &x[block.clone()]);
+    !simd::dispatch(
+        #[inline(always)]
+        || work::moved_beyond(pos, then, 0.25 * skin * skin),
+    )
 }
 
 /// The report of one force computation: the list's entries are its pair checks, plus the
