@@ -213,10 +213,11 @@ impl<T: Real, const D: usize> Region<'_, T, D> {
         let colors = self.plan.colors();
         if colors.disjoint() {
             for (c, claim) in self.claims.iter().enumerate() {
-                let parts: Vec<usize> = colors.of_color(c).collect();
                 loop {
                     let k = claim.fetch_add(1, Ordering::Relaxed);
-                    let Some(&part) = parts.get(k) else { break };
+                    let Some(part) = colors.nth_of_color(c, k) else {
+                        break;
+                    };
                     // SAFETY: only this colour's parts run until the barrier, each once (the
                     // claim), and they touch disjoint places.
                     unsafe { self.plan.interact(part, view, &a.forces) };

@@ -55,6 +55,12 @@ impl Colors {
         (c..self.parts).step_by(2)
     }
 
+    /// The `k`-th part of colour `c`, if the colour has that many.
+    pub fn nth_of_color(&self, c: usize, k: usize) -> Option<usize> {
+        let part = c + 2 * k;
+        (part < self.parts).then_some(part)
+    }
+
     /// Every part in the order their contributions are added: colour 0, then colour 1.
     pub fn order(&self) -> impl Iterator<Item = usize> + use<> {
         self.of_color(0).chain(self.of_color(1))
@@ -125,6 +131,10 @@ mod tests {
         assert_eq!(c.parts(), 5);
         assert!(c.disjoint());
         assert_eq!(c.order().collect::<Vec<_>>(), vec![0, 2, 4, 1, 3]);
+        for colour in 0..2 {
+            let nth: Vec<usize> = (0..5).map_while(|k| c.nth_of_color(colour, k)).collect();
+            assert_eq!(nth, c.of_color(colour).collect::<Vec<_>>());
+        }
     }
 
     #[test]
