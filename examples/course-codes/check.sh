@@ -8,8 +8,12 @@
 # What is checked, and why the tolerances are what they are:
 # (a) each run prints the header line and every phase, time and energy line, with the n, steps,
 #     threads and ranks it was given, and its phases add up to its `time total` (at least 90%:
-#     nothing large in the loop escapes the phases; at most 200%: MPI phases are maxima over ranks
-#     and can add up to more than the slowest rank's total);
+#     nothing large in the loop escapes the phases; at most 200%). On more than one rank the
+#     phases are means over ranks and the total is the slowest rank's, so the two differ by how
+#     unevenly the ranks leave the starting barrier and reach the end; on a machine whose ranks
+#     share CPUs that is a scheduler slice or more (2 ms of a 5.6 ms run was seen in CI), as large
+#     as these runs: on more than one rank only the upper bound is checked (the lower one is checked
+#     on the serial and OpenMP codes);
 # (b) energy conservation, relative to |E0|:
 #     - LJ, 1e-3 over 100 steps of n = 200: velocity Verlet's error is bounded, and here it is set
 #       by the hardest collisions (the r^-13 core; at dt = 1e-4 a fast pair closes 4% of sigma per
@@ -111,7 +115,9 @@ check_lines() { # name, program, n, steps, threads, ranks
     local sum total
     sum=$(awk '/^phase / { s += $3 } END { printf "%.9f", s }' "$f")
     total=$(value "$1" "time total")
-    awk -v s="$sum" -v t="$total" 'BEGIN { exit !(s >= 0.9 * t && s <= 2.0 * t + 1e-4) }' ||
+    local lower=0.9
+    [ "$6" -gt 1 ] && lower=0
+    awk -v s="$sum" -v t="$total" -v l="$lower" 'BEGIN { exit !(s >= l * t && s <= 2.0 * t + 1e-4) }' ||
         fail "$1: phases add up to $sum s but time total is $total s"
 }
 check_drift() { # name, tolerance
