@@ -108,7 +108,7 @@ pip install --quiet --no-build-isolation --no-deps --force-reinstall "./$tree" \
 
 "$venv/bin/python" -c "import fmm3dpy, numpy"
 so=$("$venv/bin/python" -c "import fmm3dpy.lfmm3d_fortran as m; print(m.__file__)")
-ldd "$so" | grep -q libgomp ||
+ldd "$so" | grep libgomp >/dev/null ||
     { echo "install-fmm3d-native.sh: $so is not linked with OpenMP" >&2; exit 1; }
 {
     echo "fmm3dpy $version from its sdist, libfmm3d.a by FMM3D's makefile"
