@@ -59,15 +59,23 @@ fn detect() -> SimdLevel {
     SimdLevel::Baseline
 }
 
+/// Runs `f` compiled for AVX-512 (and everything it calls with `#[inline(always)]`).
+///
+/// # Safety
+/// The CPU must have AVX-512 (F, VL, DQ, BW), AVX2 and FMA: `level()` is `Avx512`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma,bmi1,bmi2")]
-unsafe fn run_avx512<R>(f: impl FnOnce() -> R) -> R {
+pub(crate) unsafe fn run_avx512<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 
+/// Runs `f` compiled for AVX2 and FMA.
+///
+/// # Safety
+/// The CPU must have AVX2 and FMA: `level()` is `Avx2` or `Avx512`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma,bmi1,bmi2")]
-unsafe fn run_avx2<R>(f: impl FnOnce() -> R) -> R {
+pub(crate) unsafe fn run_avx2<R>(f: impl FnOnce() -> R) -> R {
     f()
 }
 

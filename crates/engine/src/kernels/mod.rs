@@ -13,6 +13,8 @@ mod compiled;
 mod counting_sort;
 mod fmm;
 pub mod footprint;
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 mod naive;
 mod octree;
 mod per_thread;

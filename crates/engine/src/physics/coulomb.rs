@@ -65,6 +65,14 @@ impl<T: Real> PairLaw<T> for Coulomb<T> {
     fn softening2(&self) -> T {
         T::zero()
     }
+
+    fn inverse_square(&self) -> Option<super::InverseSquare<T>> {
+        Some(super::InverseSquare {
+            k: -T::one(),
+            eps2: T::zero(),
+            quench2: self.quench2,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -67,6 +67,14 @@ impl<T: Real> PairLaw<T> for Gravity<T> {
     fn softening2(&self) -> T {
         self.eps2
     }
+
+    fn inverse_square(&self) -> Option<super::InverseSquare<T>> {
+        Some(super::InverseSquare {
+            k: self.g,
+            eps2: self.eps2,
+            quench2: T::zero(),
+        })
+    }
 }
 
 #[cfg(test)]

@@ -134,6 +134,22 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     /// ε² of a Plummer-softened law (`coeff ∝ 1/(r² + ε²)^{3/2}`), 0 for an unsoftened one:
     /// the tree's quadrupole expansion of a 1/r² law needs it. Unused for short-ranged laws.
     fn softening2(&self) -> T;
+
+    /// The law as an [`InverseSquare`], for the batched SIMD pair kernels; `None` for a law
+    /// of another form.
+    fn inverse_square(&self) -> Option<InverseSquare<T>> {
+        None
+    }
+}
+
+/// A law whose coefficient is `k · s_i · s_j · (r² + ε²)^{−3/2}`, zero where `r² + ε²` is
+/// below `quench2` (gravity: k = G; Coulomb: k = −1, ε = 0, quenched).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InverseSquare<T> {
+    pub k: T,
+    pub eps2: T,
+    /// Zero for a law that is never quenched.
+    pub quench2: T,
 }
 
 /// The force of source `j` on target `i` given the separation `dx = x_j − x_i`, returned: the

@@ -25,6 +25,7 @@
 //! interaction list per thread (a few thousand entries). The quadrupole order adds
 //! D(D+1)/2 + 1 values per node (Q and T) and a node list per thread.
 
+mod m2p;
 mod moments;
 mod node;
 mod nodes;

@@ -23,13 +23,13 @@ use crate::real::{Real, select};
 /// Accepted nodes: centres, strengths, the components of Q and T; `len` real entries followed
 /// by padding up to `padded`.
 pub(super) struct NodeList<T, const D: usize> {
-    pos: [Vec<T>; D],
-    m: Vec<T>,
+    pub(super) pos: [Vec<T>; D],
+    pub(super) m: Vec<T>,
     /// Q in the component order of `moments` (the first `sym(D)` arrays in use).
-    q: [Vec<T>; 6],
-    trace: Vec<T>,
+    pub(super) q: [Vec<T>; 6],
+    pub(super) trace: Vec<T>,
     pub len: usize,
-    padded: usize,
+    pub(super) padded: usize,
 }
 
 impl<T: Real, const D: usize> NodeList<T, D> {
@@ -84,6 +84,18 @@ impl<T: Real, const D: usize> NodeList<T, D> {
         }
         self.len = len;
         self.padded = padded;
+    }
+
+    /// Force on `t` from every listed node, on the timed path: the batched loop
+    /// ([`super::m2p`]) for an inverse-square law where the machine has one, else [`Self::gather`].
+    #[inline(always)]
+    pub fn forces<L: PairLaw<T>>(&self, law: &L, t: &Target<T, D>) -> [T; D] {
+        if let Some(p) = law.inverse_square()
+            && let Some(force) = super::m2p::node_forces(self, &p, t)
+        {
+            return force;
+        }
+        self.gather::<L, false>(law, t).force
     }
 
     /// Force on `t` from every listed node; with `PROBE`, also the energy and the number of

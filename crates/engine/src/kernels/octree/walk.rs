@@ -301,9 +301,9 @@ fn group_forces<T: Real, L: PairLaw<T>, const D: usize, const QUAD: bool>(
                 x: std::array::from_fn(|d| tree.pos[d][i]),
                 s: tree.src[i],
             };
-            let sum = list.nodes.gather::<L, false>(law, &t);
+            let force = list.nodes.forces(law, &t);
             for d in 0..D {
-                out[d][k] += sum.force[d];
+                out[d][k] += force[d];
             }
         }
     }

@@ -8,6 +8,8 @@
 //! or tile it is in, and so at every thread count. Timed steps only: the probe keeps the
 //! gather form, which also sums energies and counts interactions.
 
+mod batched;
+
 use super::rows::{LANES, Sources};
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
@@ -44,6 +46,11 @@ pub(crate) fn tile_forces<T: Real, L: PairLaw<T>, const D: usize>(
     src: &Sources<'_, T, D>,
     own: usize,
 ) -> [[T; LANES]; D] {
+    if let Some(p) = law.inverse_square()
+        && let Some(force) = batched::forces(&p, tile, src, own)
+    {
+        return force;
+    }
     let n = src.len();
     // Any `own` at or past the run means no lane's slot is in it; clamped, `j − own` wraps to
     // far past the lanes for every j (unclamped, `usize::MAX` would wrap to j + 1).

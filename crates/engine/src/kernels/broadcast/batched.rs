@@ -1,0 +1,208 @@
+//! The batched inverse-square pair kernel: the tile's targets in vector registers, each source
+//! broadcast to them, written with intrinsics for AVX-512 and AVX2 in both precisions (the
+//! layout of Phantom-GRAPE's and PKDGRAV3's CPU kernels).
+//!
+//! Against the portable loop of [`super::tile_forces`] it gains what LLVM cannot do without
+//! leave to reorder floating point: multiplies and adds fused (the squared distance, the
+//! Newton steps, the force sums), the hardware's reciprocal-square-root estimate in place of
+//! the integer one (two or three Newton steps instead of four), `k · s_i` taken out of the
+//! sum, and the test of a lane's own slot only in the `LANES` sources that can hold it.
+//!
+//! Each target's force is still summed over the sources in their order, whatever its lane
+//! or tile, so the forces are the same bits at every thread count. They differ in the last
+//! bits between instruction sets (the estimates differ) and from the portable loop.
+
+use super::Tile;
+#[cfg(target_arch = "x86_64")]
+use crate::kernels::lanes::{Avx2F32, Avx2F64, Avx512F32, Avx512F64, Isa, Lanes, is, isa, same};
+use crate::kernels::rows::{LANES, Sources};
+use crate::physics::InverseSquare;
+use crate::real::Real;
+#[cfg(target_arch = "x86_64")]
+use crate::simd::{run_avx2, run_avx512};
+use std::ops::Range;
+
+/// The forces on the tile's targets from `src` under the law `p`, lane `l` skipping source
+/// `own + l` (as [`super::tile_forces`]), by this machine's batched kernel; `None` at the
+/// baseline instruction set, which has none.
+#[inline(always)]
+pub(super) fn forces<T: Real, const D: usize>(
+    p: &InverseSquare<T>,
+    tile: &Tile<T, D>,
+    src: &Sources<'_, T, D>,
+    own: usize,
+) -> Option<[[T; LANES]; D]> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let isa = isa()?;
+        // SAFETY (both blocks): `is` makes `T` the type the references are cast to, and
+        // `isa()` has checked the CPU for the features `run_*` enables. Two vectors of targets
+        // per pass where they fit the registers with their sums (16 f64 in zmm, 8 f64 or 16
+        // f32 in ymm), one where a vector is the whole tile (16 f32 in a zmm).
+        if is::<T, f64>() {
+            let (p, tile, src) = unsafe { (same(p), same(tile), same(src)) };
+            let f = unsafe {
+                match isa {
+                    Isa::Avx512 => run_avx512(|| passes::<Avx512F64, D, 2>(p, tile, src, own)),
+                    Isa::Avx2 => run_avx2(|| passes::<Avx2F64, D, 2>(p, tile, src, own)),
+                }
+            };
+            return Some(unsafe { *same(&f) });
+        }
+        if is::<T, f32>() {
+            let (p, tile, src) = unsafe { (same(p), same(tile), same(src)) };
+            let f = unsafe {
+                match isa {
+                    Isa::Avx512 => run_avx512(|| passes::<Avx512F32, D, 1>(p, tile, src, own)),
+                    Isa::Avx2 => run_avx2(|| passes::<Avx2F32, D, 2>(p, tile, src, own)),
+                }
+            };
+            return Some(unsafe { *same(&f) });
+        }
+    }
+    let _ = (p, tile, src, own);
+    None
+}
+
+/// The tile in passes of `K` vectors of targets, each pass over every source. Runs `V`'s
+/// intrinsics: only under `V`'s features (a safe function, so that it inlines into the
+/// closures of [`forces`]).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn passes<V: Lanes, const D: usize, const K: usize>(
+    p: &InverseSquare<V::Elem>,
+    tile: &Tile<V::Elem, D>,
+    src: &Sources<'_, V::Elem, D>,
+    own: usize,
+) -> [[V::Elem; LANES]; D]
+where
+    V::Elem: Real,
+{
+    let zero = <V::Elem as num_traits::Zero>::zero();
+    let lane_number: [V::Elem; LANES] = std::array::from_fn(|l| V::Elem::of(l as f64));
+    let mut out = [[zero; LANES]; D];
+    let per_pass = K * V::WIDTH;
+    debug_assert!(LANES.is_multiple_of(per_pass));
+    for first in (0..LANES).step_by(per_pass) {
+        // SAFETY: `first + k · WIDTH + WIDTH ≤ LANES` for every k < K, so every load and
+        // store stays inside the tile's arrays; the intrinsics are the caller's.
+        unsafe {
+            // Plain loops, not `array::from_fn`: its closures are functions of their own,
+            // compiled without the features, where the intrinsics would not inline.
+            let mut pass = Pass::<V, D, K> {
+                x: [[V::splat(zero); K]; D],
+                lane: [V::splat(zero); K],
+                eps2: V::splat(p.eps2),
+                quench2: V::splat(p.quench2),
+            };
+            for k in 0..K {
+                let at = first + k * V::WIDTH;
+                for d in 0..D {
+                    pass.x[d][k] = V::load(&tile.x[d][at]);
+                }
+                pass.lane[k] = V::load(&lane_number[at]);
+            }
+            let mut acc = [[V::splat(zero); K]; D];
+            if p.quench2 > zero {
+                pass.sources::<true>(src, own, &mut acc);
+            } else {
+                pass.sources::<false>(src, own, &mut acc);
+            }
+            for k in 0..K {
+                let at = first + k * V::WIDTH;
+                let scale = V::load(&tile.s[at]).mul(V::splat(p.k));
+                for d in 0..D {
+                    acc[d][k].mul(scale).store(&mut out[d][at]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// One pass's targets, in registers.
+#[cfg(target_arch = "x86_64")]
+struct Pass<V, const D: usize, const K: usize> {
+    x: [[V; K]; D],
+    /// Each lane's number within the tile.
+    lane: [V; K],
+    eps2: V,
+    quench2: V,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<V: Lanes, const D: usize, const K: usize> Pass<V, D, K>
+where
+    V::Elem: Real,
+{
+    /// Adds `s_j (r² + ε²)^{−3/2} (x_j − x_i)` over every source of `src` to each lane's
+    /// sums, lane `l` skipping source `own + l`; with `QUENCH`, zero where `r² + ε²` is below
+    /// the quench radius's square.
+    ///
+    /// # Safety
+    /// The caller must have `V`'s features.
+    #[inline(always)]
+    unsafe fn sources<const QUENCH: bool>(
+        &self,
+        src: &Sources<'_, V::Elem, D>,
+        own: usize,
+        acc: &mut [[V; K]; D],
+    ) {
+        let n = src.len();
+        let own = own.min(n);
+        // Only these sources can be some lane's own slot.
+        let mine = own..(own + LANES).min(n);
+        // SAFETY: the runs lie within `src`; the features are the caller's.
+        unsafe {
+            self.run::<QUENCH, false>(src, 0..mine.start, own, acc);
+            self.run::<QUENCH, true>(src, mine.clone(), own, acc);
+            self.run::<QUENCH, false>(src, mine.end..n, own, acc);
+        }
+    }
+
+    /// [`Pass::sources`] over the run `js`; with `MINE`, lane `l` skips source `own + l`.
+    ///
+    /// # Safety
+    /// `js` must lie within `src`, and the caller must have `V`'s features.
+    #[inline(always)]
+    unsafe fn run<const QUENCH: bool, const MINE: bool>(
+        &self,
+        src: &Sources<'_, V::Elem, D>,
+        js: Range<usize>,
+        own: usize,
+        acc: &mut [[V; K]; D],
+    ) {
+        debug_assert!(js.end <= src.len());
+        for j in js {
+            // SAFETY: j < src.len(), which every array of `src` has; the intrinsics are the
+            // caller's.
+            unsafe {
+                let mut xj = [self.eps2; D];
+                for d in 0..D {
+                    xj[d] = V::splat(*src.pos[d].get_unchecked(j));
+                }
+                let sj = V::splat(*src.s.get_unchecked(j));
+                let slot = V::splat(V::Elem::of(j.wrapping_sub(own) as f64));
+                for k in 0..K {
+                    let mut r2 = self.eps2;
+                    let mut dx = [self.eps2; D];
+                    for d in 0..D {
+                        dx[d] = xj[d].sub(self.x[d][k]);
+                        r2 = dx[d].mul_add(dx[d], r2);
+                    }
+                    let inv = r2.rsqrt();
+                    let mut c = inv.mul(inv).mul(inv.mul(sj));
+                    if QUENCH {
+                        c = c.zero_where_less(r2, self.quench2);
+                    }
+                    if MINE {
+                        c = c.zero_where_equal(self.lane[k], slot);
+                    }
+                    for d in 0..D {
+                        acc[d][k] = c.mul_add(dx[d], acc[d][k]);
+                    }
+                }
+            }
+        }
+    }
+}

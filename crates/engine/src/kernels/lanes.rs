@@ -1,0 +1,182 @@
+//! The few vector operations the batched pair kernel needs, over the registers of one
+//! instruction set and precision: AVX-512 (`zmm`) and AVX2 (`ymm`), f64 and f32.
+//!
+//! Each method is a thin `#[inline(always)]` wrapper of one or two intrinsics; it must only be
+//! reached from code running under the matching `target_feature` ([`crate::simd::run_avx512`],
+//! [`crate::simd::run_avx2`]), where the intrinsics inline into straight vector code. A batched
+//! kernel is written once, generic over [`Lanes`], and run through [`isa`] and [`same`].
+
+use crate::simd::{SimdLevel, level};
+use std::any::TypeId;
+#[cfg(target_arch = "x86_64")]
+use std::arch::x86_64::*;
+
+/// The instruction set the batched kernels run with on this machine.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Isa {
+    Avx512,
+    Avx2,
+}
+
+/// The batched kernels' instruction set here; `None` at the baseline (and off x86-64), where
+/// the portable loops run instead.
+#[inline(always)]
+pub(crate) fn isa() -> Option<Isa> {
+    match level() {
+        SimdLevel::Avx512 if cfg!(target_arch = "x86_64") => Some(Isa::Avx512),
+        SimdLevel::Avx2 if cfg!(target_arch = "x86_64") => Some(Isa::Avx2),
+        _ => None,
+    }
+}
+
+/// Whether the generic `T` is `U` (to pick a kernel's precision).
+#[inline(always)]
+pub(crate) fn is<T: 'static, U: 'static>() -> bool {
+    TypeId::of::<T>() == TypeId::of::<U>()
+}
+
+/// `a` as a `B`.
+///
+/// # Safety
+/// `A` and `B` must be the same type (as [`is`] says), differing only in how the caller
+/// names them.
+#[inline(always)]
+pub(crate) unsafe fn same<A, B>(a: &A) -> &B {
+    // SAFETY: the same type, so the same layout and validity.
+    unsafe { &*(a as *const A).cast::<B>() }
+}
+
+/// One register of `WIDTH` lanes of `Elem`.
+///
+/// # Safety
+/// Every method needs the CPU features of its implementation; callers run them only inside a
+/// function that enables those features, after `simd::level()` has checked the CPU.
+pub(super) unsafe trait Lanes: Copy {
+    type Elem: Copy;
+    const WIDTH: usize;
+    unsafe fn splat(x: Self::Elem) -> Self;
+    /// `WIDTH` elements from `p` (no alignment needed).
+    unsafe fn load(p: *const Self::Elem) -> Self;
+    unsafe fn store(self, p: *mut Self::Elem);
+    unsafe fn sub(self, b: Self) -> Self;
+    unsafe fn mul(self, b: Self) -> Self;
+    /// `self · b + c`, rounded once.
+    unsafe fn mul_add(self, b: Self, c: Self) -> Self;
+    /// `c − self · b`, rounded once.
+    unsafe fn neg_mul_add(self, b: Self, c: Self) -> Self;
+    /// `1/√self` to within a few units in the last place: the hardware estimate, refined by
+    /// Newton steps (each squares the relative error and multiplies it by 1.5).
+    unsafe fn rsqrt(self) -> Self;
+    /// `self`, with zeros in the lanes where `a < b`.
+    unsafe fn zero_where_less(self, a: Self, b: Self) -> Self;
+    /// `self`, with zeros in the lanes where `a == b`.
+    unsafe fn zero_where_equal(self, a: Self, b: Self) -> Self;
+}
+
+/// One Newton step towards `1/√x` from `y`, with `half = x/2`: `y · (3/2 − half · y²)`.
+#[inline(always)]
+unsafe fn newton<V: Lanes>(y: V, half: V, three_halves: V) -> V {
+    // SAFETY: the caller runs with V's features.
+    unsafe { y.mul(half.neg_mul_add(y.mul(y), three_halves)) }
+}
+
+macro_rules! lanes {
+    ($name:ident, $reg:ty, $elem:ty, $width:expr,
+     splat $splat:ident, load $load:ident, store $store:ident, sub $sub:ident, mul $mul:ident,
+     fma $fma:ident, fnma $fnma:ident, rsqrt |$x:ident| $rsqrt:expr, newton_steps $steps:expr,
+     less |$a:ident, $b:ident, $v:ident| $less:expr, equal |$ea:ident, $eb:ident, $ev:ident| $equal:expr) => {
+        #[cfg(target_arch = "x86_64")]
+        #[derive(Clone, Copy)]
+        pub(super) struct $name($reg);
+
+        // SAFETY: every method is an intrinsic of the features named in the entry point that
+        // instantiates this type.
+        #[cfg(target_arch = "x86_64")]
+        unsafe impl Lanes for $name {
+            type Elem = $elem;
+            const WIDTH: usize = $width;
+            #[inline(always)]
+            unsafe fn splat(x: $elem) -> Self {
+                unsafe { $name($splat(x)) }
+            }
+            #[inline(always)]
+            unsafe fn load(p: *const $elem) -> Self {
+                unsafe { $name($load(p)) }
+            }
+            #[inline(always)]
+            unsafe fn store(self, p: *mut $elem) {
+                unsafe { $store(p, self.0) }
+            }
+            #[inline(always)]
+            unsafe fn sub(self, b: Self) -> Self {
+                unsafe { $name($sub(self.0, b.0)) }
+            }
+            #[inline(always)]
+            unsafe fn mul(self, b: Self) -> Self {
+                unsafe { $name($mul(self.0, b.0)) }
+            }
+            #[inline(always)]
+            unsafe fn mul_add(self, b: Self, c: Self) -> Self {
+                unsafe { $name($fma(self.0, b.0, c.0)) }
+            }
+            #[inline(always)]
+            unsafe fn neg_mul_add(self, b: Self, c: Self) -> Self {
+                unsafe { $name($fnma(self.0, b.0, c.0)) }
+            }
+            #[inline(always)]
+            unsafe fn rsqrt(self) -> Self {
+                unsafe {
+                    let $x = self.0;
+                    let mut y: Self = $name($rsqrt);
+                    let half = self.mul(Self::splat(0.5));
+                    let three_halves = Self::splat(1.5);
+                    for _ in 0..$steps {
+                        y = newton(y, half, three_halves);
+                    }
+                    y
+                }
+            }
+            #[inline(always)]
+            unsafe fn zero_where_less(self, a: Self, b: Self) -> Self {
+                unsafe {
+                    let ($a, $b, $v) = (a.0, b.0, self.0);
+                    $name($less)
+                }
+            }
+            #[inline(always)]
+            unsafe fn zero_where_equal(self, a: Self, b: Self) -> Self {
+                unsafe {
+                    let ($ea, $eb, $ev) = (a.0, b.0, self.0);
+                    $name($equal)
+                }
+            }
+        }
+    };
+}
+
+// AVX-512: a 14-bit estimate (relative error below 2^-14); f64 takes two Newton steps
+// (6.1e-5 → 5.6e-9 → 4.7e-17, rounding), f32 one (→ 5.6e-9, below its rounding).
+lanes!(Avx512F64, __m512d, f64, 8, 
+    splat _mm512_set1_pd, load _mm512_loadu_pd, store _mm512_storeu_pd, sub _mm512_sub_pd,
+    mul _mm512_mul_pd, fma _mm512_fmadd_pd, fnma _mm512_fnmadd_pd, rsqrt |x| _mm512_rsqrt14_pd(x), newton_steps 2,
+    less |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_LT_OQ>(a, b), v),
+    equal |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, b), v));
+lanes!(Avx512F32, __m512, f32, 16, 
+    splat _mm512_set1_ps, load _mm512_loadu_ps, store _mm512_storeu_ps, sub _mm512_sub_ps,
+    mul _mm512_mul_ps, fma _mm512_fmadd_ps, fnma _mm512_fnmadd_ps, rsqrt |x| _mm512_rsqrt14_ps(x), newton_steps 1,
+    less |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b), v),
+    equal |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b), v));
+// AVX2: the 12-bit f32 estimate (relative error below 1.5 · 2^-12 = 3.7e-4); f64 converts to
+// f32 and back around it and takes three steps (→ 2.0e-7 → 6.0e-14 → rounding), f32 two
+// (→ 2.0e-7 → rounding). The f32 estimate needs x in f32's normal range (1.2e-38 to 3.4e38).
+lanes!(Avx2F64, __m256d, f64, 4, 
+    splat _mm256_set1_pd, load _mm256_loadu_pd, store _mm256_storeu_pd, sub _mm256_sub_pd,
+    mul _mm256_mul_pd, fma _mm256_fmadd_pd, fnma _mm256_fnmadd_pd,
+    rsqrt |x| _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(x))), newton_steps 3,
+    less |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(a, b), v),
+    equal |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(a, b), v));
+lanes!(Avx2F32, __m256, f32, 8, 
+    splat _mm256_set1_ps, load _mm256_loadu_ps, store _mm256_storeu_ps, sub _mm256_sub_ps,
+    mul _mm256_mul_ps, fma _mm256_fmadd_ps, fnma _mm256_fnmadd_ps, rsqrt |x| _mm256_rsqrt_ps(x), newton_steps 2,
+    less |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b), v),
+    equal |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(a, b), v));
