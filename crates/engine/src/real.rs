@@ -34,7 +34,8 @@ pub trait Real:
     /// `1/√x` for `x > 0` to within a few units in the last place, from an integer estimate
     /// refined by Newton steps: multiplies and adds only, which vectorize at full width, where
     /// a square root and a division occupy the divider for tens of cycles per vector. The same
-    /// operations at every instruction set, so every SIMD level gives the same bits.
+    /// operations at every instruction set, so every SIMD level gives the same bits (the
+    /// batched 1/r² kernels, written with intrinsics, use the hardware's estimate instead).
     fn rsqrt(self) -> Self;
 }
 

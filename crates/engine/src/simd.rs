@@ -4,7 +4,9 @@
 //! valgrind, and so results from different build hosts stay comparable), while the pair loops
 //! are compiled a second time for AVX2+FMA and a third time for AVX-512 and chosen once at run
 //! time. The loops are written as plain Rust over fixed-width lane arrays, which LLVM vectorizes
-//! for whichever target the enclosing function was compiled for.
+//! for whichever target the enclosing function was compiled for; the batched 1/r² kernels
+//! are written with intrinsics instead (`kernels::lanes`), run under [`run_avx512`] and
+//! [`run_avx2`].
 
 use std::sync::OnceLock;
 

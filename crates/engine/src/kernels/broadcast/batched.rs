@@ -229,6 +229,9 @@ mod tests {
     use super::*;
     use crate::physics::{Coulomb, Gravity, PairLaw, pair_force};
     use crate::simd::{SimdLevel, level};
+    use crate::testing::SEED_1;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
 
     /// The instruction sets this CPU can run.
     fn isas() -> Vec<Isa> {
@@ -242,13 +245,8 @@ mod tests {
     /// Sources scattered in the unit cube with strengths of both signs (a fixed sequence),
     /// source 3 placed on source 0 (a coincident pair).
     fn sources<T: Real>(n: usize) -> ([Vec<T>; 3], Vec<T>) {
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Pcg64Mcg::seed_from_u64(SEED_1);
+        let mut next = || rng.random::<f64>();
         let mut pos: [Vec<T>; 3] = std::array::from_fn(|_| Vec::new());
         let mut s = Vec::new();
         for j in 0..n {

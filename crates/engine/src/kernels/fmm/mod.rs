@@ -19,8 +19,9 @@
 //! a fixed order, so the forces are the same bits at every thread count (see [`walk`]). The
 //! expansions are computed in f64 whatever the precision of the particles, the cell–cell
 //! interactions of a cell with `LANES` partners at a time in SIMD lanes; the near field runs
-//! in the state's precision. Both go through `simd::dispatch`, with the same operations at
-//! every instruction set, so every level gives the same bits.
+//! in the state's precision. Both go through `simd::dispatch`; the cell–cell loop does the
+//! same operations at every instruction set, while the near field of a 1/r² law runs the
+//! batched intrinsics of `broadcast`, whose last bits differ between instruction sets.
 //!
 //! Counters: `pair_checks` counts the particle pairs of the near field (each pair once),
 //! `nodes_accepted` the cell–cell interactions, `nodes_opened` the pairs of cells split.

@@ -163,17 +163,14 @@ mod tests {
     use super::*;
     use crate::physics::{Coulomb, Gravity, PairLaw};
     use crate::simd::{SimdLevel, level};
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
 
     /// A node list of `len` nodes (a fixed sequence of centres in the unit cube, strengths,
     /// second moments of both signs and traces), padded to whole blocks with empty nodes.
     fn list<T: Real>(len: usize, seed: u64) -> NodeList<T, 3> {
-        let mut state = seed;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6_364_136_223_846_793_005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        let mut next = || rng.random::<f64>();
         let padded = len.next_multiple_of(16);
         let mut l = NodeList::new();
         l.pos = std::array::from_fn(|_| vec![T::of(5.0); padded]);
