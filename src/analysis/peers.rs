@@ -284,10 +284,14 @@ impl Settings {
 }
 
 /// A case's setting within its code: "θ=0.5 quadrupole", "θ=0.4 order 6", or a family
-/// member's name without the family's ("eps1e-2" of "fmm3d-eps1e-2").
+/// member's name without the family's ("eps1e-2" of "fmm3d-eps1e-2"), after the θ it ran at
+/// when the sweep gave it one ("θ=0.7 quadrupole" of "pytreegrav-quadrupole").
 fn setting(p: &Point, code: &str) -> String {
     if let Some(member) = p.family_setting(code) {
-        return member;
+        return match p.theta {
+            Some(t) => format!("θ={t} {member}"),
+            None => member,
+        };
     }
     let mut parts = Vec::new();
     if let Some(t) = p.theta {
@@ -515,6 +519,27 @@ mod tests {
         assert_eq!(cost_at_error(&[(0.0, 1.0), (f64::NAN, 1.0)], 1e-3), None);
     }
 
+    /// A family member is named by its suffix, after the θ it ran at when it has one, so
+    /// that a member swept over θ names each of its settings apart.
+    #[test]
+    fn a_family_member_is_named_with_its_theta() {
+        let plain = point(ScenarioKind::Coulomb, "fmm3d-eps1e-2", 1000, 1, 1, 1.0);
+        assert_eq!(setting(&plain, "fmm3d"), "eps1e-2");
+        let mut swept = point(
+            ScenarioKind::Galaxy,
+            "pytreegrav-quadrupole",
+            1000,
+            1,
+            1,
+            1.0,
+        );
+        swept.theta = Some(0.7);
+        assert_eq!(setting(&swept, "pytreegrav"), "θ=0.7 quadrupole");
+        let mut head = point(ScenarioKind::Galaxy, "pytreegrav", 1000, 1, 1, 1.0);
+        head.theta = Some(0.5);
+        assert_eq!(setting(&head, "pytreegrav"), "θ=0.5");
+    }
+
     #[test]
     fn tighter_errors_are_compared_only_where_the_other_code_reaches_them() {
         use crate::analysis::groups::SeriesKey;
@@ -553,7 +578,7 @@ mod tests {
             series("fmm", &[(1e-5, 4.0), (1e-3, 1.0)]),
             // Another order of ours: one code with the first, at its best of both.
             series("fmm", &[(1e-4, 1.5)]),
-            // Reaches 1e-4: compared there too.
+            // Reaches 1e-4 and 1e-6: compared there too.
             series("fast-multipole", &[(1e-6, 8.0), (1e-2, 2.0)]),
             // Does not: compared at 1e-3 only. Its setting at 2e-3 is slower than the one
             // at 5e-4 and is left out.
@@ -566,7 +591,8 @@ mod tests {
             [
                 (1e-3, "fast-multipole"),
                 (1e-3, "tree"),
-                (1e-4, "fast-multipole")
+                (1e-4, "fast-multipole"),
+                (1e-6, "fast-multipole")
             ]
         );
         // At 1e-4 theirs interpolates between 1e-6 (8 s) and 1e-2 (2 s): 4 s; ours has a
