@@ -313,10 +313,14 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
 
 /// What a point of an accuracy series was run at: "θ=0.5", or for a member of an external
 /// family (the series named after the family) its program's name without the family's
-/// prefix ("eps1e-2" of "fmm3d-eps1e-2"); `None` for a θ series point without a θ.
+/// prefix ("eps1e-2" of "fmm3d-eps1e-2"), after its θ when it has one ("θ=0.7 quadrupole");
+/// `None` for a θ series point without a θ.
 fn setting_label(p: &Point, series: &KernelOrProgram) -> Option<String> {
-    p.family_setting(series.name())
-        .or_else(|| Some(format!("θ={}", p.theta?)))
+    let theta = p.theta.map(|t| format!("θ={t}"));
+    match (p.family_setting(series.name()), theta) {
+        (Some(member), Some(theta)) => Some(format!("{theta} {member}")),
+        (member, theta) => member.or(theta),
+    }
 }
 
 /// "octree θ=0.5 p=2 n=16384" — short enough for a category axis: the case key (whose form

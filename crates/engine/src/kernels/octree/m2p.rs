@@ -11,13 +11,27 @@
 use super::moments::sym;
 use super::nodes::NodeList;
 use crate::kernels::rows::Target;
-use crate::physics::InverseSquare;
+use crate::physics::{InverseSquare, PairLaw};
 use crate::real::Real;
 #[cfg(target_arch = "x86_64")]
 use crate::{
     kernels::lanes::{Avx2F32, Avx2F64, Avx512F32, Avx512F64, Isa, Lanes, is, isa, same},
     simd::{run_avx2, run_avx512},
 };
+
+impl<T: Real, const D: usize> NodeList<T, D> {
+    /// Force on `t` from every listed node, on the timed path: the batched loop for an
+    /// inverse-square law where the machine has one, else [`NodeList::gather`].
+    #[inline(always)]
+    pub fn forces<L: PairLaw<T>>(&self, law: &L, t: &Target<T, D>) -> [T; D] {
+        if let Some(p) = law.inverse_square()
+            && let Some(force) = node_forces(self, &p, t)
+        {
+            return force;
+        }
+        self.gather::<L, false>(law, t).force
+    }
+}
 
 /// The force on `t` from every node of `list` under the law `p`, by this machine's batched
 /// loop; `None` at the baseline instruction set.
@@ -161,7 +175,7 @@ where
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::*;
-    use crate::physics::{Coulomb, Gravity, PairLaw};
+    use crate::physics::{Coulomb, Gravity};
     use crate::simd::{SimdLevel, level};
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64Mcg;

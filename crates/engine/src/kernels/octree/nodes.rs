@@ -86,18 +86,6 @@ impl<T: Real, const D: usize> NodeList<T, D> {
         self.padded = padded;
     }
 
-    /// Force on `t` from every listed node, on the timed path: the batched loop
-    /// ([`super::m2p`]) for an inverse-square law where the machine has one, else [`Self::gather`].
-    #[inline(always)]
-    pub fn forces<L: PairLaw<T>>(&self, law: &L, t: &Target<T, D>) -> [T; D] {
-        if let Some(p) = law.inverse_square()
-            && let Some(force) = super::m2p::node_forces(self, &p, t)
-        {
-            return force;
-        }
-        self.gather::<L, false>(law, t).force
-    }
-
     /// Force on `t` from every listed node; with `PROBE`, also the energy and the number of
     /// real entries that interact.
     #[inline(always)]
