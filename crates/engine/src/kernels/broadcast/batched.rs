@@ -199,7 +199,6 @@ where
                     xj[d] = V::splat(*src.pos[d].get_unchecked(j));
                 }
                 let sj = V::splat(*src.s.get_unchecked(j));
-                let slot = V::splat(V::Elem::of(j.wrapping_sub(own) as f64));
                 for k in 0..K {
                     let mut r2 = self.eps2;
                     let mut dx = [self.eps2; D];
@@ -213,6 +212,8 @@ where
                         c = c.zero_where_less(r2, self.quench2);
                     }
                     if MINE {
+                        // Lane `j − own` is the one whose own slot this is.
+                        let slot = V::splat(V::Elem::of((j - own) as f64));
                         c = c.zero_where_equal(self.lane[k], slot);
                     }
                     for d in 0..D {

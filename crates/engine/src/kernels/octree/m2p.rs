@@ -10,7 +10,7 @@
 
 use super::moments::sym;
 use super::nodes::NodeList;
-use crate::kernels::rows::Target;
+use crate::kernels::rows::{LANES, Target};
 use crate::physics::{InverseSquare, PairLaw};
 use crate::real::Real;
 #[cfg(target_arch = "x86_64")]
@@ -161,7 +161,7 @@ where
         let scale = p.k * t.s;
         let mut force = [zero; D];
         for d in 0..D {
-            let mut lanes = [zero; 16];
+            let mut lanes = [zero; LANES];
             acc[d].store(&mut lanes[0]);
             for &v in &lanes[..width] {
                 force[d] += v;
