@@ -29,6 +29,17 @@ pub(crate) fn isa() -> Option<Isa> {
     }
 }
 
+/// Every instruction set with batched kernels that this machine can run, for tests that
+/// compare each with the portable loops.
+#[cfg(test)]
+pub(crate) fn isas_here() -> Vec<Isa> {
+    match level() {
+        SimdLevel::Avx512 => vec![Isa::Avx512, Isa::Avx2],
+        SimdLevel::Avx2 => vec![Isa::Avx2],
+        SimdLevel::Baseline => vec![],
+    }
+}
+
 /// Whether the generic `T` is `U` (to pick a kernel's precision).
 #[inline(always)]
 pub(crate) fn is<T: 'static, U: 'static>() -> bool {
@@ -58,6 +69,7 @@ pub(super) unsafe trait Lanes: Copy {
     /// `WIDTH` elements from `p` (no alignment needed).
     unsafe fn load(p: *const Self::Elem) -> Self;
     unsafe fn store(self, p: *mut Self::Elem);
+    unsafe fn add(self, b: Self) -> Self;
     unsafe fn sub(self, b: Self) -> Self;
     unsafe fn mul(self, b: Self) -> Self;
     /// `self · b + c`, rounded once.
@@ -82,7 +94,7 @@ unsafe fn newton<V: Lanes>(y: V, half: V, three_halves: V) -> V {
 
 macro_rules! lanes {
     ($name:ident, $reg:ty, $elem:ty, $width:expr,
-     splat $splat:ident, load $load:ident, store $store:ident, sub $sub:ident, mul $mul:ident,
+     splat $splat:ident, load $load:ident, store $store:ident, add $add:ident, sub $sub:ident, mul $mul:ident,
      fma $fma:ident, fnma $fnma:ident, rsqrt |$x:ident| $rsqrt:expr, newton_steps $steps:expr,
      less |$a:ident, $b:ident, $v:ident| $less:expr, equal |$ea:ident, $eb:ident, $ev:ident| $equal:expr) => {
         #[cfg(target_arch = "x86_64")]
@@ -106,6 +118,10 @@ macro_rules! lanes {
             #[inline(always)]
             unsafe fn store(self, p: *mut $elem) {
                 unsafe { $store(p, self.0) }
+            }
+            #[inline(always)]
+            unsafe fn add(self, b: Self) -> Self {
+                unsafe { $name($add(self.0, b.0)) }
             }
             #[inline(always)]
             unsafe fn sub(self, b: Self) -> Self {
@@ -157,12 +173,12 @@ macro_rules! lanes {
 // AVX-512: a 14-bit estimate (relative error below 2^-14); f64 takes two Newton steps
 // (6.1e-5 → 5.6e-9 → 4.7e-17, rounding), f32 one (→ 5.6e-9, below its rounding).
 lanes!(Avx512F64, __m512d, f64, 8, 
-    splat _mm512_set1_pd, load _mm512_loadu_pd, store _mm512_storeu_pd, sub _mm512_sub_pd,
+    splat _mm512_set1_pd, load _mm512_loadu_pd, store _mm512_storeu_pd, add _mm512_add_pd, sub _mm512_sub_pd,
     mul _mm512_mul_pd, fma _mm512_fmadd_pd, fnma _mm512_fnmadd_pd, rsqrt |x| _mm512_rsqrt14_pd(x), newton_steps 2,
     less |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_LT_OQ>(a, b), v),
     equal |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, b), v));
 lanes!(Avx512F32, __m512, f32, 16, 
-    splat _mm512_set1_ps, load _mm512_loadu_ps, store _mm512_storeu_ps, sub _mm512_sub_ps,
+    splat _mm512_set1_ps, load _mm512_loadu_ps, store _mm512_storeu_ps, add _mm512_add_ps, sub _mm512_sub_ps,
     mul _mm512_mul_ps, fma _mm512_fmadd_ps, fnma _mm512_fnmadd_ps, rsqrt |x| _mm512_rsqrt14_ps(x), newton_steps 1,
     less |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b), v),
     equal |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b), v));
@@ -170,13 +186,13 @@ lanes!(Avx512F32, __m512, f32, 16,
 // f32 and back around it and takes three steps (→ 2.0e-7 → 6.0e-14 → rounding), f32 two
 // (→ 2.0e-7 → rounding). The f32 estimate needs x in f32's normal range (1.2e-38 to 3.4e38).
 lanes!(Avx2F64, __m256d, f64, 4, 
-    splat _mm256_set1_pd, load _mm256_loadu_pd, store _mm256_storeu_pd, sub _mm256_sub_pd,
+    splat _mm256_set1_pd, load _mm256_loadu_pd, store _mm256_storeu_pd, add _mm256_add_pd, sub _mm256_sub_pd,
     mul _mm256_mul_pd, fma _mm256_fmadd_pd, fnma _mm256_fnmadd_pd,
     rsqrt |x| _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(x))), newton_steps 3,
     less |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(a, b), v),
     equal |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(a, b), v));
 lanes!(Avx2F32, __m256, f32, 8, 
-    splat _mm256_set1_ps, load _mm256_loadu_ps, store _mm256_storeu_ps, sub _mm256_sub_ps,
+    splat _mm256_set1_ps, load _mm256_loadu_ps, store _mm256_storeu_ps, add _mm256_add_ps, sub _mm256_sub_ps,
     mul _mm256_mul_ps, fma _mm256_fmadd_ps, fnma _mm256_fnmadd_ps, rsqrt |x| _mm256_rsqrt_ps(x), newton_steps 2,
     less |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b), v),
     equal |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(a, b), v));

@@ -228,20 +228,11 @@ where
 #[cfg(all(test, target_arch = "x86_64"))]
 mod tests {
     use super::*;
+    use crate::kernels::lanes::isas_here;
     use crate::physics::{Coulomb, Gravity, PairLaw, pair_force};
-    use crate::simd::{SimdLevel, level};
     use crate::testing::SEED_1;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64Mcg;
-
-    /// The instruction sets this CPU can run.
-    fn isas() -> Vec<Isa> {
-        match level() {
-            SimdLevel::Avx512 => vec![Isa::Avx512, Isa::Avx2],
-            SimdLevel::Avx2 => vec![Isa::Avx2],
-            SimdLevel::Baseline => vec![],
-        }
-    }
 
     /// Sources scattered in the unit cube with strengths of both signs (a fixed sequence),
     /// source 3 placed on source 0 (a coincident pair).
@@ -281,7 +272,7 @@ mod tests {
         let src = Sources::range(&pos, &s, 0, n);
         let wide = law.widen();
         let p = law.inverse_square().expect("an inverse-square law");
-        for isa in isas() {
+        for isa in isas_here() {
             // SAFETY: `isas` lists only what this CPU runs.
             let got = unsafe { forces_on(isa, &p, &tile, &src, if own { lo } else { usize::MAX }) }
                 .expect("a kernel for f32 and f64");
@@ -337,7 +328,7 @@ mod tests {
                 let tile = Tile::load(&pos, &s, 0, 1);
                 let none = Sources::range(&pos, &s, 0, 0);
                 let p = gravity.inverse_square().expect("gravity");
-                for isa in isas() {
+                for isa in isas_here() {
                     // SAFETY: as above.
                     let got = unsafe { forces_on(isa, &p, &tile, &none, usize::MAX) };
                     assert_eq!(got, Some([[0.0; LANES]; 3]));

@@ -45,15 +45,15 @@ pub struct Expansion {
     pub len: usize,
     /// For every index past 0: the index of `n − e_d`, the dimension `d` and `1/n_d`, so that
     /// `v^n/n! = (v^{n−e_d}/(n−e_d)!) · v_d / n_d`.
-    step: Vec<(usize, usize, f64)>,
+    pub(super) step: Vec<(usize, usize, f64)>,
     /// `add[m · len + k]` = index of `m + k`, for `|k| ≤ p − |m|`: the first `row_len[m] =
     /// terms(p − |m|)` indices k, as the order is graded.
-    add: Vec<u16>,
-    row_len: Vec<usize>,
+    pub(super) add: Vec<u16>,
+    pub(super) row_len: Vec<usize>,
     /// Derivative terms of every index (CSR by `deriv_start`): `(coefficient, monomial index,
     /// j)`, the coefficient `Π a!/(2^i i!)` including the factorial of the scaled monomial.
-    deriv_start: Vec<usize>,
-    deriv: Vec<(f64, u16, u8)>,
+    pub(super) deriv_start: Vec<usize>,
+    pub(super) deriv: Vec<(f64, u16, u8)>,
     /// For every index n, the pairs `(k, n − k)` with `k ≤ n` componentwise (M2M).
     conv_start: Vec<usize>,
     conv: Vec<(u16, u16)>,

@@ -19,9 +19,9 @@
 //! a fixed order, so the forces are the same bits at every thread count (see [`walk`]). The
 //! expansions are computed in f64 whatever the precision of the particles, the cell–cell
 //! interactions of a cell with `LANES` partners at a time in SIMD lanes; the near field runs
-//! in the state's precision. Both go through `simd::dispatch`; the cell–cell loop does the
-//! same operations at every instruction set, while the near field of a 1/r² law runs the
-//! batched intrinsics of `broadcast`, whose last bits differ between instruction sets.
+//! in the state's precision. Both run intrinsics for AVX-512 or AVX2 where the machine has
+//! them (the cell–cell loop in [`m2l`], the near field of a 1/r² law in `broadcast`), whose
+//! last bits differ between instruction sets, and portable loops at the baseline.
 //!
 //! Counters: `pair_checks` counts the particle pairs of the near field (each pair once),
 //! `nodes_accepted` the cell–cell interactions, `nodes_opened` the pairs of cells split.
@@ -32,6 +32,7 @@
 //! pair and its entry in both cells' lists). `footprint` has the measured totals.
 
 mod expansion;
+mod m2l;
 mod near;
 mod tree;
 mod walk;
@@ -259,20 +260,29 @@ fn far_of_cell<W: PairLaw<f64>>(
     let len = exp.len;
     let eps2 = wide.softening2();
     let z = cells.centre[c];
+    let isa = m2l::isa();
     for row in &mut batch.la[..len] {
         *row = [0.0; LANES];
     }
     for group in partners.chunks(LANES) {
         let mut r = [[0.0; LANES]; 3];
-        for l in 0..LANES {
-            // Lanes past the partners repeat the first one with a zero multipole.
-            let b = group[if l < group.len() { l } else { 0 }] as usize;
+        for (l, &b) in group.iter().enumerate() {
+            let b = b as usize;
             for d in 0..3 {
                 r[d][l] = z[d] - cells.centre[b][d];
             }
             let m = &cells.multipole[b * len..(b + 1) * len];
             for (row, &v) in batch.mb[..len].iter_mut().zip(m) {
-                row[l] = if l < group.len() { v } else { 0.0 };
+                row[l] = v;
+            }
+        }
+        // Lanes past the partners repeat the first one's offset with a zero multipole.
+        for l in group.len()..LANES {
+            for d in 0..3 {
+                r[d][l] = r[d][0];
+            }
+            for row in &mut batch.mb[..len] {
+                row[l] = 0.0;
             }
         }
         let r2: Lanes =
@@ -280,15 +290,20 @@ fn far_of_cell<W: PairLaw<f64>>(
         let coeff: Lanes = std::array::from_fn(|l| wide.coeff(r2[l], 1.0, 1.0));
         let soft: Lanes = std::array::from_fn(|l| r2[l] + eps2);
         expansion::scaled_derivatives(&coeff, &soft, exp.p, &mut batch.dj);
-        exp.m2l_lanes(
-            &r,
-            &batch.dj,
-            &batch.mb,
-            &mut batch.la,
-            first,
-            &mut batch.mono,
-            &mut batch.t,
-        );
+        // SAFETY: `m2l::isa()` has checked the CPU.
+        unsafe {
+            m2l::m2l_batch(
+                isa,
+                exp,
+                &r,
+                &batch.dj,
+                &batch.mb,
+                &mut batch.la,
+                first,
+                &mut batch.mono,
+                &mut batch.t,
+            );
+        }
     }
     for (out, lanes) in local.iter_mut().zip(&batch.la[..len]) {
         *out = crate::kernels::rows::lane_sum(*lanes);
