@@ -1,5 +1,9 @@
 //! Shared fixtures for tests and benches: seeded random configurations, and the comparisons
-//! of force fields that the kernels' tests make against the direct sum.
+//! of force fields that the kernels' tests make against the direct sum ([`short_range`] has
+//! the short-range kernels' own).
+
+#[cfg(test)]
+pub(crate) mod short_range;
 
 #[cfg(test)]
 use crate::kernels::{ForceKernel, ForceReport};

@@ -2,95 +2,31 @@
 //! states, serial and parallel.
 
 use super::*;
-use crate::kernels::Naive;
 use crate::physics::{Coulomb, LennardJones};
 use crate::state::zero_field;
+use crate::testing::short_range::{SIGMA, agrees_with_naive, lj, spaced_states};
 use crate::testing::{SEED_1, SEED_2, on_threads, random_state, spaced_state};
 
-const SIGMA: f64 = 0.01;
-
-fn lj<T: Real>(rc: f64) -> LennardJones<T> {
-    LennardJones::new(1.0, SIGMA, rc)
-}
-
-/// Relative force tolerance (of the largest force) for a precision: summation order differs.
-fn tol<T: Real>() -> f64 {
-    if T::EPSILON_F64 > 1e-10 { 1e-4 } else { 1e-10 }
-}
-
-/// Runs `f` on a rayon pool of `p` threads.
-/// Compares forces, energy and interacting pairs of `kernel` with the naive kernel on `state`,
-/// at 1 and 2 threads, both the timed and the probe path.
+/// The comparison with the naive kernel, with the list's own check: no more pairs looked at
+/// than there are.
 fn agrees_with<T: Real, const D: usize>(
     kernel: &mut CellList<LennardJones<T>, T, D>,
     state: &State<T, D>,
     law: LennardJones<T>,
 ) {
-    let n = state.len();
-    let mut want = zero_field::<T, D>(n);
-    let oracle = Naive::new(law).compute(state, &mut want, true);
-    let fmax = (0..n)
-        .map(|i| {
-            (0..D)
-                .map(|d| want[d][i].as_f64().powi(2))
-                .sum::<f64>()
-                .sqrt()
-        })
-        .fold(0.0, f64::max);
-    for p in [1, 2] {
-        for probe in [false, true] {
-            let mut got = zero_field::<T, D>(n);
-            let report = on_threads(p, || kernel.compute(state, &mut got, probe));
-            for i in 0..n {
-                let err: f64 = (0..D)
-                    .map(|d| (got[d][i].as_f64() - want[d][i].as_f64()).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                assert!(
-                    err <= tol::<T>() * fmax,
-                    "{} D={D} n={n} p={p} probe={probe}: particle {i} off by {err:e} (max |F| {fmax:e})",
-                    T::NAME
-                );
-            }
-            assert!(report.work.pair_checks <= (n * n.saturating_sub(1)) as u64);
-            if probe {
-                let (e, e0) = (report.energy.expect("probe energy"), oracle.energy.unwrap());
-                let scale = e0.abs().max(1e-3);
-                let etol = if T::EPSILON_F64 > 1e-10 { 1e-5 } else { 1e-9 };
-                assert!(
-                    (e - e0).abs() <= etol * scale,
-                    "{} D={D} n={n}: energy {e} vs naive {e0}",
-                    T::NAME
-                );
-                assert_eq!(
-                    report.work.pairs_interacting, oracle.work.pairs_interacting,
-                    "interacting pairs"
-                );
-            }
-        }
-    }
+    let n = state.len() as u64;
+    agrees_with_naive(kernel, state, law, |_, run| {
+        assert!(run.report.work.pair_checks <= n * n.saturating_sub(1));
+    });
 }
 
 /// Random spaced states (no two particles closer than 0.8σ) at a few sizes and densities.
 fn random_states<T: Real, const D: usize>() {
-    // Liquid-like: ~8 neighbours inside rc = 2.5σ.
-    let density = if D == 2 { 4000.0 } else { 1.2e5 };
     let law = lj::<T>(2.5 * SIGMA);
     let mut kernel = CellList::new(law).expect("LJ has a cutoff");
-    for (n, seed) in [
-        (1, SEED_1),
-        (2, SEED_2),
-        (7, SEED_1),
-        (100, SEED_2),
-        (3000, SEED_1),
-    ] {
-        let side = (n as f64 / density).powf(1.0 / D as f64);
-        let state = spaced_state::<T, D>(n, side, 0.8 * SIGMA, seed);
-        agrees_with(&mut kernel, &state, law);
-        // The same particles spread out: most bins empty, a few interacting pairs.
-        let state = spaced_state::<T, D>(n.min(100), 4.0 * side, 0.8 * SIGMA, seed);
-        agrees_with(&mut kernel, &state, law);
-    }
+    // Liquid-like: ~8 neighbours inside rc = 2.5σ.
+    let density = if D == 2 { 4000.0 } else { 1.2e5 };
+    spaced_states::<T, D>(density, |state| agrees_with(&mut kernel, state, law));
 }
 
 #[test]

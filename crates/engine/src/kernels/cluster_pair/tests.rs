@@ -6,87 +6,28 @@ use super::*;
 use crate::kernels::Naive;
 use crate::physics::LennardJones;
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, on_threads, spaced_state};
+use crate::testing::short_range::{SIGMA, agrees_with_naive, lj, spaced_states};
+use crate::testing::{SEED_1, SEED_2, max_rel_diff, on_threads, spaced_state};
 
-const SIGMA: f64 = 0.01;
 const SKIN: f64 = 0.3 * SIGMA;
 
-fn lj<T: Real>(rc: f64) -> LennardJones<T> {
-    LennardJones::new(1.0, SIGMA, rc)
-}
-
-/// Relative force tolerance (of the largest force) for a precision: summation order differs.
-fn tol<T: Real>() -> f64 {
-    if T::EPSILON_F64 > 1e-10 { 1e-4 } else { 1e-10 }
-}
-
-/// The largest |a − b| over particles over the largest |b|.
-fn relative_error<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> f64 {
-    let norm = |f: &Field<T, D>, g: Option<&Field<T, D>>, i: usize| {
-        (0..D)
-            .map(|d| (f[d][i].as_f64() - g.map_or(0.0, |g| g[d][i].as_f64())).powi(2))
-            .sum::<f64>()
-            .sqrt()
-    };
-    let n = a[0].len();
-    let err = (0..n).map(|i| norm(a, Some(b), i)).fold(0.0, f64::max);
-    let max = (0..n).map(|i| norm(b, None, i)).fold(0.0, f64::max);
-    err / max.max(f64::MIN_POSITIVE)
-}
-
-/// Compares forces, energy and interacting pairs with the naive kernel on `state`, at 1 and 2
-/// threads, the timed and the probe path.
+/// The comparison with the naive kernel, with the list's own check: its runs counted.
 fn agrees_with<T: Real, const D: usize>(
     kernel: &mut ClusterPair<LennardJones<T>, T, D>,
     state: &State<T, D>,
     law: LennardJones<T>,
 ) {
-    let n = state.len();
-    let mut want = zero_field::<T, D>(n);
-    let oracle = Naive::new(law).compute(state, &mut want, true);
-    for p in [1, 2] {
-        for probe in [false, true] {
-            let mut got = zero_field::<T, D>(n);
-            let report = on_threads(p, || kernel.compute(state, &mut got, probe));
-            let err = relative_error(&got, &want);
-            assert!(
-                err <= tol::<T>(),
-                "{} D={D} n={n} p={p} probe={probe}: off by {err:e}",
-                T::NAME
-            );
-            assert_eq!(report.work.list_entries, kernel.runs());
-            if probe {
-                let (e, e0) = (report.energy.expect("probe energy"), oracle.energy.unwrap());
-                let etol = if T::EPSILON_F64 > 1e-10 { 1e-5 } else { 1e-9 };
-                assert!(
-                    (e - e0).abs() <= etol * e0.abs().max(1e-3),
-                    "{} D={D} n={n}: energy {e} vs naive {e0}",
-                    T::NAME
-                );
-                assert_eq!(report.work.pairs_interacting, oracle.work.pairs_interacting);
-            }
-        }
-    }
+    agrees_with_naive(kernel, state, law, |kernel, run| {
+        assert_eq!(run.report.work.list_entries, kernel.runs());
+    });
 }
 
 /// Random spaced states (no two particles closer than 0.8σ), dense and dilute.
 fn random_states<T: Real, const D: usize>() {
-    let density = if D == 2 { 8000.0 } else { 6e5 };
     let law = lj::<T>(2.5 * SIGMA);
     let mut kernel = ClusterPair::new(law, SKIN).expect("LJ has a cutoff");
-    for (n, seed) in [
-        (1, SEED_1),
-        (2, SEED_2),
-        (7, SEED_1),
-        (100, SEED_2),
-        (3000, SEED_1),
-    ] {
-        let side = (n as f64 / density).powf(1.0 / D as f64);
-        let state = spaced_state::<T, D>(n, side, 0.8 * SIGMA, seed);
-        agrees_with(&mut kernel, &state, law);
-        let state = spaced_state::<T, D>(n.min(100), 4.0 * side, 0.8 * SIGMA, seed);
-        agrees_with(&mut kernel, &state, law);
-    }
+    let density = if D == 2 { 8000.0 } else { 6e5 };
+    spaced_states::<T, D>(density, |state| agrees_with(&mut kernel, state, law));
 }
 
 #[test]
@@ -173,7 +114,7 @@ fn a_moving_run_agrees_at_every_step() {
         rebuilds += report.work.rebuilds;
         let mut want = zero_field::<f64, 2>(n);
         Naive::new(law).compute(&state, &mut want, false);
-        let err = relative_error(&got, &want);
+        let err = max_rel_diff(&got, &want);
         assert!(err <= 1e-10, "step {step}: off by {err:e}");
         for d in 0..2 {
             for x in state.pos[d].iter_mut() {

@@ -6,101 +6,47 @@ use super::*;
 use crate::kernels::{MIN_PARALLEL_PAIRS, Naive};
 use crate::physics::{Coulomb, LennardJones};
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, on_threads, random_state, spaced_state};
+use crate::testing::short_range::{SIGMA, agrees_with_naive, force_tol, lj, spaced_states};
+use crate::testing::{SEED_1, SEED_2, max_rel_diff, on_threads, random_state, spaced_state};
 
-const SIGMA: f64 = 0.01;
 const SKIN: f64 = 0.3 * SIGMA;
 
-fn lj<T: Real>(rc: f64) -> LennardJones<T> {
-    LennardJones::new(1.0, SIGMA, rc)
-}
-
-/// Relative force tolerance (of the largest force) for a precision: summation order differs.
-fn tol<T: Real>() -> f64 {
-    if T::EPSILON_F64 > 1e-10 { 1e-4 } else { 1e-10 }
-}
-
-/// The largest |a − b| over particles, and the largest |b|.
-fn worst<T: Real, const D: usize>(a: &Field<T, D>, b: &Field<T, D>) -> (f64, f64) {
-    let norm = |f: &Field<T, D>, g: Option<&Field<T, D>>, i: usize| {
-        (0..D)
-            .map(|d| (f[d][i].as_f64() - g.map_or(0.0, |g| g[d][i].as_f64())).powi(2))
-            .sum::<f64>()
-            .sqrt()
-    };
-    let n = a[0].len();
-    let err = (0..n).map(|i| norm(a, Some(b), i)).fold(0.0, f64::max);
-    let max = (0..n).map(|i| norm(b, None, i)).fold(0.0, f64::max);
-    (err, max)
-}
-
-/// Compares forces, energy and interacting pairs with the naive kernel on `state`, at 1 and 2
-/// threads, the timed and the probe path, and the targets of two blocks.
+/// The comparison with the naive kernel, with the list's own checks: its entries counted, and
+/// after the probe run the forces on the targets of two blocks (`compute_targets`).
 fn agrees_with<T: Real, const D: usize>(
     kernel: &mut Verlet<LennardJones<T>, T, D>,
     state: &State<T, D>,
     law: LennardJones<T>,
 ) {
     let n = state.len();
-    let mut want = zero_field::<T, D>(n);
-    let oracle = Naive::new(law).compute(state, &mut want, true);
-    for p in [1, 2] {
-        for probe in [false, true] {
-            let mut got = zero_field::<T, D>(n);
-            let report = on_threads(p, || kernel.compute(state, &mut got, probe));
-            let (err, max) = worst(&got, &want);
-            assert!(
-                err <= tol::<T>() * max,
-                "{} D={D} n={n} p={p} probe={probe}: off by {err:e} (max |F| {max:e})",
-                T::NAME
-            );
-            assert_eq!(report.work.list_entries, kernel.entries());
-            if probe {
-                let (e, e0) = (report.energy.expect("probe energy"), oracle.energy.unwrap());
-                let etol = if T::EPSILON_F64 > 1e-10 { 1e-5 } else { 1e-9 };
-                assert!(
-                    (e - e0).abs() <= etol * e0.abs().max(1e-3),
-                    "{} D={D} n={n}: energy {e} vs naive {e0}",
-                    T::NAME
-                );
-                assert_eq!(report.work.pairs_interacting, oracle.work.pairs_interacting);
-            }
+    agrees_with_naive(kernel, state, law, |kernel, run| {
+        assert_eq!(run.report.work.list_entries, kernel.entries());
+        if !run.probe {
+            return;
         }
         let half = n / 2;
         for block in [0..half, half..n] {
             let mut part = zero_field::<T, D>(block.len());
             let out = part.each_mut().map(|f| f.as_mut_slice());
-            on_threads(p, || kernel.compute_targets(state, block.clone(), out));
-            let want_block: Field<T, D> = std::array::from_fn(|d| want[d][block.clone()].to_vec());
-            let (err, max) = worst(&part, &want_block);
+            on_threads(run.p, || kernel.compute_targets(state, block.clone(), out));
+            let want: Field<T, D> = std::array::from_fn(|d| run.want[d][block.clone()].to_vec());
+            let err = max_rel_diff(&part, &want);
             assert!(
-                err <= tol::<T>() * max.max(f64::MIN_POSITIVE),
-                "{} D={D} n={n} p={p} targets {block:?}: off by {err:e}",
-                T::NAME
+                err <= force_tol::<T>(),
+                "{} D={D} n={n} p={} targets {block:?}: off by {err:e}",
+                T::NAME,
+                run.p
             );
         }
-    }
+    });
 }
 
 /// Random spaced states (no two particles closer than 0.8σ) at a few sizes and densities.
 fn random_states<T: Real, const D: usize>() {
-    let density = if D == 2 { 4000.0 } else { 1.2e5 };
     let law = lj::<T>(2.5 * SIGMA);
     let mut kernel = Verlet::new(law, SKIN).expect("LJ has a cutoff");
-    for (n, seed) in [
-        (1, SEED_1),
-        (2, SEED_2),
-        (7, SEED_1),
-        (100, SEED_2),
-        (3000, SEED_1),
-    ] {
-        let side = (n as f64 / density).powf(1.0 / D as f64);
-        let state = spaced_state::<T, D>(n, side, 0.8 * SIGMA, seed);
-        agrees_with(&mut kernel, &state, law);
-        // The same particles spread out: most bins empty, a few interacting pairs.
-        let state = spaced_state::<T, D>(n.min(100), 4.0 * side, 0.8 * SIGMA, seed);
-        agrees_with(&mut kernel, &state, law);
-    }
+    let density = if D == 2 { 4000.0 } else { 1.2e5 };
+    spaced_states::<T, D>(density, |state| agrees_with(&mut kernel, state, law));
 }
 
 #[test]
