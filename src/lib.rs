@@ -15,7 +15,7 @@ pub mod console;
 
 pub use nbody_engine::{
     boundary, clock, decomp, engine, export, geometry, input, integrator, kernels, output, par,
-    physics, real, run, scenario, simd, state, stats, stepper, testing, validate,
+    physics, real, run, scenario, simd, state, stats, stepper, validate,
 };
 
 pub mod analysis;

@@ -8,7 +8,7 @@ use crate::records::config::SweepConfig;
 use crate::records::plan::cases;
 use crate::records::results::{CaseRecord, Metadata, RESULTS_SCHEMA};
 use crate::records::round::RoundOutcome;
-use crate::testing::{SEED_1, SEED_2};
+use nbody_engine::testing::{SEED_1, SEED_2};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::path::Path;

@@ -4,7 +4,7 @@
 use nbody_bench::kernels::{CompiledKernels, KernelKind, KernelParams};
 use nbody_bench::physics::{Coulomb, Gravity, LennardJones};
 use nbody_bench::state::{Field, State, zero_field};
-use nbody_bench::testing::{random_state, spaced_state};
+use nbody_engine::testing::{random_state, spaced_state};
 use proptest::prelude::*;
 
 fn forces<L: CompiledKernels<f64, D>, const D: usize>(

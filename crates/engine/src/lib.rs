@@ -29,7 +29,9 @@ pub mod simd;
 pub mod state;
 pub mod stats;
 pub mod stepper;
-#[doc(hidden)]
+/// Test fixtures: in the crate's own tests, and for other crates' tests through the `testing`
+/// feature (never in a build that measures).
+#[cfg(any(test, feature = "testing"))]
 pub mod testing;
 pub mod validate;
 
