@@ -30,6 +30,36 @@ use crate::simd::LANES;
 /// One value per SIMD lane.
 pub(crate) type Lanes = [f64; LANES];
 
+/// The rows of one M2L batch, `LANES` partner cells in the lanes; reused across batches.
+pub(crate) struct Batch {
+    /// The separations `z_A − z_B`, per dimension.
+    pub r: [Lanes; 3],
+    /// The scalar derivatives `κ D_j`, j = 0..=p (see [`scaled_derivatives`]).
+    pub dj: Vec<Lanes>,
+    /// The partners' multipoles, `len` rows.
+    pub mb: Vec<Lanes>,
+    /// The local expansion being summed, `len` rows.
+    pub la: Vec<Lanes>,
+    /// Scratch of `len` rows: the monomials and the derivative tensor.
+    pub mono: Vec<Lanes>,
+    pub t: Vec<Lanes>,
+}
+
+impl Batch {
+    /// Zeroed rows for expansions of `len` coefficients.
+    pub(crate) fn new(len: usize) -> Self {
+        let rows = || vec![[0.0; LANES]; len];
+        Batch {
+            r: [[0.0; LANES]; 3],
+            dj: vec![[0.0; LANES]; MAX_ORDER + 1],
+            mb: rows(),
+            la: rows(),
+            mono: rows(),
+            t: rows(),
+        }
+    }
+}
+
 /// Highest supported expansion order.
 pub const MAX_ORDER: usize = 8;
 
@@ -186,26 +216,22 @@ impl Expansion {
     }
 
     /// M2L onto one cell from `LANES` source cells at once, one in each lane (SIMD across
-    /// the cell's partners): with `r[d][l]` the separation `z_A − z_B` of lane l's partner,
-    /// `dj[j][l]` the scalar derivatives there (see [`scaled_derivatives`]) and `mb[n][l]` its
-    /// multipole, adds `Σ_{|n| ≤ p − |m|} M[n] ∂^{n+m} G(R)` to `la[m][l]` for every local
-    /// index m from `first` on (1 for forces only: the potential `L_0` is needed for the
-    /// energy alone). A lane of zero multipole adds nothing. `mono` and `t` are scratch of
-    /// `len` rows. Lanes never mix, so each lane's sum is the same whichever lanes share its
-    /// batch.
+    /// the cell's partners): with `b.r[d][l]` the separation `z_A − z_B` of lane l's partner,
+    /// `b.dj[j][l]` the scalar derivatives there (see [`scaled_derivatives`]) and `b.mb[n][l]`
+    /// its multipole, adds `Σ_{|n| ≤ p − |m|} M[n] ∂^{n+m} G(R)` to `b.la[m][l]` for every
+    /// local index m from `first` on (1 for forces only: the potential `L_0` is needed for
+    /// the energy alone). A lane of zero multipole adds nothing. Lanes never mix, so each
+    /// lane's sum is the same whichever lanes share its batch.
     #[inline(always)]
-    pub(crate) fn m2l_lanes(
-        &self,
-        r: &[Lanes; 3],
-        dj: &[Lanes],
-        mb: &[Lanes],
-        la: &mut [Lanes],
-        first: usize,
-        mono: &mut [Lanes],
-        t: &mut [Lanes],
-    ) {
+    pub(crate) fn m2l_lanes(&self, b: &mut Batch, first: usize) {
         let len = self.len;
-        let (mono, t, mb, la) = (&mut mono[..len], &mut t[..len], &mb[..len], &mut la[..len]);
+        let (r, dj) = (&b.r, &b.dj);
+        let (mono, t, mb, la) = (
+            &mut b.mono[..len],
+            &mut b.t[..len],
+            &b.mb[..len],
+            &mut b.la[..len],
+        );
         mono[0] = [1.0; LANES];
         for i in 1..len {
             let (parent, d, inv) = self.step[i];

@@ -10,7 +10,7 @@
 //! same bits at every thread count; they differ from the portable loop's in the last bits,
 //! where a fused multiply-add rounds once.
 
-use super::expansion::{Expansion, Lanes as Rows};
+use super::expansion::{Batch, Expansion};
 pub(super) use crate::kernels::lanes::{Isa, isa};
 use crate::kernels::rows::LANES;
 #[cfg(target_arch = "x86_64")]
@@ -25,32 +25,19 @@ use crate::{
 /// # Safety
 /// The CPU must have the features of `isa`.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-pub(super) unsafe fn m2l_batch(
-    isa: Option<Isa>,
-    exp: &Expansion,
-    r: &[Rows; 3],
-    dj: &[Rows],
-    mb: &[Rows],
-    la: &mut [Rows],
-    first: usize,
-    mono: &mut [Rows],
-    t: &mut [Rows],
-) {
+pub(super) unsafe fn m2l_batch(isa: Option<Isa>, exp: &Expansion, b: &mut Batch, first: usize) {
     #[cfg(target_arch = "x86_64")]
     if let Some(isa) = isa {
         // SAFETY: the caller has checked the CPU for the features `run_*` enables.
         unsafe {
             match isa {
-                Isa::Avx512 => {
-                    run_avx512(|| batch::<Avx512F64>(exp, r, dj, mb, la, first, mono, t))
-                }
-                Isa::Avx2 => run_avx2(|| batch::<Avx2F64>(exp, r, dj, mb, la, first, mono, t)),
+                Isa::Avx512 => run_avx512(|| batch::<Avx512F64>(exp, b, first)),
+                Isa::Avx2 => run_avx2(|| batch::<Avx2F64>(exp, b, first)),
             }
         }
         return;
     }
-    exp.m2l_lanes(r, dj, mb, la, first, mono, t);
+    exp.m2l_lanes(b, first);
 }
 
 /// The batch in vectors of `V::WIDTH` lanes, each vector of partners through the whole
@@ -58,32 +45,23 @@ pub(super) unsafe fn m2l_batch(
 /// that it inlines into the closures above).
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn batch<V: Lanes<Elem = f64>>(
-    exp: &Expansion,
-    r: &[Rows; 3],
-    dj: &[Rows],
-    mb: &[Rows],
-    la: &mut [Rows],
-    first: usize,
-    mono: &mut [Rows],
-    t: &mut [Rows],
-) {
+fn batch<V: Lanes<Elem = f64>>(exp: &Expansion, b: &mut Batch, first: usize) {
     let len = exp.len;
     assert!(
-        mb.len() >= len && la.len() >= len && mono.len() >= len && t.len() >= len,
+        b.mb.len() >= len && b.la.len() >= len && b.mono.len() >= len && b.t.len() >= len,
         "M2L scratch rows shorter than the expansion"
     );
-    assert!(dj.len() > exp.p, "M2L derivatives shorter than the order");
+    assert!(b.dj.len() > exp.p, "M2L derivatives shorter than the order");
     debug_assert!(LANES.is_multiple_of(V::WIDTH));
+    let r = &b.r;
     // Row `i`'s lanes `h..h + WIDTH` of a table of rows, by pointer (slicing each row,
     // with its bounds checks, cost a quarter of the loop).
     let (mono, t, la) = (
-        mono.as_mut_ptr().cast::<f64>(),
-        t.as_mut_ptr().cast::<f64>(),
-        la.as_mut_ptr().cast::<f64>(),
+        b.mono.as_mut_ptr().cast::<f64>(),
+        b.t.as_mut_ptr().cast::<f64>(),
+        b.la.as_mut_ptr().cast::<f64>(),
     );
-    let (mb, dj) = (mb.as_ptr().cast::<f64>(), dj.as_ptr().cast::<f64>());
+    let (mb, dj) = (b.mb.as_ptr().cast::<f64>(), b.dj.as_ptr().cast::<f64>());
     // SAFETY: every load and store touches lanes `h..h + WIDTH ≤ LANES` of a row that the
     // asserts above put in bounds (the tables' indices are below `len`, the derivatives'
     // below p + 1); the intrinsics run under the caller's features.

@@ -48,7 +48,7 @@ use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
 pub use expansion::MAX_ORDER;
-use expansion::{Expansion, Lanes};
+use expansion::{Batch, Expansion, Lanes};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
@@ -83,28 +83,6 @@ pub struct Fmm<L: PairLaw<T>, T: Real, const D: usize> {
     /// The previous step's near pairs plus cell pairs: the estimate that decides whether to
     /// fork.
     last_work: Option<u64>,
-}
-
-/// Per-task buffers of the far field: a batch of partners in lanes.
-struct Batch {
-    dj: Vec<Lanes>,
-    mb: Vec<Lanes>,
-    la: Vec<Lanes>,
-    mono: Vec<Lanes>,
-    t: Vec<Lanes>,
-}
-
-impl Batch {
-    fn new(len: usize) -> Self {
-        let rows = || vec![[0.0; LANES]; len];
-        Batch {
-            dj: vec![[0.0; LANES]; MAX_ORDER + 1],
-            mb: rows(),
-            la: rows(),
-            mono: rows(),
-            t: rows(),
-        }
-    }
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
@@ -265,7 +243,7 @@ fn far_of_cell<W: PairLaw<f64>>(
         *row = [0.0; LANES];
     }
     for group in partners.chunks(LANES) {
-        let mut r = [[0.0; LANES]; 3];
+        let r = &mut batch.r;
         for (l, &b) in group.iter().enumerate() {
             let b = b as usize;
             for d in 0..3 {
@@ -291,19 +269,7 @@ fn far_of_cell<W: PairLaw<f64>>(
         let soft: Lanes = std::array::from_fn(|l| r2[l] + eps2);
         expansion::scaled_derivatives(&coeff, &soft, exp.p, &mut batch.dj);
         // SAFETY: `m2l::isa()` has checked the CPU.
-        unsafe {
-            m2l::m2l_batch(
-                isa,
-                exp,
-                &r,
-                &batch.dj,
-                &batch.mb,
-                &mut batch.la,
-                first,
-                &mut batch.mono,
-                &mut batch.t,
-            );
-        }
+        unsafe { m2l::m2l_batch(isa, exp, batch, first) };
     }
     for (out, lanes) in local.iter_mut().zip(&batch.la[..len]) {
         *out = crate::kernels::rows::lane_sum(*lanes);

@@ -2,7 +2,7 @@
 //! identities (the shifted expansion is the same polynomial, so only rounding may differ), and
 //! M2L then L2P matches the direct sum with an error that falls with the order.
 
-use super::super::expansion::{self, Expansion, Lanes, MAX_ORDER, terms};
+use super::super::expansion::{self, Batch, Expansion, Lanes, MAX_ORDER, terms};
 use super::super::m2l;
 use crate::kernels::lanes::isas_here;
 use crate::kernels::rows::LANES;
@@ -111,20 +111,17 @@ fn l2l_moves_the_local_expansion_without_changing_it() {
 /// the source in lane 0 and zero multipoles in the other lanes (as a cell's last batch of
 /// partners is padded).
 fn m2l_one<L: PairLaw<f64>>(exp: &Expansion, law: &L, r: [f64; 3], m: &[f64]) -> Vec<f64> {
-    let len = exp.len;
-    let lanes: [Lanes; 3] = std::array::from_fn(|d| [r[d]; LANES]);
-    let mut mb = vec![[0.0; LANES]; len];
-    for (row, &v) in mb.iter_mut().zip(m) {
+    let mut b = Batch::new(exp.len);
+    b.r = std::array::from_fn(|d| [r[d]; LANES]);
+    for (row, &v) in b.mb.iter_mut().zip(m) {
         row[0] = v;
     }
     let r2: f64 = r.iter().map(|x| x * x).sum();
     let coeff = [law.coeff(r2, 1.0, 1.0); LANES];
     let soft = [r2 + law.softening2(); LANES];
-    let mut dj = vec![[0.0; LANES]; MAX_ORDER + 1];
-    expansion::scaled_derivatives(&coeff, &soft, exp.p, &mut dj);
-    let (mut la, mut mono, mut t) = (vec![[0.0; LANES]; len], mb.clone(), mb.clone());
-    exp.m2l_lanes(&lanes, &dj, &mb, &mut la, 0, &mut mono, &mut t);
-    la.iter().map(|row| row[0]).collect()
+    expansion::scaled_derivatives(&coeff, &soft, exp.p, &mut b.dj);
+    exp.m2l_lanes(&mut b, 0);
+    b.la.iter().map(|row| row[0]).collect()
 }
 
 /// Sources within 0.5 of one centre, targets within 0.5 of another at random well-separated
@@ -196,18 +193,26 @@ fn vector_m2l_matches_the_portable_loop_at_every_order() {
     for p in 1..=MAX_ORDER {
         let exp = Expansion::new(p);
         let len = exp.len;
-        let r: [Lanes; 3] = std::array::from_fn(|_| lanes());
-        let dj: Vec<Lanes> = (0..=MAX_ORDER).map(|_| lanes()).collect();
-        let mut mb: Vec<Lanes> = (0..len).map(|_| lanes()).collect();
-        for row in &mut mb {
+        let mut b = Batch::new(len);
+        b.r = std::array::from_fn(|_| lanes());
+        b.dj = (0..=MAX_ORDER).map(|_| lanes()).collect();
+        b.mb = (0..len).map(|_| lanes()).collect();
+        for row in &mut b.mb {
             row[LANES - 1] = 0.0;
         }
         let start: Vec<Lanes> = (0..len).map(|_| lanes()).collect();
         let run = |isa: Option<m2l::Isa>| {
-            let (mut la, mut mono, mut t) = (start.clone(), start.clone(), start.clone());
+            let mut b = Batch {
+                la: start.clone(),
+                mono: start.clone(),
+                t: start.clone(),
+                r: b.r,
+                dj: b.dj.clone(),
+                mb: b.mb.clone(),
+            };
             // SAFETY: `isas_here` lists only what this CPU has.
-            unsafe { m2l::m2l_batch(isa, &exp, &r, &dj, &mb, &mut la, 1, &mut mono, &mut t) };
-            la
+            unsafe { m2l::m2l_batch(isa, &exp, &mut b, 1) };
+            b.la
         };
         let want = run(None);
         assert_eq!(
