@@ -1,12 +1,12 @@
-//! Renders every figure of `nbody_bench::plot::figures` from made-up but realistic numbers into
+//! Renders every figure of `nbody_harness::plot::figures` from made-up but realistic numbers into
 //! `target/plot-preview/` (or the directory given as the first argument), to look at them.
 //!
 //!     cargo run --release --example plot_preview
 
-use nbody_bench::plot::figures::{
+use nbody_harness::plot::figures::{
     self, CommTimes, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
-use nbody_bench::plot::{self, Axis, Chart, Scale, Unit};
+use nbody_harness::plot::{self, Axis, Chart, Scale, Unit};
 use std::path::PathBuf;
 
 const CAPTION: &str =

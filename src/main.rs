@@ -1,6 +1,6 @@
 use clap::Parser;
 #[macro_use]
-extern crate nbody_bench;
+extern crate nbody_harness;
 
 mod cli;
 
@@ -17,20 +17,20 @@ fn main() -> ExitCode {
     // Ctrl-C does not reach, and are stopped here. Results saved before the signal are whole.
     let _ = ctrlc::set_handler(|| {
         // Held until the exit: no program starts after this.
-        let _stopped = nbody_bench::children::stop_all();
-        nbody_bench::output::remove_temporaries_and_exit(130)
+        let _stopped = nbody_harness::children::stop_all();
+        nbody_engine::output::remove_temporaries_and_exit(130)
     });
     let code = match cli::dispatch(cli) {
         Ok(code) => code,
         Err(err) => {
-            nbody_bench::console::print_error(cli::error_chain(&err));
+            nbody_harness::console::print_error(cli::error_chain(&err));
             2
         }
     };
     // A closed pipe on stdout ends the output quietly; any other failed write is an error.
-    match nbody_bench::console::finish() {
+    match nbody_harness::console::finish() {
         Err(why) => {
-            nbody_bench::console::print_error(why);
+            nbody_harness::console::print_error(why);
             ExitCode::from(2)
         }
         Ok(()) => ExitCode::from(code as u8),

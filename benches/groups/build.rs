@@ -4,8 +4,8 @@
 
 use super::{SCENARIOS, criterion, kernels_for, setup, sizes};
 use criterion::{BenchmarkId, Criterion, Throughput};
-use nbody_bench::kernels::KernelKind;
-use nbody_bench::run::bench_cases::{Work, bench_case};
+use nbody_engine::kernels::KernelKind;
+use nbody_engine::run::bench_cases::{Work, bench_case};
 
 fn build(c: &mut Criterion) {
     for scenario in SCENARIOS {

@@ -2,7 +2,7 @@
 
 use super::{SCENARIOS, criterion, kernels_for, pool, setup, sizes, thread_counts};
 use criterion::{BenchmarkId, Criterion, Throughput};
-use nbody_bench::run::bench_cases::{Work, bench_case};
+use nbody_engine::run::bench_cases::{Work, bench_case};
 
 fn force(c: &mut Criterion) {
     for scenario in SCENARIOS {

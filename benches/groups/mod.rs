@@ -5,8 +5,8 @@ pub mod force;
 pub mod step;
 
 use criterion::Criterion;
-use nbody_bench::kernels::KernelKind;
-use nbody_bench::scenario::{ScenarioKind, Setup};
+use nbody_engine::kernels::KernelKind;
+use nbody_engine::scenario::{ScenarioKind, Setup};
 use std::time::Duration;
 
 /// Short measurements and few samples: the benches cover many kernels and sizes, and a

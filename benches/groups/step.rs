@@ -3,7 +3,7 @@
 
 use super::{SCENARIOS, criterion, kernels_for, pool, setup, sizes};
 use criterion::{BenchmarkId, Criterion, Throughput};
-use nbody_bench::run::bench_cases::{Work, bench_case};
+use nbody_engine::run::bench_cases::{Work, bench_case};
 
 fn step(c: &mut Criterion) {
     for scenario in SCENARIOS {

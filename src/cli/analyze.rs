@@ -1,10 +1,10 @@
 //! `analyze`: refit and re-plot a saved sweep.
 
 use crate::cli::args::AnalyzeArgs;
-use nbody_bench::analysis;
-use nbody_bench::records::locate;
-use nbody_bench::records::results::ResultsFile;
-use nbody_bench::render::Written;
+use nbody_harness::analysis;
+use nbody_harness::render::Written;
+use nbody_records::locate;
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 
 pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
@@ -12,14 +12,14 @@ pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
     if path != args.results {
         eprintln!("analyzing {}", path.display());
     }
-    if args.out.is_none() && nbody_bench::input::is_pipe(&path) {
+    if args.out.is_none() && nbody_engine::input::is_pipe(&path) {
         anyhow::bail!(
             "{} is a pipe: its analysis has no directory to go beside; name one with --out DIR",
             path.display()
         );
     }
     // Whatever the analysis writes, under whatever name, never replaces what it reads.
-    nbody_bench::output::protect_inputs(&[("results", &path)]);
+    nbody_engine::output::protect_inputs(&[("results", &path)]);
     let results = ResultsFile::load(&path)?;
     let dir = args.out.unwrap_or_else(|| default_dir(&path));
     let written = run(&results, &path, &dir)?;
@@ -35,7 +35,7 @@ pub fn default_dir(results: &Path) -> PathBuf {
 /// Analyses `results` into `dir`; shared with the end of `sweep`.
 pub fn run(results: &ResultsFile, source: &Path, dir: &Path) -> anyhow::Result<Written> {
     let analysis = analysis::analyze(results, source)?;
-    Ok(nbody_bench::render::write(&analysis, dir)?)
+    Ok(nbody_harness::render::write(&analysis, dir)?)
 }
 
 pub fn print_written(w: &Written) {

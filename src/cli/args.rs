@@ -1,12 +1,12 @@
 //! Command-line interface: argument definitions only; the work is in `commands`.
 
 use clap::{Args, Parser, Subcommand};
-use nbody_bench::decomp::Decomposition;
-use nbody_bench::export::ExportFormat;
-use nbody_bench::kernels::{KernelKind, Multipole};
-use nbody_bench::output::nbview::NbviewFormat;
-use nbody_bench::records::tidy::TidyFormat;
-use nbody_bench::scenario::{Precision, ScenarioKind, lj};
+use nbody_engine::decomp::Decomposition;
+use nbody_engine::export::ExportFormat;
+use nbody_engine::kernels::{KernelKind, Multipole};
+use nbody_engine::output::nbview::NbviewFormat;
+use nbody_engine::scenario::{Precision, ScenarioKind, lj};
+use nbody_records::tidy::TidyFormat;
 use std::path::PathBuf;
 
 #[derive(Debug, Parser)]
@@ -233,8 +233,8 @@ fn lj_help(what: &str, default: String) -> String {
 }
 
 impl LjArgs {
-    pub fn overrides(&self) -> nbody_bench::scenario::LjOverrides {
-        nbody_bench::scenario::LjOverrides {
+    pub fn overrides(&self) -> nbody_engine::scenario::LjOverrides {
+        nbody_engine::scenario::LjOverrides {
             epsilon: self.epsilon,
             sigma: self.sigma,
             g: self.g,
@@ -256,7 +256,7 @@ pub struct KernelArgs {
     pub multipole: Option<Multipole>,
     /// Expansion order p of the fmm's cells, 1 to 8 (fmm only): the force error falls as
     /// theta^p [default: 4].
-    #[arg(long, value_parser = parse_count_at_most::<{ nbody_bench::kernels::MAX_FMM_ORDER }>)]
+    #[arg(long, value_parser = parse_count_at_most::<{ nbody_engine::kernels::MAX_FMM_ORDER }>)]
     pub order: Option<usize>,
     /// Most particles in a tree leaf (octree and fmm) [default: 8 for the octree, 64 for
     /// the fmm].
@@ -459,9 +459,9 @@ fn parse_count_at_most<const MAX: usize>(s: &str) -> Result<usize, String> {
 
 fn parse_threads(s: &str) -> Result<usize, String> {
     match parse_count(s)? {
-        t if t > nbody_bench::run::MAX_THREADS => Err(format!(
+        t if t > nbody_engine::run::MAX_THREADS => Err(format!(
             "{t} threads is more than {} (each is an OS thread with its own stack)",
-            nbody_bench::run::MAX_THREADS
+            nbody_engine::run::MAX_THREADS
         )),
         t => Ok(t),
     }
@@ -504,7 +504,7 @@ fn parse_positive(s: &str) -> Result<f64, String> {
 /// A gate threshold: a fraction from 0 to `gate::MAX_THRESHOLD`.
 fn parse_threshold(s: &str) -> Result<f64, String> {
     let v = parse_non_negative(s)?;
-    nbody_bench::gate::check_threshold(v).map_err(|e| e.to_string())?;
+    nbody_harness::gate::check_threshold(v).map_err(|e| e.to_string())?;
     Ok(v)
 }
 
@@ -513,7 +513,7 @@ fn parse_ab_rounds(s: &str) -> Result<usize, String> {
     let v = s
         .parse::<usize>()
         .map_err(|_| format!("`{s}` is not a whole number"))?;
-    nbody_bench::gate::ab::check_rounds(v).map_err(|e| e.to_string())?;
+    nbody_harness::gate::ab::check_rounds(v).map_err(|e| e.to_string())?;
     Ok(v)
 }
 
@@ -625,7 +625,7 @@ pub struct FitArgs {
     pub json: Option<PathBuf>,
     /// Seed of the bootstrap that gives the confidence intervals (fixed by default, so the
     /// output is reproducible).
-    #[arg(long, default_value_t = nbody_bench::fit::DEFAULT_SEED)]
+    #[arg(long, default_value_t = nbody_harness::fit::DEFAULT_SEED)]
     pub seed: u64,
     /// gustafson with an n column: the cost g(n) of the whole problem; times are normalised to
     /// the one-worker run's work per worker g(n)/p [default: n].
@@ -682,7 +682,7 @@ pub struct GateArgs {
     pub config: Option<PathBuf>,
     /// Rounds of every case per build in an A/B run: even (each build goes first as often),
     /// from 2 to 100.
-    #[arg(long, default_value_t = nbody_bench::gate::AB_ROUNDS, value_parser = parse_ab_rounds, conflicts_with = "current")]
+    #[arg(long, default_value_t = nbody_harness::gate::AB_ROUNDS, value_parser = parse_ab_rounds, conflicts_with = "current")]
     pub rounds: usize,
     /// Longest one build's sweep of one case may take in an A/B run, seconds (also the limit
     /// of asking the base binary for its options) [default: 10 times the case's estimate, at
@@ -702,17 +702,17 @@ pub struct GateArgs {
     pub threshold: Option<f64>,
     /// Output format; markdown is made for a CI job summary.
     #[arg(long, value_enum, default_value = "text")]
-    pub format: nbody_bench::gate::Format,
+    pub format: nbody_harness::gate::Format,
     /// What the times are divided by before comparing: the reference workload timed around each
     /// case, the sweep's calibration, or nothing; auto takes the best both files have.
     #[arg(long, value_enum, default_value = "auto")]
-    pub normalize: nbody_bench::gate::NormalizationChoice,
+    pub normalize: nbody_harness::gate::NormalizationChoice,
     /// Which ratio a case is judged on: the normalised one, the raw one, or both (a change is
     /// claimed only when both show it) [default: raw for A/B runs, where interleaving keeps raw
     /// times fair; both for the fast path and two files, measured at different times: the
     /// rules the gate's noise study chose, docs/explanation/gate.md].
     #[arg(long, value_enum)]
-    pub judge: Option<nbody_bench::gate::Judged>,
+    pub judge: Option<nbody_harness::gate::Judged>,
     /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
     #[arg(long)]
     pub force: bool,
@@ -752,13 +752,13 @@ pub struct GateStudyArgs {
     pub blocks: u64,
     /// What else runs meanwhile: nothing, or a process spinning on one CPU.
     #[arg(long, value_enum, default_value = "quiet")]
-    pub load: nbody_bench::gate::study::Load,
+    pub load: nbody_harness::gate::study::Load,
     /// Measure the two sides at the same moment, one per CPU (A/A only).
     #[arg(long, conflicts_with = "load")]
     pub duet: bool,
     /// The kernel made slower for the power decisions.
     #[arg(long, value_enum, default_value = "octree")]
-    pub slow: nbody_bench::kernels::KernelKind,
+    pub slow: nbody_engine::kernels::KernelKind,
     /// The folder of baselines: this machine class's file gives the config and the fast
     /// path's reference.
     #[arg(long, value_name = "DIR", default_value = "results/baseline")]
@@ -827,13 +827,13 @@ fn export_results_help() -> String {
          measured, never 0; the build's fields repeat on every row, so the tables of several \
          sweeps can be concatenated):\n",
     );
-    for (name, what) in nbody_bench::records::tidy::SAMPLE_COLUMNS {
+    for (name, what) in nbody_records::tidy::SAMPLE_COLUMNS {
         help.push_str(&format!("  {name:<19} {what}\n"));
     }
     help.push_str(
         "\nColumns of a history, one row per record (the case's fields taken from its key):\n",
     );
-    for (name, what) in nbody_bench::history::tidy::HISTORY_COLUMNS {
+    for (name, what) in nbody_harness::history::tidy::HISTORY_COLUMNS {
         help.push_str(&format!("  {name:<22} {what}\n"));
     }
     help.push_str(

@@ -3,9 +3,9 @@
 //! both ends in doubt.
 
 use clap::Args;
-use nbody_bench::gate::{AB_ROUNDS, AB_THRESHOLD, prefix};
-use nbody_bench::history::bisect::probe::GateProbe;
-use nbody_bench::history::bisect::{self, Bisection, Direction, Finding, Settings};
+use nbody_harness::gate::{AB_ROUNDS, AB_THRESHOLD, prefix};
+use nbody_harness::history::bisect::probe::GateProbe;
+use nbody_harness::history::bisect::{self, Bisection, Direction, Finding, Settings};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -55,14 +55,14 @@ pub struct BisectArgs {
 }
 
 pub fn bisect(args: BisectArgs) -> anyhow::Result<i32> {
-    nbody_bench::gate::check_threshold(args.threshold)?;
-    nbody_bench::gate::ab::check_rounds(args.rounds)?;
-    let repo = nbody_bench::gate::base_build::repository_root(&std::env::current_dir()?)?;
-    let config = nbody_bench::records::locate::find_config(&args.config)?;
+    nbody_harness::gate::check_threshold(args.threshold)?;
+    nbody_harness::gate::ab::check_rounds(args.rounds)?;
+    let repo = nbody_harness::gate::base_build::repository_root(&std::env::current_dir()?)?;
+    let config = nbody_records::locate::find_config(&args.config)?;
     let path = bisect::first_parent_path(&repo, &args.good, &args.bad)?;
     let runs = args.runs.join(format!(
         "{}-{}",
-        nbody_bench::records::results::utc_now().replace(':', "-"),
+        nbody_engine::output::provenance::utc_now().replace(':', "-"),
         prefix(&path[path.len() - 1], 12)
     ));
     let mut probe = GateProbe::new(
@@ -87,7 +87,7 @@ pub fn bisect(args: BisectArgs) -> anyhow::Result<i32> {
     })?;
     let json = serde_json::to_string_pretty(&found)?;
     let kept = runs.join("bisect.json");
-    nbody_bench::output::write_atomic(&kept, format!("{json}\n").as_bytes())?;
+    nbody_engine::output::write_atomic(&kept, format!("{json}\n").as_bytes())?;
     if args.json {
         outln!("{json}");
     } else {

@@ -4,11 +4,11 @@
 //! here writes a file or creates a directory.
 
 use crate::cli::args::SweepArgs;
-use nbody_bench::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::plan::cases;
-use nbody_bench::records::results::ResultsFile;
-use nbody_bench::units::{Duration, WallTime};
+use nbody_harness::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
+use nbody_harness::units::{Duration, WallTime};
+use nbody_records::config::SweepConfig;
+use nbody_records::plan::cases;
+use nbody_records::results::ResultsFile;
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::Path;
 
@@ -40,10 +40,10 @@ pub fn before_sweep(
         (true, Some(path)) if path.exists() => done_in(ResultsFile::load(path)?),
         _ => Done::default(),
     };
-    let planned = nbody_bench::records::plan::unique_cases(config).map_err(anyhow::Error::msg)?;
+    let planned = nbody_records::plan::unique_cases(config).map_err(anyhow::Error::msg)?;
     let probed = estimate::probe(config, &planned)?;
     let calibrate = !args.no_calibration;
-    let logical = nbody_bench::run::logical_cpus();
+    let logical = nbody_engine::run::logical_cpus();
     let est = estimate::estimate(config, &probed.cases, &done, calibrate, logical);
     if args.dry_run {
         print_plan(args, config, &est, &probed, logical, path);
@@ -167,7 +167,7 @@ fn print_plan(
             .map_or("-".to_string(), |e| {
                 format!(
                     "{} steps",
-                    nbody_bench::experiment::external::run::steps(e, c)
+                    nbody_harness::experiment::external::run::steps(e, c)
                 )
             });
         outln!(
@@ -229,20 +229,20 @@ fn print_plan(
         Some(path) => outln!("results would go to {}", path.display()),
         None => outln!(
             "results would go to a new run directory {}/<UTC time>/",
-            nbody_bench::records::locate::runs_dir(&config.out, &config.name).display()
+            nbody_records::locate::runs_dir(&config.out, &config.name).display()
         ),
     }
     outln!("estimate_s: {:.3}", est.total_s);
 }
 
 /// Runs this small need no estimate: even the naive kernel in f64 finishes them in minutes.
-const SMALL_RUN_N: usize = nbody_bench::experiment::estimate::PROBE_MAX_N;
+const SMALL_RUN_N: usize = nbody_harness::experiment::estimate::PROBE_MAX_N;
 const SMALL_RUN_STEPS: u64 = 100_000;
 
 /// Refuses a run estimated at more than an hour (the sweep's limit) unless `--yes` is given.
 pub fn refuse_long_run(
-    setup: &nbody_bench::scenario::Setup,
-    kernel: nbody_bench::kernels::KernelKind,
+    setup: &nbody_engine::scenario::Setup,
+    kernel: nbody_engine::kernels::KernelKind,
     kernel_args: &crate::cli::args::KernelArgs,
     steps: u64,
 ) -> anyhow::Result<()> {
@@ -250,7 +250,7 @@ pub fn refuse_long_run(
     if n <= SMALL_RUN_N && steps <= SMALL_RUN_STEPS {
         return Ok(());
     }
-    let case = nbody_bench::records::plan::Case {
+    let case = nbody_records::plan::Case {
         scenario: setup.scenario,
         kernel: kernel.into(),
         n,
@@ -259,11 +259,11 @@ pub fn refuse_long_run(
         theta: kernel_args.theta,
         multipole: kernel_args
             .multipole
-            .unwrap_or(nbody_bench::kernels::KernelParams::default().multipole),
-        order: (kernel == nbody_bench::kernels::KernelKind::Fmm).then(|| {
+            .unwrap_or(nbody_engine::kernels::KernelParams::default().multipole),
+        order: (kernel == nbody_engine::kernels::KernelKind::Fmm).then(|| {
             kernel_args
                 .order
-                .unwrap_or(nbody_bench::kernels::KernelParams::default().order)
+                .unwrap_or(nbody_engine::kernels::KernelParams::default().order)
         }),
         skin: match kernel_args.skin {
             Some(crate::cli::args::SkinArg::Length(s)) => Some(s),
@@ -274,10 +274,10 @@ pub fn refuse_long_run(
         time_factor: 1,
         decomp: None,
     };
-    let wall_s = nbody_bench::experiment::estimate::run_seconds(
+    let wall_s = nbody_harness::experiment::estimate::run_seconds(
         &case,
         steps,
-        nbody_bench::run::logical_cpus(),
+        nbody_engine::run::logical_cpus(),
     )?;
     let limit = LONG_SWEEP_S;
     if wall_s > limit {

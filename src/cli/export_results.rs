@@ -1,12 +1,12 @@
 //! `nbody-bench export-results`: a results file, or a performance history, as a tidy table for
-//! notebooks: one row per sample (`nbody_bench::records::tidy::samples`) or per history record
-//! (`nbody_bench::history::tidy::records`).
+//! notebooks: one row per sample (`nbody_records::tidy::samples`) or per history record
+//! (`nbody_harness::history::tidy::records`).
 
 use crate::cli::args::ExportResultsArgs;
-use nbody_bench::history::store::{self, HISTORY_SCHEMA};
-use nbody_bench::records::locate;
-use nbody_bench::records::results::ResultsFile;
-use nbody_bench::records::tidy::{self, TidyTable};
+use nbody_harness::history::store::{self, HISTORY_SCHEMA};
+use nbody_records::locate;
+use nbody_records::results::ResultsFile;
+use nbody_records::tidy::{self, TidyTable};
 use std::path::{Path, PathBuf};
 
 pub fn export_results(args: ExportResultsArgs) -> anyhow::Result<i32> {
@@ -32,7 +32,7 @@ pub fn export_results(args: ExportResultsArgs) -> anyhow::Result<i32> {
             Some(files) => files.iter().map(|f| ("HISTORY", f.as_path())).collect(),
             None => vec![("RESULTS", path.as_path())],
         };
-        nbody_bench::output::check_outputs(&[("--out", out)], &inputs)?;
+        nbody_engine::output::check_outputs(&[("--out", out)], &inputs)?;
     }
     let (table, what) = match &history {
         Some(files) => history_table(files)?,
@@ -56,7 +56,7 @@ pub fn export_results(args: ExportResultsArgs) -> anyhow::Result<i32> {
     let text = args.format.write(&table);
     match &args.out {
         Some(out) => {
-            nbody_bench::output::write_atomic(out, text.as_bytes())?;
+            nbody_engine::output::write_atomic(out, text.as_bytes())?;
             eprintln!("wrote {} ({what})", out.display());
         }
         None => out!("{text}"),
@@ -111,7 +111,7 @@ fn history_table(files: &[PathBuf]) -> anyhow::Result<(TidyTable, String)> {
         }
         records.extend(history.records);
     }
-    let table = nbody_bench::history::tidy::records(&records);
+    let table = nbody_harness::history::tidy::records(&records);
     let what = format!(
         "{} records of {} history files",
         table.rows.len(),

@@ -3,8 +3,8 @@
 use super::fit_tables;
 use crate::cli::args::{CostModel, FitArgs, FitModel};
 use anyhow::{Context, bail};
-use nbody_bench::fit::csv::{self, WeakTable};
-use nbody_bench::fit::{ComplexityClass, fit_power, fit_strong, fit_weak, fit_weak_with_n};
+use nbody_harness::fit::csv::{self, WeakTable};
+use nbody_harness::fit::{ComplexityClass, fit_power, fit_strong, fit_weak, fit_weak_with_n};
 use serde::Serialize;
 use std::path::Path;
 
@@ -21,9 +21,9 @@ struct FitDocument<'a, T: Serialize> {
 
 pub fn fit(args: FitArgs) -> anyhow::Result<i32> {
     if let Some(json) = &args.json {
-        nbody_bench::output::check_outputs(&[("--json", json)], &[("--csv", &args.csv)])?;
+        nbody_engine::output::check_outputs(&[("--json", json)], &[("--csv", &args.csv)])?;
     }
-    let text = nbody_bench::input::read_text(&args.csv)
+    let text = nbody_engine::input::read_text(&args.csv)
         .with_context(|| format!("cannot read {}", args.csv.display()))?;
     let in_csv = |e: csv::CsvError| anyhow::anyhow!("{}: {e}", args.csv.display());
     let name = args.csv.display().to_string();
@@ -89,7 +89,7 @@ fn write_json<T: Serialize>(args: &FitArgs, model: &'static str, fit: &T) -> any
     };
     let mut text = serde_json::to_string_pretty(&doc)?;
     text.push('\n');
-    nbody_bench::output::write_atomic(Path::new(path), text.as_bytes())?;
+    nbody_engine::output::write_atomic(Path::new(path), text.as_bytes())?;
     outln!("\nfit written to {}", path.display());
     Ok(())
 }

@@ -1,7 +1,7 @@
 //! The readable tables `fit` prints.
 
-use nbody_bench::fit::{CiMethod, ComplexityClass, Input, PowerFit, StrongFit, WeakFit};
-use nbody_bench::units::{Duration, Number, WithCi};
+use nbody_harness::fit::{CiMethod, ComplexityClass, Input, PowerFit, StrongFit, WeakFit};
+use nbody_harness::units::{Duration, Number, WithCi};
 
 fn r2(r2: Option<f64>) -> String {
     r2.map_or("-".to_string(), |r| format!("{r:.4}"))

@@ -1,14 +1,14 @@
 //! `gate`: compare two results files, or measure this build and judge it (against the
 //! baseline file of its machine class, else A/B against the baseline's revision). The policy is
-//! the library's (`nbody_bench::gate::drive`); this parses, calls it and prints.
+//! the library's (`nbody_harness::gate::drive`); this parses, calls it and prints.
 
 use crate::cli::args::GateArgs;
-use nbody_bench::gate::drive::{self, Request};
-use nbody_bench::gate::render;
+use nbody_harness::gate::drive::{self, Request};
+use nbody_harness::gate::render;
 
 pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     if let Some(results) = &args.save_baseline {
-        let (target, info) = nbody_bench::gate::save::save_baseline(&args.baseline, results)?;
+        let (target, info) = nbody_harness::gate::save::save_baseline(&args.baseline, results)?;
         eprintln!(
             "gate: {} kept as the baseline of {} ({} logical CPUs): {}",
             results.display(),
@@ -57,25 +57,25 @@ fn record(
             .map(|f| kept.join(f))
             .filter(|p| p.is_file())
             .collect(),
-        (None, Some(current)) => vec![nbody_bench::records::locate::find_results(
+        (None, Some(current)) => vec![nbody_records::locate::find_results(
             current,
             std::path::Path::new("results"),
         )?],
         (None, None) => Vec::new(),
     };
     // The verdicts beside the records: the page shows each class's latest gate run.
-    let run = nbody_bench::history::verdicts::GateRun::of(
+    let run = nbody_harness::history::verdicts::GateRun::of(
         &outcome.report,
-        &nbody_bench::gate::route::this_machine(),
+        &nbody_harness::gate::route::this_machine(),
     );
-    for (to, count) in nbody_bench::history::verdicts::append(dir, &[run])? {
+    for (to, count) in nbody_harness::history::verdicts::append(dir, &[run])? {
         eprintln!(
             "gate: the verdicts of {count} gate run(s) appended to {}",
             to.display()
         );
     }
     for path in files {
-        let file = nbody_bench::records::results::ResultsFile::load(&path)?;
+        let file = nbody_records::results::ResultsFile::load(&path)?;
         for (to, count) in super::history::append_results(dir, &file, "gate")? {
             eprintln!(
                 "gate: {count} records of {} appended to {}",

@@ -1,8 +1,8 @@
 //! `gate-study`: measure the gate's false-alarm rate and power on this machine, or regenerate
-//! the gate page's tables from the study files (`nbody_bench::gate::study`).
+//! the gate page's tables from the study files (`nbody_harness::gate::study`).
 
 use crate::cli::args::GateStudyArgs;
-use nbody_bench::gate::study::{run, table};
+use nbody_harness::gate::study::{run, table};
 use std::path::Path;
 
 /// The page whose generated region holds the study's tables.
@@ -26,12 +26,12 @@ pub fn gate_study(args: GateStudyArgs) -> anyhow::Result<i32> {
 
 fn write_docs(out: &Path) -> anyhow::Result<i32> {
     let files = run::study_files(out).map_err(|e| anyhow::anyhow!(e))?;
-    let page = nbody_bench::input::read_text(Path::new(GATE_PAGE))
+    let page = nbody_engine::input::read_text(Path::new(GATE_PAGE))
         .map_err(|e| anyhow::anyhow!("cannot read {GATE_PAGE}: {e}"))?;
     let Some(new) = table::splice(&page, &table::markdown(&files)) else {
         anyhow::bail!("{GATE_PAGE} has no generated region (its marks were removed)");
     };
-    nbody_bench::output::write_atomic(Path::new(GATE_PAGE), new.as_bytes())?;
+    nbody_engine::output::write_atomic(Path::new(GATE_PAGE), new.as_bytes())?;
     eprintln!(
         "gate-study: {GATE_PAGE} regenerated from {} study file(s) in {}",
         files.len(),
@@ -42,11 +42,11 @@ fn write_docs(out: &Path) -> anyhow::Result<i32> {
 
 #[cfg(feature = "test-slowdown")]
 fn measure(args: GateStudyArgs) -> anyhow::Result<i32> {
-    use nbody_bench::records::{config::SweepConfig, locate};
+    use nbody_records::{config::SweepConfig, locate};
     let config = match &args.config {
         Some(name) => {
             let path = locate::find_config(name)?;
-            let text = nbody_bench::input::read_text(&path)
+            let text = nbody_engine::input::read_text(&path)
                 .map_err(|e| anyhow::anyhow!("cannot read config {}: {e}", path.display()))?;
             Some((SweepConfig::parse(&text, &path)?, text))
         }
@@ -69,8 +69,8 @@ fn measure(args: GateStudyArgs) -> anyhow::Result<i32> {
         paths.study.display(),
         paths.raw.display()
     );
-    let file =
-        nbody_bench::gate::study::StudyFile::load(&paths.study).map_err(|e| anyhow::anyhow!(e))?;
+    let file = nbody_harness::gate::study::StudyFile::load(&paths.study)
+        .map_err(|e| anyhow::anyhow!(e))?;
     out!("{}", table::markdown(&[file]));
     Ok(0)
 }

@@ -3,12 +3,12 @@
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use nbody_bench::history::series::{Metric, Series, series};
-use nbody_bench::history::steps::{Step, steps};
-use nbody_bench::history::store::{self, CommitFacts, History};
-use nbody_bench::history::verdicts::{self, GateRun};
-use nbody_bench::records::results::ResultsFile;
-use nbody_bench::units::Duration;
+use nbody_harness::history::series::{Metric, Series, series};
+use nbody_harness::history::steps::{Step, steps};
+use nbody_harness::history::store::{self, CommitFacts, History};
+use nbody_harness::history::verdicts::{self, GateRun};
+use nbody_harness::units::Duration;
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 
 /// Where the committed history lives.
@@ -99,8 +99,8 @@ pub fn history(args: HistoryArgs) -> anyhow::Result<i32> {
 }
 
 fn backfill(dir: &Path, args: &BackfillArgs) -> anyhow::Result<i32> {
-    use nbody_bench::history::backfill::{self, Backfill, Done};
-    let config = nbody_bench::records::locate::find_config(&args.config)?;
+    use nbody_harness::history::backfill::{self, Backfill, Done};
+    let config = nbody_records::locate::find_config(&args.config)?;
     let job = Backfill {
         range: args.range.clone(),
         every: args.every,
@@ -117,13 +117,13 @@ fn backfill(dir: &Path, args: &BackfillArgs) -> anyhow::Result<i32> {
             Done::Recorded { commit, records } => {
                 outln!(
                     "{} {records} records",
-                    nbody_bench::gate::prefix(commit, 12)
+                    nbody_harness::gate::prefix(commit, 12)
                 )
             }
-            Done::Built { commit } => outln!("{} built", nbody_bench::gate::prefix(commit, 12)),
+            Done::Built { commit } => outln!("{} built", nbody_harness::gate::prefix(commit, 12)),
             Done::Skipped { commit, why } => {
                 skipped += 1;
-                outln!("{} skipped: {why}", nbody_bench::gate::prefix(commit, 12))
+                outln!("{} skipped: {why}", nbody_harness::gate::prefix(commit, 12))
             }
         }
     }
@@ -178,7 +178,7 @@ fn gate_report(path: &Path) -> anyhow::Result<Option<GateRun>> {
     if schema.as_deref() != Some(verdicts::GATE_REPORT_SCHEMA) {
         return Ok(None);
     }
-    let machine = nbody_bench::gate::route::this_machine();
+    let machine = nbody_harness::gate::route::this_machine();
     GateRun::from_report_json(&text, &machine)
         .map(Some)
         .map_err(|why| anyhow::anyhow!("{}: a gate report, but {why}", path.display()))
@@ -192,7 +192,7 @@ pub fn append_results(
     source: &str,
 ) -> anyhow::Result<Vec<(PathBuf, usize)>> {
     let facts = CommitFacts::of(Path::new("."), &file.metadata.git_commit);
-    let machine = nbody_bench::gate::route::this_machine();
+    let machine = nbody_harness::gate::route::this_machine();
     let records = store::records_of(file, source, &facts, &machine);
     if records.is_empty() {
         bail!("no case of the results has a successful sample: nothing to record");
@@ -204,8 +204,8 @@ fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
     let class = match &args.class {
         Some(c) => c.clone(),
         None => {
-            let m = nbody_bench::gate::route::this_machine();
-            nbody_bench::gate::baselines::class_name(m.cpu_signature.as_deref(), m.logical_cpus)
+            let m = nbody_harness::gate::route::this_machine();
+            nbody_harness::gate::baselines::class_name(m.cpu_signature.as_deref(), m.logical_cpus)
         }
     };
     let path = store::file_of(&args.dir, &class);
@@ -322,7 +322,7 @@ fn print_series(f: &Found) {
 
 /// A commit as read from a history file, which may hold anything: cut by characters.
 fn short(commit: &str) -> &str {
-    nbody_bench::gate::prefix(commit, 10)
+    nbody_harness::gate::prefix(commit, 10)
 }
 
 /// A `*` / `?` pattern as an anchored regular expression.

@@ -4,7 +4,7 @@
 
 use crate::cli::args::{InitArgs, InitLang};
 use anyhow::bail;
-use nbody_bench::records::config::SweepConfig;
+use nbody_records::config::SweepConfig;
 use std::path::{Path, PathBuf};
 
 /// The program name the templates are written for.
@@ -34,13 +34,13 @@ impl Template {
 
 pub fn init(args: InitArgs) -> anyhow::Result<i32> {
     let name = args.external.as_str();
-    if !nbody_bench::records::external::config::plain_name(name) {
+    if !nbody_records::external::config::plain_name(name) {
         bail!(
             "--external `{name}`: a program's name is letters, digits, '-', '_' and '.' (it names \
              its cases and the config file)"
         );
     }
-    if nbody_bench::kernels::KernelKind::ALL
+    if nbody_engine::kernels::KernelKind::ALL
         .iter()
         .any(|k| k.name() == name)
     {
@@ -64,7 +64,7 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
             .iter()
             .map(|(path, _)| ("the program", path.as_path())),
     );
-    nbody_bench::output::check_outputs(&outputs, &[])?;
+    nbody_engine::output::check_outputs(&outputs, &[])?;
     // Both are checked before either is written: a refusal leaves nothing behind.
     for (_, path) in &outputs {
         if std::fs::symlink_metadata(path).is_ok() {
@@ -84,9 +84,9 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
     // What is written is a config the sweep accepts as it is.
     SweepConfig::parse(&text, &out)?;
     if let Some((path, code)) = &program {
-        nbody_bench::output::write_atomic(path, code.as_bytes())?;
+        nbody_engine::output::write_atomic(path, code.as_bytes())?;
     }
-    if let Err(e) = nbody_bench::output::write_atomic(&out, text.as_bytes()) {
+    if let Err(e) = nbody_engine::output::write_atomic(&out, text.as_bytes()) {
         // A program without its config is half an init: take it back, so that a second try
         // does not find it in the way.
         if let Some((path, _)) = &program {

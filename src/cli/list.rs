@@ -1,5 +1,5 @@
-use nbody_bench::kernels::KernelKind;
-use nbody_bench::scenario::ScenarioKind;
+use nbody_engine::kernels::KernelKind;
+use nbody_engine::scenario::ScenarioKind;
 
 pub fn list() -> anyhow::Result<i32> {
     outln!("Kernels:");
@@ -60,7 +60,7 @@ pub fn list() -> anyhow::Result<i32> {
             "  {:<10} ({}): {}",
             s.name(),
             s.law().name(),
-            nbody_bench::kernels::supported_for(s.law())
+            nbody_engine::kernels::supported_for(s.law())
         );
     }
     Ok(0)

@@ -26,8 +26,8 @@ mod sweep;
 mod validate;
 
 use crate::cli::args::{Cli, Command, KernelArgs, SkinArg, StartArgs, SystemArgs};
-use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::scenario::{ScenarioKind, Setup};
+use nbody_engine::kernels::{KernelKind, KernelParams};
+use nbody_engine::scenario::{ScenarioKind, Setup};
 
 /// Runs the parsed command line.
 pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
@@ -51,7 +51,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<i32> {
         Command::Publish(args) => publish::publish(args),
         Command::Reference(args) => reference::reference(args),
         Command::Job(args) => {
-            nbody_bench::experiment::slurm::job_main(&args.dir)
+            nbody_harness::experiment::slurm::job_main(&args.dir)
                 .map_err(|e| anyhow::anyhow!("job {}: {e}", args.dir.display()))?;
             Ok(0)
         }
@@ -110,7 +110,7 @@ fn start_setup(
     let mut setup = setup(scenario, system);
     setup.lj = start.lj.overrides();
     if let Some(path) = &start.initial {
-        let bodies = nbody_bench::scenario::initial::read(path)?;
+        let bodies = nbody_engine::scenario::initial::read(path)?;
         if let Some(from) = bodies
             .exported_from
             .as_deref()

@@ -6,8 +6,8 @@
 //! points to it. Only rank 0 prints results and writes files.
 
 use crate::cli::args::{MpiBenchArgs, MpiCheckArgs, RunArgs};
-use nbody_bench::decomp::Decomposition;
-use nbody_bench::ranks::job::Job;
+use nbody_engine::decomp::Decomposition;
+use nbody_mpi::ranks::job::Job;
 
 /// The job the ranks compare when MPI starts (`Mpi::init`): the subcommand `name` and its
 /// parsed arguments (so `--steps=3` and `--steps 3` agree, and defaults count), and the
@@ -26,17 +26,17 @@ fn job(name: &str, args: &dyn std::fmt::Debug) -> Job {
 
 #[cfg(not(feature = "mpi"))]
 pub fn run(_args: RunArgs, _decomp: Decomposition) -> anyhow::Result<i32> {
-    anyhow::bail!(nbody_bench::decomp::WITHOUT_MPI)
+    anyhow::bail!(nbody_engine::decomp::WITHOUT_MPI)
 }
 
 #[cfg(not(feature = "mpi"))]
 pub fn check(_args: MpiCheckArgs) -> anyhow::Result<i32> {
-    anyhow::bail!(nbody_bench::decomp::WITHOUT_MPI)
+    anyhow::bail!(nbody_engine::decomp::WITHOUT_MPI)
 }
 
 #[cfg(not(feature = "mpi"))]
 pub fn bench(_args: MpiBenchArgs) -> anyhow::Result<i32> {
-    anyhow::bail!(nbody_bench::decomp::WITHOUT_MPI)
+    anyhow::bail!(nbody_engine::decomp::WITHOUT_MPI)
 }
 
 #[cfg(feature = "mpi")]
@@ -49,11 +49,11 @@ mod with_mpi {
     use crate::cli::summary::print_summary;
     use crate::cli::{error_chain, kernel_params, setup, start_setup};
     use anyhow::Context;
-    use nbody_bench::decomp::stats::MpiReport;
-    use nbody_bench::kernels::KernelKind;
-    use nbody_bench::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
-    use nbody_bench::scenario::Precision;
-    use nbody_bench::units::Duration;
+    use nbody_engine::decomp::stats::MpiReport;
+    use nbody_engine::kernels::KernelKind;
+    use nbody_engine::scenario::Precision;
+    use nbody_harness::units::Duration;
+    use nbody_mpi::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
     use std::path::PathBuf;
 
     /// Starts MPI and checks that every rank runs `job` (see `Mpi::init`, which prints a
@@ -67,7 +67,7 @@ mod with_mpi {
     /// Prints an error on the ranks that should, and gives exit code 2.
     fn fail(rank: usize, err: MpiError) -> i32 {
         if err.printed_by(rank) {
-            nbody_bench::console::print_error(crate::cli::error_chain(&anyhow::Error::from(err)));
+            nbody_harness::console::print_error(crate::cli::error_chain(&anyhow::Error::from(err)));
         }
         2
     }
@@ -112,7 +112,7 @@ mod with_mpi {
     /// Refuses a job whose ranks on this machine would not fit in its memory: with allgather
     /// every rank holds all n particles, with domain about n / ranks.
     fn fits(
-        setup: &nbody_bench::scenario::Setup,
+        setup: &nbody_engine::scenario::Setup,
         kernel: KernelKind,
         decomp: Decomposition,
         kernel_args: &KernelArgs,
@@ -134,7 +134,7 @@ mod with_mpi {
         }
         let params =
             kernel_params(kernel_args, Some(kernel)).map_err(|e| MpiError::Usage(e.to_string()))?;
-        nbody_bench::run::check_memory(setup, kernel, &params, kernel_args.threads, copies)
+        nbody_engine::run::check_memory(setup, kernel, &params, kernel_args.threads, copies)
             .map_err(|e| MpiError::Usage(e.to_string()))
     }
 
@@ -192,7 +192,7 @@ mod with_mpi {
                 "warning: {} ranks x {} threads on {} logical CPUs: oversubscribed; timings do not show real parallel speedup",
                 mpi.size(),
                 outcome.threads,
-                nbody_bench::run::logical_cpus()
+                nbody_engine::run::logical_cpus()
             );
         }
         print_summary(&outcome);
@@ -201,7 +201,7 @@ mod with_mpi {
         }
         if let Some(path) = &args.json {
             let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
-            nbody_bench::output::write_atomic(path, text.as_bytes())?;
+            nbody_engine::output::write_atomic(path, text.as_bytes())?;
             outln!("result written to {}", path.display());
         }
         Ok(0)
@@ -225,7 +225,7 @@ mod with_mpi {
             r.rebalances,
             r.library.lines().next().unwrap_or("")
         );
-        let span = |m: &nbody_bench::decomp::stats::MinMeanMax| {
+        let span = |m: &nbody_engine::decomp::stats::MinMeanMax| {
             format!("{:.4}/{:.4}/{:.4}", m.min, m.mean, m.max)
         };
         outln!(
@@ -329,8 +329,8 @@ mod with_mpi {
                 "energy drift      {:.2e} (serial {:.2e}, allowed {:.1e}); the positions are not held to rounding: the tree's nodes differ",
                 t.energy_drift,
                 t.serial_energy_drift,
-                nbody_bench::decomp::check::DRIFT_FACTOR * t.serial_energy_drift
-                    + nbody_bench::decomp::check::DRIFT_FLOOR
+                nbody_engine::decomp::check::DRIFT_FACTOR * t.serial_energy_drift
+                    + nbody_engine::decomp::check::DRIFT_FLOOR
             );
         }
         outln!(
@@ -373,7 +373,7 @@ mod with_mpi {
     }
 
     pub fn bench(args: MpiBenchArgs) -> anyhow::Result<i32> {
-        nbody_bench::output::check_outputs(&[("--out", &args.out)], &[])?;
+        nbody_engine::output::check_outputs(&[("--out", &args.out)], &[])?;
         let mut mpi = match start(&job("mpi-bench", &args)) {
             Ok(mpi) => mpi,
             Err(code) => return Ok(code),
@@ -409,8 +409,8 @@ mod with_mpi {
             "allgatherv p50"
         );
         for (p, a) in file.ping_pong.points.iter().zip(&file.allgatherv.points) {
-            let pp = nbody_bench::stats::median(&p.seconds).unwrap_or(0.0);
-            let ag = nbody_bench::stats::median(&a.seconds).unwrap_or(0.0);
+            let pp = nbody_engine::stats::median(&p.seconds).unwrap_or(0.0);
+            let ag = nbody_engine::stats::median(&a.seconds).unwrap_or(0.0);
             outln!(
                 "{:>10} {:>14} {:>14.3} {:>18}",
                 p.bytes,
@@ -424,7 +424,7 @@ mod with_mpi {
             );
         }
         let text = serde_json::to_string_pretty(&file).context("serializing the timings")?;
-        nbody_bench::output::write_atomic(&args.out, text.as_bytes())?;
+        nbody_engine::output::write_atomic(&args.out, text.as_bytes())?;
         outln!("timings written to {}", args.out.display());
         Ok(0)
     }
@@ -435,7 +435,7 @@ mod tests {
     use super::job;
     use crate::cli::args::{Cli, Command};
     use clap::Parser;
-    use nbody_bench::ranks::job::{Difference, JobDigest};
+    use nbody_mpi::ranks::job::{Difference, JobDigest};
 
     /// The digest of the MPI job of a command line, as `Mpi::init` computes it.
     fn digest(line: &str) -> JobDigest {

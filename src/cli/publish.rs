@@ -1,11 +1,11 @@
 //! `nbody-bench publish`: the performance history as one self-contained HTML page, or as a
 //! Markdown summary for a pull-request comment (`--markdown`). The page and the summary are
-//! the library's (`nbody_bench::history::publish`); this parses, calls it and prints.
+//! the library's (`nbody_harness::history::publish`); this parses, calls it and prints.
 
 use super::history::DEFAULT_DIR;
 use anyhow::Context;
 use clap::Args;
-use nbody_bench::history::publish::{self, markdown};
+use nbody_harness::history::publish::{self, markdown};
 use std::path::{Path, PathBuf};
 
 #[derive(Debug, Args)]

@@ -5,11 +5,11 @@ use crate::cli::args::ReportArgs;
 pub fn report(args: ReportArgs) -> anyhow::Result<i32> {
     // The report is read (its kept regions) and then replaced: it must be a regular file and
     // none of the results it is made from (`--out /dev/full` would be read without end).
-    let inputs = nbody_bench::report::find_results(&args.results)?;
+    let inputs = nbody_harness::report::find_results(&args.results)?;
     let inputs: Vec<(&str, &std::path::Path)> =
         inputs.iter().map(|p| ("--results", p.as_path())).collect();
-    nbody_bench::output::check_outputs(&[("--out", &args.out)], &inputs)?;
-    let generated = nbody_bench::report::generate(&args.results, &args.out)?;
+    nbody_engine::output::check_outputs(&[("--out", &args.out)], &inputs)?;
+    let generated = nbody_harness::report::generate(&args.results, &args.out)?;
     outln!(
         "{}: {} sweeps, {} figures",
         generated.path.display(),

@@ -3,7 +3,7 @@ use super::summary::print_summary;
 use super::{kernel_params, start_setup};
 use crate::cli::args::{RunArgs, SkinArg};
 use anyhow::Context;
-use nbody_bench::run::{RunSpec, TrajectorySpec, logical_cpus, run_setup};
+use nbody_engine::run::{RunSpec, TrajectorySpec, logical_cpus, run_setup};
 
 pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     // Every output is checked before the run starts: a result is never lost at the end.
@@ -15,7 +15,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     .into_iter()
     .filter_map(|(flag, path)| Some((flag, path?)))
     .collect();
-    nbody_bench::output::check_outputs(&outputs, &super::initial_input(&args.start))?;
+    nbody_engine::output::check_outputs(&outputs, &super::initial_input(&args.start))?;
     let auto_skin = args.kernel_args.skin == Some(SkinArg::Auto);
     if let Some(decomp) = args.decomp {
         if auto_skin {
@@ -28,7 +28,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     }
     let setup = start_setup(args.scenario, &args.system, &args.start)?;
     let params = kernel_params(&args.kernel_args, Some(args.kernel))?;
-    nbody_bench::run::check_memory(&setup, args.kernel, &params, args.kernel_args.threads, 1)?;
+    nbody_engine::run::check_memory(&setup, args.kernel, &params, args.kernel_args.threads, 1)?;
     if !args.yes {
         refuse_long_run(&setup, args.kernel, &args.kernel_args, args.steps as u64)?;
     }
@@ -58,7 +58,7 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
     print_summary(&outcome);
     if let Some(path) = &args.json {
         let text = serde_json::to_string_pretty(&outcome).context("serializing the result")?;
-        nbody_bench::output::write_atomic(path, text.as_bytes())?;
+        nbody_engine::output::write_atomic(path, text.as_bytes())?;
         outln!("result written to {}", path.display());
     }
     Ok(0)
@@ -66,11 +66,11 @@ pub fn run(args: RunArgs) -> anyhow::Result<i32> {
 
 /// `--skin auto`: every candidate skin timed on the run's system and threads, the table on the
 /// error stream, the fastest returned.
-fn choose_skin(setup: &nbody_bench::scenario::Setup, spec: &RunSpec) -> anyhow::Result<f64> {
-    use nbody_bench::experiment::skin::{TRIAL_STEPS, fastest, tune};
+fn choose_skin(setup: &nbody_engine::scenario::Setup, spec: &RunSpec) -> anyhow::Result<f64> {
+    use nbody_harness::experiment::skin::{TRIAL_STEPS, fastest, tune};
     eprintln!(
         "--skin auto: timing {} skins, {TRIAL_STEPS} steps each on {} thread(s)",
-        nbody_bench::experiment::skin::SKIN_FACTORS.len(),
+        nbody_harness::experiment::skin::SKIN_FACTORS.len(),
         spec.threads
     );
     let trials = tune(setup, spec.kernel, &spec.params, spec.threads, TRIAL_STEPS)?;

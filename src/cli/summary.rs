@@ -1,7 +1,7 @@
 //! The summary `run` prints, serial or under MPI.
 
-use nbody_bench::run::RunOutcome;
-use nbody_bench::units::Duration;
+use nbody_engine::run::RunOutcome;
+use nbody_harness::units::Duration;
 
 pub fn print_summary(r: &RunOutcome) {
     let t = &r.timing;

@@ -1,15 +1,16 @@
 use crate::cli::args::SweepArgs;
-use nbody_bench::experiment::progress;
-use nbody_bench::experiment::runner::{SweepOptions, run_sweep_wall};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::locate;
-use nbody_bench::records::results::{ResultsFile, utc_now};
-use nbody_bench::units::Duration;
+use nbody_engine::output::provenance::utc_now;
+use nbody_harness::experiment::progress;
+use nbody_harness::experiment::runner::{SweepOptions, run_sweep_wall};
+use nbody_harness::units::Duration;
+use nbody_records::config::SweepConfig;
+use nbody_records::locate;
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 
 pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     if let Some(Some(run)) = &args.resume
-        && nbody_bench::input::is_pipe(run)
+        && nbody_engine::input::is_pipe(run)
     {
         anyhow::bail!(
             "--resume {}: is a pipe; a resumed run is written back in place: pass its run \
@@ -20,10 +21,10 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let config_path = locate::find_config(&args.config)?;
     let (config, text) = SweepConfig::load(&config_path)?;
     // A config read from a pipe has no directory: its {config_dir} is the current one.
-    let from_pipe = nbody_bench::input::is_pipe(&config_path);
+    let from_pipe = nbody_engine::input::is_pipe(&config_path);
     let target = where_to_write(&args, &config)?;
     let existing = match &target {
-        Target::Out => Some(nbody_bench::experiment::runner::results_path(
+        Target::Out => Some(nbody_harness::experiment::runner::results_path(
             &config,
             args.out.as_deref(),
         )),
@@ -42,7 +43,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
             config_dir: config_dir.clone(),
             ..Default::default()
         };
-        nbody_bench::experiment::runner::check_before_running(&config, &options)?;
+        nbody_harness::experiment::runner::check_before_running(&config, &options)?;
     }
     if let Some(code) = super::dry_run::before_sweep(&args, &config, existing.as_deref())? {
         return Ok(code);

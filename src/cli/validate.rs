@@ -1,9 +1,9 @@
 use super::{kernel_params, setup};
 use crate::cli::args::ValidateArgs;
-use nbody_bench::kernels::KernelKind;
-use nbody_bench::scenario::ScenarioKind;
-use nbody_bench::units::WallTime;
-use nbody_bench::validate::{ScenarioCheck, ValidateJob, validate_setup};
+use nbody_engine::kernels::KernelKind;
+use nbody_engine::scenario::ScenarioKind;
+use nbody_engine::validate::{ScenarioCheck, ValidateJob, validate_setup};
+use nbody_harness::units::WallTime;
 use std::path::PathBuf;
 
 pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
@@ -16,7 +16,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
             .iter()
             .map(|&s| dump_file(dump, scenarios.len(), s))
             .collect();
-        nbody_bench::output::check_derived("--dump", dump, &paths)?;
+        nbody_engine::output::check_derived("--dump", dump, &paths)?;
     }
     super::no_auto_skin(&args.kernel_args, "validate")?;
     let params = kernel_params(&args.kernel_args, None)?;
@@ -40,7 +40,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
             KernelKind::Verlet,
             KernelKind::PerThread,
         ] {
-            nbody_bench::run::check_memory(&s, kernel, &params, args.kernel_args.threads, 1)?;
+            nbody_engine::run::check_memory(&s, kernel, &params, args.kernel_args.threads, 1)?;
         }
         if !args.yes {
             refuse_long_check(&s, params, args.kernel_args.threads)?;
@@ -53,7 +53,7 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
         let check = validate_setup(&s, job)??;
         if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
             let path = dump_file(path, scenarios.len(), scenario);
-            nbody_bench::output::write_atomic(&path, text.as_bytes())?;
+            nbody_engine::output::write_atomic(&path, text.as_bytes())?;
             if !args.json {
                 outln!("forces written to {}", path.display());
             }
@@ -102,8 +102,8 @@ const PROBE_N: usize = 1000;
 /// Refuses a check estimated at more than an hour unless `--yes` is given: the same check at
 /// [`PROBE_N`] particles, timed, carried to n as n² (its direct sums dominate).
 fn refuse_long_check(
-    setup: &nbody_bench::scenario::Setup,
-    params: nbody_bench::kernels::KernelParams,
+    setup: &nbody_engine::scenario::Setup,
+    params: nbody_engine::kernels::KernelParams,
     threads: usize,
 ) -> anyhow::Result<()> {
     let n = setup.n();

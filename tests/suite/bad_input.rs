@@ -236,6 +236,17 @@ fn configs_name_the_key_and_the_allowed_forms() {
 }
 
 #[test]
+fn a_missing_config_lists_the_places_and_the_configs() {
+    let o = bin()
+        .current_dir(env!("CARGO_MANIFEST_DIR"))
+        .args(["sweep", "--config", "no-such-config", "--dry-run"])
+        .output()
+        .unwrap();
+    refused(&o, "configs/no-such-config.toml");
+    assert!(text(&o.stderr).contains("quick"), "{}", text(&o.stderr));
+}
+
+#[test]
 fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
     for (kernel, flag, users) in [
         ("naive", ["--theta", "0.7"], "octree and fmm kernels"),

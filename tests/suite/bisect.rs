@@ -7,7 +7,7 @@
 //! ⌈log₂ 16⌉ + 3 builds. The command line's refusals are checked through the binary.
 
 use super::{bin, refused};
-use nbody_bench::history::bisect::{self, Finding, Probe, Settings};
+use nbody_harness::history::bisect::{self, Finding, Probe, Settings};
 use rand::{Rng, SeedableRng};
 use rand_distr::StandardNormal;
 use rand_pcg::Pcg64Mcg;
@@ -167,8 +167,8 @@ fn the_commit_is_named_in_19_of_20_seeded_trials_within_the_build_budget() {
         };
         let settings = Settings {
             direction: bisect::Direction::Slower,
-            threshold: nbody_bench::gate::AB_THRESHOLD,
-            rounds: nbody_bench::gate::AB_ROUNDS,
+            threshold: nbody_harness::gate::AB_THRESHOLD,
+            rounds: nbody_harness::gate::AB_ROUNDS,
             seed: trial,
         };
         let found = bisect::bisect(&path, &mut probe, settings, &mut |_| {}).unwrap();

@@ -47,7 +47,7 @@ fn help_and_list() {
     // The top-level help's summary names every kernel the binary has.
     let help = String::from_utf8_lossy(&bin(&["--help"]).stdout).into_owned();
     let summary = help.split("Exit codes").next().unwrap_or_default();
-    for kind in nbody_bench::kernels::KernelKind::ALL {
+    for kind in nbody_engine::kernels::KernelKind::ALL {
         assert!(
             summary.contains(kind.name()),
             "--help's summary lacks the {} kernel",
@@ -415,7 +415,7 @@ fn trajectory_is_written_in_nbview_binary() {
         path.to_str().unwrap(),
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let t = nbody_bench::output::nbview::read_binary(std::fs::File::open(&path).unwrap()).unwrap();
+    let t = nbody_engine::output::nbview::read_binary(std::fs::File::open(&path).unwrap()).unwrap();
     assert_eq!((t.n, t.frames.len()), (50, 5));
     assert!((t.scale - 0.316).abs() < 0.01, "scale {}", t.scale);
 }

@@ -1,7 +1,7 @@
 //! Every config in tests/configs/good and configs/ parses; every config in tests/configs/bad
 //! fails with the message on its first line (`#^ expected text`).
 
-use nbody_bench::records::config::SweepConfig;
+use nbody_records::config::SweepConfig;
 use std::path::Path;
 
 fn tomls(dir: &str) -> Vec<std::path::PathBuf> {

@@ -1,13 +1,13 @@
 //! Energy conservation of velocity Verlet over a few hundred steps for every scenario, and a
 //! two-body circular orbit that stays circular (the fmm's through its expansions).
 
-use nbody_bench::boundary::Boundary;
-use nbody_bench::engine::Simulation;
-use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::physics::Gravity;
-use nbody_bench::run::{RunJob, RunSpec};
-use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemInfo};
-use nbody_bench::state::State;
+use nbody_engine::boundary::Boundary;
+use nbody_engine::engine::Simulation;
+use nbody_engine::kernels::{KernelKind, KernelParams};
+use nbody_engine::physics::Gravity;
+use nbody_engine::run::{RunJob, RunSpec};
+use nbody_engine::scenario::{Precision, ScenarioKind, Setup, System, SystemInfo};
+use nbody_engine::state::State;
 
 fn drift(scenario: ScenarioKind, kernel: KernelKind, n: usize, steps: u64, dt: Option<f64>) -> f64 {
     let mut setup = Setup::new(scenario);
@@ -21,7 +21,7 @@ fn drift(scenario: ScenarioKind, kernel: KernelKind, n: usize, steps: u64, dt: O
         trajectory: None,
         dump_state: None,
     };
-    let clock = nbody_bench::clock::WallClock::new();
+    let clock = nbody_engine::clock::WallClock::new();
     let r = setup.dispatch(RunJob(&spec, &clock)).unwrap().unwrap();
     assert_eq!(r.steps, steps);
     r.energy.rel_drift
@@ -190,7 +190,7 @@ fn run_times_its_steps_with_the_clock_it_is_given() {
         trajectory: None,
         dump_state: None,
     };
-    let clock = nbody_bench::clock::MockClock::new(std::time::Duration::from_millis(1));
+    let clock = nbody_engine::clock::MockClock::new(std::time::Duration::from_millis(1));
     let r = setup.dispatch(RunJob(&spec, &clock)).unwrap().unwrap();
     let p = &r.timing.per_step_ns;
     // The step histogram keeps three significant digits.

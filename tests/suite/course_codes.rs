@@ -70,8 +70,8 @@ fn the_course_codes_build_run_and_report_their_phases() {
             assert!(run.reported_s.is_some_and(|t| t > 0.0), "{key}");
         }
     }
-    let analysis = nbody_bench::analysis::analyze(&results, &path).unwrap();
-    let table = nbody_bench::render::runs::external_phases(&analysis);
+    let analysis = nbody_harness::analysis::analyze(&results, &path).unwrap();
+    let table = nbody_harness::render::runs::external_phases(&analysis);
     for program in ["lj_serial", "lj_omp", "lj_mpi", "coulomb_mpi"] {
         assert!(table.contains(program), "{program} missing from\n{table}");
     }

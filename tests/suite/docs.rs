@@ -6,10 +6,10 @@
 //! `NBODY_BENCH_UPDATE_DOCS=1 cargo test --test suite docs` rewrites the generated pages.
 
 use crate::{bin, text};
-use nbody_bench::records::external::SampleError;
-use nbody_bench::records::results::{InitialRecord, ResultsFile};
-use nbody_bench::records::scheduler::{JobError, JobRecord};
-use nbody_bench::records::vet::Rejected;
+use nbody_records::external::SampleError;
+use nbody_records::results::{InitialRecord, ResultsFile};
+use nbody_records::scheduler::{JobError, JobRecord};
+use nbody_records::vet::Rejected;
 use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 
@@ -350,7 +350,7 @@ fn every_relative_link_of_the_docs_leads_somewhere() {
 /// file of a committed baseline's machine class reads back.
 #[test]
 fn the_gate_page_tables_come_from_the_study_files() {
-    use nbody_bench::gate::study::{run, table};
+    use nbody_harness::gate::study::{run, table};
     let files = run::study_files(&root().join("results/gate-study")).unwrap();
     let path = root().join("docs/explanation/gate.md");
     let page = std::fs::read_to_string(&path).unwrap();

@@ -2,8 +2,8 @@
 //! against a real sweep's wall time, and the guard that refuses a sweep of hours without
 //! `--yes` when there is no terminal to ask.
 
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::plan::cases;
+use nbody_records::config::SweepConfig;
+use nbody_records::plan::cases;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::sync::Mutex;

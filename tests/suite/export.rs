@@ -1,10 +1,10 @@
 //! `nbody-bench export`: the files read back give our initial state (LAMMPS data in reduced
 //! units, the text table exactly, the .npy array exactly), and other laws are refused for LAMMPS.
 
-use nbody_bench::kernels::CompiledKernels;
-use nbody_bench::physics::LawParameters;
-use nbody_bench::real::Real;
-use nbody_bench::scenario::{ScenarioKind, Setup, System, SystemJob};
+use nbody_engine::kernels::CompiledKernels;
+use nbody_engine::physics::LawParameters;
+use nbody_engine::real::Real;
+use nbody_engine::scenario::{ScenarioKind, Setup, System, SystemJob};
 use std::path::Path;
 
 /// Per particle in id order: position, velocity, mass, strength (f64), and the law.

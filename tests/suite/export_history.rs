@@ -187,7 +187,7 @@ fn the_help_and_the_outputs_page_name_every_history_column() {
         .nth(1)
         .and_then(|s| s.split("\n## ").next())
         .expect("docs/reference/outputs.md's export-results section has a history part");
-    for (c, _) in nbody_bench::history::tidy::HISTORY_COLUMNS {
+    for (c, _) in nbody_harness::history::tidy::HISTORY_COLUMNS {
         assert!(help.contains(&format!("  {c} ")), "--help: {c}");
         assert!(
             section.contains(&format!("`{c}`")),

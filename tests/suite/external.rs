@@ -3,10 +3,10 @@
 //! placeholders and environment, a threads study read as strong scaling, failing samples kept
 //! as errors, resume, arguments passed literally, bad configs refused.
 
-use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::results::ResultsFile;
+use nbody_engine::clock::MockClock;
+use nbody_harness::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
+use nbody_records::config::SweepConfig;
+use nbody_records::results::ResultsFile;
 use std::path::Path;
 use std::time::Duration;
 
@@ -70,10 +70,7 @@ rounds = 2
 min_sample_s = 0.002
 "#;
 
-pub(crate) fn record<'a>(
-    r: &'a ResultsFile,
-    key: &str,
-) -> &'a nbody_bench::records::results::CaseRecord {
+pub(crate) fn record<'a>(r: &'a ResultsFile, key: &str) -> &'a nbody_records::results::CaseRecord {
     r.cases.iter().find(|c| c.key == key).unwrap_or_else(|| {
         panic!(
             "no case {key} in {:?}",
@@ -156,7 +153,7 @@ time = "wall"
     );
     // The analysis sets the kernel against the faster program of the same case, with the ratio
     // of the medians and an interval around it, and the slower one beside it.
-    let a = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
+    let a = nbody_harness::analysis::analyze(&r, Path::new("results.json")).unwrap();
     let naive = record(&r, "lj-box/naive/n=50/p=1/r=1/seed=1")
         .summary
         .as_ref()
@@ -176,14 +173,14 @@ time = "wall"
     let ci = row.speedup_ci.unwrap();
     assert!(ci[0] <= row.speedup && row.speedup <= ci[1], "{ci:?}");
     assert!((row.theirs_ns - 1.5e-3 * 1e9 / 50.0).abs() < 1e-6);
-    let table = nbody_bench::render::tables::peers(&a);
+    let table = nbody_harness::render::tables::peers(&a);
     assert!(table.contains("| lj-box | 50 | 1 | naive |"), "{table}");
     assert!(
         table.contains("| printed |") && table.contains("walled: "),
         "{table}"
     );
     // How each program ran comes from the config the results file holds.
-    let runs = nbody_bench::render::runs::external_runs(&a);
+    let runs = nbody_harness::render::runs::external_runs(&a);
     assert!(runs.contains("- `printed` (printed 2.1): `"), "{runs}");
     assert!(
         runs.contains("`walled`") && runs.contains("wall time"),
@@ -277,7 +274,7 @@ env = {{ OMP_NUM_THREADS = "{{threads}}" }}
     let two = record(&r, "lj-box/scaled/n=50/p=2/r=1/seed=1");
     assert_eq!(one.summary.as_ref().unwrap().median_s, 4e-3);
     assert_eq!(two.summary.as_ref().unwrap().median_s, 2e-3);
-    let analysis = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
+    let analysis = nbody_harness::analysis::analyze(&r, Path::new("results.json")).unwrap();
     let strong = analysis
         .strong
         .iter()
@@ -316,7 +313,7 @@ force_error = 'error (\S+)'
         entry("alone", "", 3.0, 5e-3),
     );
     let r = sweep(&text, dir.path());
-    let groups = nbody_bench::analysis::groups::group(&r);
+    let groups = nbody_harness::analysis::groups::group(&r);
     let names: Vec<&str> = groups.theta.iter().map(|s| s.key.kernel.name()).collect();
     // The program of no family has one setting: no series.
     assert_eq!(names, ["code"]);
@@ -404,7 +401,7 @@ check = 'check OK'
         hang[0].what
     );
     // A failed case is left out of the analysis, not read as a zero time.
-    let analysis = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
+    let analysis = nbody_harness::analysis::analyze(&r, Path::new("results.json")).unwrap();
     assert_eq!(analysis.cases.len(), 1);
 }
 

@@ -6,7 +6,7 @@
 //! rather than slept, so every number the tests check is exact.
 
 use super::external::{HEAD, MEASURE, program_dir, record, sweep};
-use nbody_bench::records::external::PhaseKind;
+use nbody_records::external::PhaseKind;
 use std::path::Path;
 
 /// A program of `serial_ms` serial work, `parallel_ms` split over OMP_NUM_THREADS and
@@ -49,7 +49,7 @@ fn a_programs_serial_phase_gives_the_timed_serial_fraction_it_was_built_with() {
         assert_eq!(run.phases["work"], 6e-3);
         assert_eq!(run.phases["exchange"], 0.0);
     }
-    let analysis = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
+    let analysis = nbody_harness::analysis::analyze(&r, Path::new("results.json")).unwrap();
     let point = analysis
         .cases
         .iter()
@@ -98,7 +98,7 @@ fn communication_phases_stand_as_the_cases_communication() {
         &strong_config(&phased("mpi-like", 1.0, 4.0, 1.0)),
         dir.path(),
     );
-    let analysis = nbody_bench::analysis::analyze(&r, Path::new("results.json")).unwrap();
+    let analysis = nbody_harness::analysis::analyze(&r, Path::new("results.json")).unwrap();
     let two = analysis
         .cases
         .iter()
@@ -107,12 +107,12 @@ fn communication_phases_stand_as_the_cases_communication() {
     assert_eq!(two.comm_s_per_step, Some(0.25e-3));
     assert!((two.median_s - 1e-3).abs() < 1e-15);
     // The summary's phase table names each phase with its kind and share.
-    let table = nbody_bench::render::runs::external_phases(&analysis);
+    let table = nbody_harness::render::runs::external_phases(&analysis);
     let row = table
         .lines()
         .find(|l| l.contains("mpi-like") && l.contains("2 threads"))
         .unwrap_or_else(|| panic!("no row for the 2-thread case in\n{table}"));
-    let quarter = nbody_bench::units::Duration(0.25e-3);
+    let quarter = nbody_harness::units::Duration(0.25e-3);
     assert!(
         row.contains(&format!("exchange (comm): {quarter} (25.0%)")),
         "{row}"

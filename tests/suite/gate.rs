@@ -308,7 +308,7 @@ fn same_tree_repo() -> (tempfile::TempDir, PathBuf) {
     let target = dir.path().join("target");
     let cached = target
         .join("gate-base")
-        .join(nbody_bench::gate::base_build::cache_key(&head));
+        .join(nbody_harness::gate::base_build::cache_key(&head));
     std::fs::create_dir_all(&cached).unwrap();
     std::fs::copy(
         env!("CARGO_BIN_EXE_nbody-bench"),
@@ -410,7 +410,7 @@ fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
 
 #[test]
 fn a_base_revision_is_built_once_and_a_broken_one_is_refused() {
-    use nbody_bench::gate::base_build::{base_binary, cache_root};
+    use nbody_harness::gate::base_build::{base_binary, cache_root};
     let dir = tempfile::tempdir().unwrap();
     let repo = dir.path();
     git(repo, &["init", "-q"]);
@@ -537,9 +537,9 @@ fn a_stale_baseline_of_this_class_takes_a_b_with_a_notice() {
         v["config"]["retired_key"] = 1.into();
         for side in ["start", "end"] {
             let c = &mut v["calibration"][side];
-            c["cpu_model"] = nbody_bench::calibrate::cpu_model().into();
-            c["cpu_signature"] = nbody_bench::calibrate::cpu_signature().into();
-            c["logical_cpus"] = nbody_bench::run::logical_cpus().into();
+            c["cpu_model"] = nbody_calibrate::cpu_model().into();
+            c["cpu_signature"] = nbody_calibrate::cpu_signature().into();
+            c["logical_cpus"] = nbody_engine::run::logical_cpus().into();
         }
     });
     assert!(stale.starts_with(&folder));

@@ -3,7 +3,7 @@
 //! class's CI falls to the A/B route, or to a refusal, because of a change of a key, a default
 //! or a schema. A baseline that is stale all the same takes the A/B route with a notice.
 
-use nbody_bench::gate::baselines::{self, Fitness};
+use nbody_harness::gate::baselines::{self, Fitness};
 use std::path::{Path, PathBuf};
 
 fn folder() -> PathBuf {
@@ -56,11 +56,11 @@ fn fitness(path: &Path) -> Result<(), String> {
 #[test]
 fn a_changed_default_is_caught() {
     let dir = tempfile::tempdir().unwrap();
-    let today = nbody_bench::kernels::KernelParams::default().multipole;
+    let today = nbody_engine::kernels::KernelParams::default().multipole;
     let without = edited(dir.path(), |v| {
         v["config"].as_object_mut().unwrap().remove("multipole");
     });
-    if today == nbody_bench::kernels::Multipole::Monopole {
+    if today == nbody_engine::kernels::Multipole::Monopole {
         assert_eq!(fitness(&without), Ok(()));
     } else {
         let why = fitness(&without).unwrap_err();

@@ -307,7 +307,7 @@ fn hanging_base(dir: &Path, head: &str, script: &str) {
     use std::os::unix::fs::PermissionsExt;
     let cached = dir
         .join("target/gate-base")
-        .join(nbody_bench::gate::base_build::cache_key(head));
+        .join(nbody_harness::gate::base_build::cache_key(head));
     std::fs::create_dir_all(&cached).unwrap();
     let path = cached.join("nbody-bench");
     std::fs::write(&path, script).unwrap();

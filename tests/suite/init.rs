@@ -2,7 +2,7 @@
 //! accepts as written, with every `[[external]]` key it can take named; never over a file.
 
 use super::bin;
-use nbody_bench::records::config::SweepConfig;
+use nbody_records::config::SweepConfig;
 
 #[test]
 fn init_writes_a_config_the_sweep_accepts_and_never_replaces_a_file() {

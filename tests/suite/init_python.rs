@@ -4,8 +4,8 @@
 //! small n, sweeps it through the binary into results with its samples.
 
 use super::{bin, refused, text};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::results::ResultsFile;
+use nbody_records::config::SweepConfig;
+use nbody_records::results::ResultsFile;
 
 /// Whether `python3` runs here; the tests that need it say so and pass without it.
 fn python3() -> bool {

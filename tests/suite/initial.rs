@@ -423,7 +423,7 @@ fn a_sweep_starts_every_case_from_the_configs_file_of_bodies() {
         )
     };
     let results = sweep_config(dir.path(), &config(64, "")).unwrap();
-    let file: nbody_bench::records::results::ResultsFile = serde_json::from_str(&results).unwrap();
+    let file: nbody_records::results::ResultsFile = serde_json::from_str(&results).unwrap();
     let record = file.metadata.initial.expect("the file recorded");
     assert!(record.path.ends_with("galaxy.txt") && Path::new(&record.path).is_absolute());
     assert_eq!((record.format.as_str(), record.bodies), ("export", 64));

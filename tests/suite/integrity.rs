@@ -4,7 +4,7 @@
 //! cases, unsupported fits, the wrong run to resume and a weak study's `n` are refused.
 
 use crate::{bin, refused};
-use nbody_bench::records::results::ResultsFile;
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -151,7 +151,7 @@ fn stored_summaries_are_recomputed_from_the_raw_samples() {
     assert_eq!(s.samples, kept.len(), "the impossible samples are out");
     assert_eq!(
         s.median_s,
-        nbody_bench::stats::median(&kept).unwrap(),
+        nbody_engine::stats::median(&kept).unwrap(),
         "stored {stored}"
     );
     assert_eq!(c.rejected.len(), 2);

@@ -1,9 +1,9 @@
 //! Physical invariants of the force kernels, over random seeded configurations (proptest):
 //! Newton's third law (Σ F ≈ 0), translation invariance and permutation invariance.
 
-use nbody_bench::kernels::{CompiledKernels, KernelKind, KernelParams};
-use nbody_bench::physics::{Coulomb, Gravity, LennardJones};
-use nbody_bench::state::{Field, State, zero_field};
+use nbody_engine::kernels::{CompiledKernels, KernelKind, KernelParams};
+use nbody_engine::physics::{Coulomb, Gravity, LennardJones};
+use nbody_engine::state::{Field, State, zero_field};
 use nbody_engine::testing::{random_state, spaced_state};
 use proptest::prelude::*;
 

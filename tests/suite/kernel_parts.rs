@@ -5,12 +5,12 @@
 //! gives them to rounding (the symmetric kernels split the pair work, so the sums are grouped
 //! differently).
 
-use nbody_bench::kernels::CompiledKernels;
-use nbody_bench::kernels::{KernelKind, KernelParams, Share};
-use nbody_bench::real::Real;
-use nbody_bench::scenario::{ScenarioKind, Setup, System, SystemJob};
-use nbody_bench::state::zero_field;
-use nbody_bench::validate::{EXACT_ULPS, reference_forces};
+use nbody_engine::kernels::CompiledKernels;
+use nbody_engine::kernels::{KernelKind, KernelParams, Share};
+use nbody_engine::real::Real;
+use nbody_engine::scenario::{ScenarioKind, Setup, System, SystemJob};
+use nbody_engine::state::zero_field;
+use nbody_engine::validate::{EXACT_ULPS, reference_forces};
 
 struct Parts {
     threads: usize,

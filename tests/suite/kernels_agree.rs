@@ -4,12 +4,12 @@
 //! orders, the quadrupole's below the monopole's; the fmm is exact at θ = 0 and within its
 //! tolerance on the scenarios, and `validate` skips it, visibly, at θ ≥ 1.
 
-use nbody_bench::kernels::CompiledKernels;
-use nbody_bench::kernels::{KernelKind, KernelParams, Multipole};
-use nbody_bench::real::Real;
-use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
-use nbody_bench::state::zero_field;
-use nbody_bench::validate::{EXACT_ULPS, reference_forces};
+use nbody_engine::kernels::CompiledKernels;
+use nbody_engine::kernels::{KernelKind, KernelParams, Multipole};
+use nbody_engine::real::Real;
+use nbody_engine::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
+use nbody_engine::state::zero_field;
+use nbody_engine::validate::{EXACT_ULPS, reference_forces};
 
 /// Per kernel: the worst |F − F_naive| / Σ|F_ij| (naive in the same precision) and the median
 /// |F − F_ref| / |F_ref| against the f64 reference.
@@ -267,7 +267,7 @@ fn octree_error_grows_with_theta_and_meets_the_target() {
             "{scenario:?}: {errors:?}"
         );
         let at_half = octree_error(scenario, 0.5, Multipole::Monopole, 1);
-        let bound = nbody_bench::validate::octree_tolerance(scenario.law(), 0.5);
+        let bound = nbody_engine::validate::octree_tolerance(scenario.law(), 0.5);
         assert!(
             at_half <= bound,
             "{scenario:?}: median error {at_half:e} > {bound:e} at theta 0.5"
@@ -327,7 +327,7 @@ fn fmm_is_exact_at_theta_zero_and_within_its_tolerance() {
                 .dispatch(job)
                 .unwrap()
                 .1;
-            let bound = nbody_bench::validate::fmm_tolerance(0.5, order);
+            let bound = nbody_engine::validate::fmm_tolerance(0.5, order);
             assert!(
                 errs[0].median_rel <= bound,
                 "{scenario:?} p={order}: median error {:e} > {bound:e}",

@@ -60,8 +60,8 @@ use wait_timeout::ChildExt;
 /// would.
 pub struct StopAfter(pub usize);
 
-impl nbody_bench::experiment::runner::Observer for StopAfter {
-    fn round_done(&mut self, _: &nbody_bench::records::results::CaseRecord, _: usize) {
+impl nbody_harness::experiment::runner::Observer for StopAfter {
+    fn round_done(&mut self, _: &nbody_records::results::CaseRecord, _: usize) {
         self.0 = self.0.saturating_sub(1);
     }
 
@@ -168,14 +168,13 @@ pub fn sweep_committed_config(
     text: &str,
     name: &str,
 ) -> (
-    nbody_bench::records::results::ResultsFile,
+    nbody_records::results::ResultsFile,
     std::path::PathBuf,
     tempfile::TempDir,
 ) {
-    use nbody_bench::experiment::runner::{Silent, SweepOptions, run_sweep};
+    use nbody_harness::experiment::runner::{Silent, SweepOptions, run_sweep};
     let configs = Path::new(env!("CARGO_MANIFEST_DIR")).join("configs");
-    let config =
-        nbody_bench::records::config::SweepConfig::parse(text, &configs.join(name)).unwrap();
+    let config = nbody_records::config::SweepConfig::parse(text, &configs.join(name)).unwrap();
     let dir = tempfile::tempdir().unwrap();
     let options = SweepOptions {
         out: Some(dir.path().to_path_buf()),
@@ -183,8 +182,8 @@ pub fn sweep_committed_config(
         nbody_bench: Some(env!("CARGO_BIN_EXE_nbody-bench").into()),
         ..Default::default()
     };
-    let clock = nbody_bench::clock::MockClock::new(std::time::Duration::from_millis(1));
+    let clock = nbody_engine::clock::MockClock::new(std::time::Duration::from_millis(1));
     let report = run_sweep(&config, text, &options, &clock, &mut Silent).unwrap();
-    let results = nbody_bench::records::results::ResultsFile::load(&report.path).unwrap();
+    let results = nbody_records::results::ResultsFile::load(&report.path).unwrap();
     (results, report.path, dir)
 }

@@ -5,9 +5,9 @@
 #![cfg(feature = "mpi")]
 
 use crate::text;
-use nbody_bench::decomp::Decomposition;
-use nbody_bench::decomp::stats::{MasterSummary, MpiReport, RankStats, reduce};
-use nbody_bench::records::results::ResultsFile;
+use nbody_engine::decomp::Decomposition;
+use nbody_engine::decomp::stats::{MasterSummary, MpiReport, RankStats, reduce};
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Output, Stdio};
 

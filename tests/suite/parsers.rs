@@ -1,8 +1,8 @@
 //! The parsers and validation of user input never panic: random and mutated sweep configs and
 //! CSV tables give a value or an error, nothing else.
 
-use nbody_bench::fit::csv;
-use nbody_bench::records::config::SweepConfig;
+use nbody_harness::fit::csv;
+use nbody_records::config::SweepConfig;
 use proptest::prelude::*;
 use std::path::Path;
 

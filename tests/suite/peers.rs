@@ -9,7 +9,7 @@ use std::path::Path;
 #[test]
 fn a_small_lammps_case_runs_through_the_harness() {
     assert!(
-        nbody_bench::experiment::external::process::resolve("lmp", None).is_ok(),
+        nbody_harness::experiment::external::process::resolve("lmp", None).is_ok(),
         "LAMMPS (`lmp`) is not installed: run scripts/install-peers.sh (or apt-get install -y lammps)"
     );
     let shipped = std::fs::read_to_string(
@@ -63,7 +63,7 @@ fn a_small_lammps_case_runs_through_the_harness() {
         .find(|c| c.key.starts_with("lj-box/lammps-tuned/"))
         .map(|c| {
             let root = path.parent().unwrap().join("work");
-            nbody_bench::experiment::external::workdir(&root, &c.key)
+            nbody_harness::experiment::external::workdir(&root, &c.key)
         })
         .unwrap();
     let stdout = std::fs::read_to_string(work.join("stdout.txt")).unwrap();

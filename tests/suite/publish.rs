@@ -13,10 +13,10 @@
 //! (`results/history/page/index.html`) from the committed history.
 
 use super::{bin, refused, text};
-use nbody_bench::gate::Verdict;
-use nbody_bench::history::publish;
-use nbody_bench::history::store::{self, Build, HISTORY_SCHEMA, Normalized, Record};
-use nbody_bench::history::verdicts::{self, CaseVerdict, GateRun, VERDICTS_SCHEMA};
+use nbody_harness::gate::Verdict;
+use nbody_harness::history::publish;
+use nbody_harness::history::store::{self, Build, HISTORY_SCHEMA, Normalized, Record};
+use nbody_harness::history::verdicts::{self, CaseVerdict, GateRun, VERDICTS_SCHEMA};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -90,7 +90,7 @@ fn fixture(dir: &Path) {
         current: commit(7),
         current_dirty: false,
         threshold: 0.03,
-        judged_on: nbody_bench::gate::Judged::Raw,
+        judged_on: nbody_harness::gate::Judged::Raw,
         cases: vec![CaseVerdict {
             key: NAIVE.into(),
             verdict: Verdict::Regressed,

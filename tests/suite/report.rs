@@ -52,7 +52,7 @@ fn report_numbers_come_from_the_results_and_regeneration_is_idempotent() {
         .find(|c| c["key"] == "lj-box/naive/n=2000/p=1/r=1/seed=1")
         .unwrap();
     let median = case["summary"]["median_s"].as_f64().unwrap();
-    assert!(text.contains(&nbody_bench::units::Duration(median).to_string()));
+    assert!(text.contains(&nbody_harness::units::Duration(median).to_string()));
     assert!(text.contains("(results/quick/analysis/time-vs-n-lj-box-f32-p1-r1.svg)"));
     assert!(
         dir.path()

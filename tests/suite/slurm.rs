@@ -4,10 +4,10 @@
 //!
 //!   scripts/slurm-local.sh -- cargo test --release --features mpi --test suite -- --ignored slurm::
 
-use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::runner::{Silent, SweepOptions, run_sweep};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::results::ResultsFile;
+use nbody_engine::clock::MockClock;
+use nbody_harness::experiment::runner::{Silent, SweepOptions, run_sweep};
+use nbody_records::config::SweepConfig;
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
@@ -81,7 +81,7 @@ fn a_sweep_through_slurm_has_the_shape_of_one_without() {
     for (a, b) in with.cases.iter().zip(&without.cases) {
         assert!(a.is_complete() && b.is_complete());
         assert_eq!(a.rounds.len(), b.rounds.len());
-        let samples = |c: &nbody_bench::records::results::CaseRecord| {
+        let samples = |c: &nbody_records::results::CaseRecord| {
             c.rounds
                 .iter()
                 .map(|r| r.samples_s.len())

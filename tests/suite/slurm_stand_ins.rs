@@ -9,7 +9,7 @@
 //! looks at the queue; `squeue` prints nothing (the job has left) and `scontrol` says COMPLETED.
 
 use crate::{finish, text};
-use nbody_bench::records::results::ResultsFile;
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
@@ -86,8 +86,8 @@ impl Slurm {
         let path = std::env::var("PATH").unwrap_or_default();
         c.args(args)
             .env("PATH", format!("{}:{path}", self.bin.display()))
-            .env_remove(nbody_bench::input::PIPE_WAIT_ENV)
-            .env_remove(nbody_bench::experiment::slurm::GRACE_ENV)
+            .env_remove(nbody_engine::input::PIPE_WAIT_ENV)
+            .env_remove(nbody_harness::experiment::slurm::GRACE_ENV)
             .stdout(Stdio::piped())
             .stderr(Stdio::piped());
         c
@@ -133,14 +133,14 @@ fn ok(o: &Output) {
 }
 
 /// The rounds of [`KEY`] in the results under `out`.
-fn rounds(out: &Path) -> Vec<nbody_bench::records::round::RoundOutcome> {
+fn rounds(out: &Path) -> Vec<nbody_records::round::RoundOutcome> {
     let r = ResultsFile::load(&out.join("batch/results.json")).unwrap();
     let case = r.cases.iter().find(|c| c.key == KEY).unwrap();
     case.rounds.clone()
 }
 
 /// Why round `i` has no samples, as its job record says.
-fn refusal(round: &nbody_bench::records::round::RoundOutcome) -> String {
+fn refusal(round: &nbody_records::round::RoundOutcome) -> String {
     assert!(round.samples_s.is_empty(), "{round:?}");
     let job = round.job.as_ref().expect("the round names its job");
     job.error
@@ -335,7 +335,7 @@ echo "$id""#,
         &config,
         &out,
         &[],
-        &[(nbody_bench::input::PIPE_WAIT_ENV, "0.3")],
+        &[(nbody_engine::input::PIPE_WAIT_ENV, "0.3")],
     );
     // No round has samples: the case failed (exit 1), no error of the sweep's own (2).
     assert_eq!(o.status.code(), Some(1), "{}", text(&o.stderr));
@@ -374,7 +374,7 @@ fn a_queue_with_other_lines_is_read_and_the_wait_is_bounded() {
         Some("COMPLETED")
     );
 
-    let grace = [(nbody_bench::experiment::slurm::GRACE_ENV, "1")];
+    let grace = [(nbody_harness::experiment::slurm::GRACE_ENV, "1")];
     for (name, squeue, seen) in [
         ("never-told", BANNER.to_string(), "no state"),
         (
@@ -450,7 +450,7 @@ fn a_job_reads_its_task_within_limits_and_checks_its_result_can_be_written_first
     std::fs::rename(&task, &kept).unwrap();
     let fifo = Command::new("mkfifo").arg(&task).status().unwrap();
     assert!(fifo.success());
-    let o = run_job(&[(nbody_bench::input::PIPE_WAIT_ENV, "0.3")]);
+    let o = run_job(&[(nbody_engine::input::PIPE_WAIT_ENV, "0.3")]);
     let err = text(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(

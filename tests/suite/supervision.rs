@@ -6,15 +6,15 @@
 //! writes to is given up after a bounded wait. Every child has a timeout.
 
 use crate::{finish, refused, text};
-use nbody_bench::children::{alive, members_left};
-use nbody_bench::records::results::ResultsFile;
+use nbody_harness::children::{alive, members_left};
+use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
 fn bin() -> Command {
     let mut c = crate::bin();
-    c.env_remove(nbody_bench::input::PIPE_WAIT_ENV)
+    c.env_remove(nbody_engine::input::PIPE_WAIT_ENV)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
     c
@@ -54,7 +54,7 @@ fn workdir(out: &Path) -> PathBuf {
 }
 
 /// The runs of the one case of [`config`].
-fn runs(out: &Path) -> Vec<nbody_bench::records::external::ExternalRun> {
+fn runs(out: &Path) -> Vec<nbody_records::external::ExternalRun> {
     let r = ResultsFile::load(&out.join("ext/results.json")).unwrap();
     r.cases[0]
         .rounds
@@ -263,7 +263,7 @@ fn bash(script: &str, dir: &Path) -> Output {
             .env("NB", env!("CARGO_BIN_EXE_nbody-bench"))
             .env("ROOT", env!("CARGO_MANIFEST_DIR"))
             .env_remove("NBODY_BENCH_TEST_SLOWDOWN")
-            .env_remove(nbody_bench::input::PIPE_WAIT_ENV)
+            .env_remove(nbody_engine::input::PIPE_WAIT_ENV)
             .args(["-c", script])
             .stdin(Stdio::null())
             .stdout(Stdio::piped())
@@ -338,7 +338,7 @@ fn a_named_pipe_nobody_writes_to_is_given_up() {
     assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o600) }, 0);
     let o = run(
         bin()
-            .env(nbody_bench::input::PIPE_WAIT_ENV, "0.5")
+            .env(nbody_engine::input::PIPE_WAIT_ENV, "0.5")
             .args(["fit", "--model", "amdahl", "--csv"])
             .arg(&fifo),
         "fit on a silent pipe",
@@ -348,12 +348,12 @@ fn a_named_pipe_nobody_writes_to_is_given_up() {
     // A bad wait is refused, not used.
     let o = run(
         bin()
-            .env(nbody_bench::input::PIPE_WAIT_ENV, "inf")
+            .env(nbody_engine::input::PIPE_WAIT_ENV, "inf")
             .args(["fit", "--model", "amdahl", "--csv"])
             .arg(&fifo),
         "bad wait",
     );
-    refused(&o, nbody_bench::input::PIPE_WAIT_ENV);
+    refused(&o, nbody_engine::input::PIPE_WAIT_ENV);
     // With a writer, the table is read.
     let mut writer = Command::new("sh")
         .arg("-c")

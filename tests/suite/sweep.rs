@@ -1,10 +1,10 @@
 //! The runner with a scripted clock (deterministic sample counts, resume without loss or
 //! repetition) and an end-to-end sweep through the CLI.
 
-use nbody_bench::clock::MockClock;
-use nbody_bench::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
-use nbody_bench::records::config::SweepConfig;
-use nbody_bench::records::results::{RESULTS_SCHEMA, ResultsFile};
+use nbody_engine::clock::MockClock;
+use nbody_harness::experiment::runner::{Silent, SweepError, SweepOptions, run_sweep};
+use nbody_records::config::SweepConfig;
+use nbody_records::results::{RESULTS_SCHEMA, ResultsFile};
 use std::path::Path;
 use std::time::Duration;
 

@@ -3,14 +3,14 @@
 //! the liquid with walls, on 1 and 2 threads, the liquid's list split over the threads); a
 //! particle that moves exactly half the skin keeps the list and the forces exact.
 
-use nbody_bench::engine::Simulation;
-use nbody_bench::kernels::CompiledKernels;
-use nbody_bench::kernels::verlet::{parts_for, step_work};
-use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::real::Real;
-use nbody_bench::scenario::{ScenarioKind, Setup, System, SystemJob};
-use nbody_bench::state::{Field, State, zero_field};
-use nbody_bench::validate::{EXACT_ULPS, reference_forces};
+use nbody_engine::engine::Simulation;
+use nbody_engine::kernels::CompiledKernels;
+use nbody_engine::kernels::verlet::{parts_for, step_work};
+use nbody_engine::kernels::{KernelKind, KernelParams};
+use nbody_engine::real::Real;
+use nbody_engine::scenario::{ScenarioKind, Setup, System, SystemJob};
+use nbody_engine::state::{Field, State, zero_field};
+use nbody_engine::validate::{EXACT_ULPS, reference_forces};
 
 /// The largest |F − F_naive| / Σ_j |F_ij| over the particles of `state` (0 for particles
 /// without partners, which must then feel nothing).

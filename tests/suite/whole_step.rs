@@ -5,12 +5,12 @@
 //! bitwise the same at any thread count, re-orderings and rebuilds included. An error in one
 //! worker's block ends the step with that error on every thread count, without a hang.
 
-use nbody_bench::engine::Simulation;
-use nbody_bench::kernels::CompiledKernels;
-use nbody_bench::kernels::{KernelKind, KernelParams};
-use nbody_bench::real::Real;
-use nbody_bench::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
-use nbody_bench::state::zero_field;
+use nbody_engine::engine::Simulation;
+use nbody_engine::kernels::CompiledKernels;
+use nbody_engine::kernels::{KernelKind, KernelParams};
+use nbody_engine::real::Real;
+use nbody_engine::scenario::{Precision, ScenarioKind, Setup, System, SystemJob};
+use nbody_engine::state::zero_field;
 
 /// Enough particles that every per-particle pass forks (above `par::MIN_FORK_ELEMENTS`).
 const N: usize = 20_000;

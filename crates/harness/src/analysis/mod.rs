@@ -1,0 +1,513 @@
+//! Offline analysis of a sweep: the series of a results file ([`groups`]) and the models fitted
+//! to them (complexity in n, strong and weak scaling, crossovers). Pure computation: no file is
+//! read or written here; `crate::render` turns an [`Analysis`] into tables, figures and files.
+//! Everything is recomputed from the raw samples, with seeded bootstraps, so the same results
+//! file always gives the same analysis.
+
+pub mod comm;
+pub mod groups;
+pub mod peers;
+pub mod tree_comm;
+mod views;
+
+use crate::fit::{
+    self, ComplexityClass, PowerFit, Samples, SerialFractionComparison, StrongFit,
+    TimedSerialFraction, WeakFit, WeakSamples,
+};
+use groups::{Groups, Point, Series, SeriesKey};
+use nbody_calibrate::Calibration;
+use nbody_engine::kernels::KernelKind;
+use nbody_records::config::{Study, WeakRule};
+use nbody_records::external::PhaseKind;
+use nbody_records::kernel_or_program::KernelOrProgram;
+use nbody_records::results::{Metadata, ResultsFile};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+pub(crate) const FITS_SCHEMA: &str = "nbody-bench/fits/v1";
+
+/// A fit, or why there is none (too few points, …): a series is never dropped silently.
+#[derive(Clone, Debug, Serialize)]
+pub struct Fitted<T> {
+    pub fit: Option<T>,
+    pub error: Option<String>,
+}
+
+impl<T> Fitted<T> {
+    fn of(result: Result<T, fit::FitError>) -> Self {
+        match result {
+            Ok(fit) => Fitted {
+                fit: Some(fit),
+                error: None,
+            },
+            Err(e) => Fitted {
+                fit: None,
+                error: Some(e.to_string()),
+            },
+        }
+    }
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ComplexityAnalysis {
+    pub series: SeriesKey,
+    pub(crate) label: String,
+    pub points: Vec<Point>,
+    pub fit: Fitted<PowerFit>,
+}
+
+/// Where two kernels' fitted cost curves cross.
+#[derive(Clone, Debug, Serialize)]
+pub(crate) struct Crossover {
+    pub scenario: String,
+    pub precision: String,
+    pub threads: usize,
+    /// The kernel that is faster above `n` and the one that is faster below it.
+    pub(crate) faster_above: String,
+    pub(crate) faster_below: String,
+    /// Where the fitted curves cross; `None` when `faster_above` is faster over the whole
+    /// measured range.
+    pub n: Option<f64>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StrongAnalysis {
+    pub series: SeriesKey,
+    pub(crate) label: String,
+    pub points: Vec<Point>,
+    /// Speedup and efficiency at every measured p, oversubscribed ones included.
+    pub measured: Vec<fit::StrongPoint>,
+    /// The models, fitted to the cases that had a logical CPU per worker only: an
+    /// oversubscribed case measures time-sharing, not parallel speedup.
+    pub fit: Fitted<StrongFit>,
+    /// The serial fraction from the one-worker case's phase timers (the Barnes-Hut report's method),
+    /// and how it compares with the fitted one.
+    pub timed_serial: Option<TimedSerialFraction>,
+    pub(crate) serial_comparison: Option<SerialFractionComparison>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct WeakAnalysis {
+    pub series: SeriesKey,
+    pub(crate) label: String,
+    pub rule: Option<WeakRule>,
+    pub points: Vec<Point>,
+    /// Efficiency at every measured p, oversubscribed ones included.
+    pub measured: Vec<fit::EfficiencyPoint>,
+    /// Gustafson's model, fitted to the cases that had a logical CPU per worker only.
+    pub fit: Fitted<WeakFit>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct ThetaAnalysis {
+    pub series: SeriesKey,
+    pub(crate) label: String,
+    pub points: Vec<Point>,
+}
+
+/// Everything `analyze` derives from one results file (`fits.json`).
+#[derive(Clone, Debug, Serialize)]
+pub struct Analysis {
+    pub schema: String,
+    pub source: String,
+    pub name: String,
+    pub study: Study,
+    pub metadata: Metadata,
+    pub calibration: Option<Calibration>,
+    pub complexity: Vec<ComplexityAnalysis>,
+    pub(crate) crossovers: Vec<Crossover>,
+    pub strong: Vec<StrongAnalysis>,
+    pub weak: Vec<WeakAnalysis>,
+    pub theta: Vec<ThetaAnalysis>,
+    /// Our kernels next to the external programs of the same sweep.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub peers: Vec<peers::PeerRatio>,
+    /// Tree codes at equal median force error ([`peers::EQUAL_ERROR`], and tighter where the
+    /// other code reaches it).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub(crate) peers_equal_error: Vec<peers::EqualErrorCost>,
+    /// How each external program was run: its `[[external]]` entry as the sweep's config
+    /// gives it (command, environment, steps, timing), so that a comparison says what it
+    /// compares against.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub external_runs: Vec<nbody_records::external::External>,
+    /// The tokens the config's `[mpi]` launcher puts before an external program's command
+    /// (`mpirun ARGS -n {ranks}`); empty without one.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub(crate) external_launcher: Vec<String>,
+    /// Every complete case, with its summary figures and physics checks.
+    pub cases: Vec<Point>,
+    /// Cases of the file still unmeasured or partly measured (left out of the analysis).
+    pub incomplete: Vec<String>,
+}
+
+impl Analysis {
+    /// The pair rate of `p` as a share of the calibrated FMA peak of its workers (f64 at half
+    /// the f32 rate), at the law's nominal flops per pair; `None` without a calibration or a
+    /// pair rate.
+    pub(crate) fn peak_share(
+        &self,
+        p: &Point,
+        law: nbody_engine::physics::LawKind,
+        precision: nbody_engine::scenario::Precision,
+    ) -> Option<f64> {
+        let c = self.calibration.as_ref()?;
+        let pair_evals_per_s = p.pair_evals_per_s?;
+        let per_number = match precision {
+            nbody_engine::scenario::Precision::F32 => 1.0,
+            nbody_engine::scenario::Precision::F64 => 0.5,
+        };
+        let flops = c.fma_gflops_1t * 1e9 * p.p() as f64 * per_number;
+        Some(pair_evals_per_s * law.flops_per_pair() / flops)
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum AnalysisError {
+    #[error("{path} has no complete case to analyse; finish it with `nbody-bench sweep --resume`")]
+    Empty { path: PathBuf },
+}
+
+/// Fits every series of `results` (read from `source`, for the record).
+pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, AnalysisError> {
+    let groups: Groups = groups::group(results);
+    if groups.cases.is_empty() {
+        return Err(AnalysisError::Empty {
+            path: source.into(),
+        });
+    }
+    let calibration = results.calibration.for_analysis();
+    let complexity: Vec<ComplexityAnalysis> = groups.complexity.iter().map(complexity).collect();
+    let crossovers = crossovers(&complexity);
+    let strong = groups
+        .strong
+        .iter()
+        .map(|s| strong(s, calibration.as_ref()))
+        .collect();
+    let rule = results.config.weak.as_ref().map(|w| w.rule);
+    let weak = groups.weak.iter().map(|s| weak(s, rule)).collect();
+    let theta = groups
+        .theta
+        .iter()
+        .map(|s| ThetaAnalysis {
+            series: s.key.clone(),
+            label: s.key.label(),
+            points: s.points.clone(),
+        })
+        .collect::<Vec<_>>();
+    let peers_equal_error = peers::equal_error(&theta);
+    Ok(Analysis {
+        schema: FITS_SCHEMA.into(),
+        source: source.display().to_string(),
+        name: results.config.name.clone(),
+        study: results.config.study,
+        metadata: results.metadata.clone(),
+        calibration,
+        complexity,
+        crossovers,
+        strong,
+        weak,
+        theta,
+        peers: peers::ratios(&groups.cases),
+        peers_equal_error,
+        external_runs: results.config.external.clone(),
+        external_launcher: results
+            .config
+            .mpi
+            .as_ref()
+            .filter(|_| !results.config.external.is_empty())
+            .map(|m| {
+                let mut v = vec![m.launcher.clone()];
+                v.extend(m.args.iter().cloned());
+                v.extend([m.rank_flag.clone(), "{ranks}".to_string()]);
+                v
+            })
+            .unwrap_or_default(),
+        incomplete: results
+            .cases
+            .iter()
+            .filter(|c| !c.is_complete())
+            .map(|c| c.key.clone())
+            .collect(),
+        cases: groups.cases,
+    })
+}
+
+fn samples_by(
+    points: &[Point],
+    x: impl Fn(&Point) -> f64,
+    scale: impl Fn(&Point) -> f64,
+) -> Vec<Samples> {
+    let mut out: Vec<Samples> = Vec::new();
+    for p in points {
+        let values = p.samples.iter().map(|v| v * scale(p));
+        match out.iter_mut().find(|s| s.x == x(p)) {
+            Some(s) => s.values.extend(values),
+            None => out.push(Samples::new(x(p), values.collect())),
+        }
+    }
+    out
+}
+
+fn complexity(s: &Series) -> ComplexityAnalysis {
+    let data = samples_by(&s.points, |p| p.n as f64, |_| 1.0);
+    ComplexityAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        points: s.points.clone(),
+        fit: Fitted::of(fit::fit_power(&data, fit::DEFAULT_SEED)),
+    }
+}
+
+fn crossovers(all: &[ComplexityAnalysis]) -> Vec<Crossover> {
+    let mut out = Vec::new();
+    for (i, a) in all.iter().enumerate() {
+        for b in &all[i + 1..] {
+            let same = a.series.scenario == b.series.scenario
+                && a.series.precision == b.series.precision
+                && a.series.threads == b.series.threads
+                && a.series.ranks == b.series.ranks;
+            let (Some(fa), Some(fb)) = (&a.fit.fit, &b.fit.fit) else {
+                continue;
+            };
+            // Kernels of the same class differ by a constant factor: a crossing of their
+            // curves is noise, not an algorithmic crossover.
+            if !same || fa.class == fb.class {
+                continue;
+            }
+            let ns = a.points.iter().chain(&b.points).map(|p| p.n as f64);
+            let lo = ns.clone().fold(f64::INFINITY, f64::min);
+            let hi = ns.fold(0.0, f64::max);
+            let n = fit::crossover(fa, fb, lo, hi);
+            let a_faster_above = fa.predict(hi) < fb.predict(hi);
+            let (above, below) = if a_faster_above { (a, b) } else { (b, a) };
+            out.push(Crossover {
+                scenario: a.series.scenario.name().into(),
+                precision: a.series.precision.name().into(),
+                threads: a.series.threads.unwrap_or(1),
+                faster_above: above.label.clone(),
+                faster_below: below.label.clone(),
+                n,
+            });
+        }
+    }
+    out
+}
+
+/// Kernels whose force interaction runs on the rayon pool; their build, integration and
+/// boundary phases stay serial. (The Verlet list also splits its list builds over the pool,
+/// which the timed serial fraction counts as serial: for it, that fraction is an upper bound.)
+fn parallel_interaction(kernel: KernelKind) -> bool {
+    !matches!(kernel, KernelKind::Symmetric)
+}
+
+fn kernel_of(s: &Series) -> Option<KernelKind> {
+    s.key.kernel.kernel()
+}
+
+/// The serial fraction of a built-in kernel's one-worker case from its phase timers.
+fn engine_serial_fraction(
+    one: &Point,
+    kernel: KernelKind,
+    dim: usize,
+) -> Option<fit::TimedSerialFraction> {
+    let ph = &one.phases;
+    // Which phases ran on the pool's threads: the per-particle passes (kick, drift, walls)
+    // and the cell and Verlet lists' binning fork from a size on; the interactions of
+    // every kernel but `symmetric` do.
+    let passes_fork = one.n * dim >= nbody_engine::par::MIN_FORK_ELEMENTS;
+    let build_forks = passes_fork && kernel.parallel_build();
+    let (mut serial, mut parallel) = (vec![ph.output], vec![]);
+    let mut put = |t: f64, forks: bool| {
+        if forks {
+            parallel.push(t)
+        } else {
+            serial.push(t)
+        }
+    };
+    put(ph.force_interact, parallel_interaction(kernel));
+    put(ph.force_build, build_forks);
+    put(ph.integrate, passes_fork);
+    put(ph.boundary, passes_fork);
+    fit::timed_serial_fraction(&serial, &parallel).ok()
+}
+
+/// The serial fraction of an external program's one-worker case from the phases it timed: its
+/// `serial` phases against its whole step (the mean step time of the runs the phases are means
+/// of), so that time no phase covers counts as the parallel part it most likely is.
+fn external_serial_fraction(one: &Point) -> Option<fit::TimedSerialFraction> {
+    let serial: Vec<f64> = one
+        .named_phases
+        .iter()
+        .filter(|p| p.kind == PhaseKind::Serial)
+        .map(|p| p.s_per_step)
+        .collect();
+    if serial.is_empty() {
+        return None;
+    }
+    let rest = (one.mean_step_s() - serial.iter().sum::<f64>()).max(0.0);
+    fit::timed_serial_fraction(&serial, &[rest]).ok()
+}
+
+fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
+    let real: Vec<Point> = s
+        .points
+        .iter()
+        .filter(|p| !p.oversubscribed)
+        .cloned()
+        .collect();
+    let data = samples_by(&real, |p| p.p() as f64, |_| 1.0);
+    let all = samples_by(&s.points, |p| p.p() as f64, |_| 1.0);
+    let ceiling: Vec<(f64, f64)> = match calibration {
+        Some(c) => s
+            .points
+            .iter()
+            .filter(|p| p.ranks == 1)
+            .filter_map(|p| {
+                // One thread is the reference of the ceiling by definition.
+                let r = if p.threads == 1 {
+                    Some(1.0)
+                } else {
+                    c.ceiling(p.threads)
+                };
+                r.map(|r| (p.threads as f64, r))
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let mut ceiling = ceiling;
+    ceiling.dedup_by(|a, b| a.0 == b.0);
+    let fit = Fitted::of(fit::fit_strong(&data, &ceiling, fit::DEFAULT_SEED));
+    let measured = match fit::fit_strong(&all, &ceiling, fit::DEFAULT_SEED) {
+        Ok(f) => f.points,
+        Err(_) => fit
+            .fit
+            .as_ref()
+            .map(|f| f.points.clone())
+            .unwrap_or_default(),
+    };
+    let one = s.points.iter().find(|p| p.p() == 1);
+    let timed_serial = one.and_then(|one| match kernel_of(s) {
+        Some(kernel) => engine_serial_fraction(one, kernel, s.key.scenario.dim()),
+        // An external program's serial fraction comes from the phases it timed, if any.
+        None => external_serial_fraction(one),
+    });
+    let serial_comparison = match (&timed_serial, &fit.fit) {
+        (Some(t), Some(f)) => {
+            // Only a program's use of its workers is in doubt: a built-in kernel is known to
+            // use them (no speedup there is the cost of running in parallel at this n).
+            let best = measured
+                .iter()
+                .filter(|m| m.p > 1.0 && kernel_of(s).is_none())
+                .map(|m| m.speedup.estimate)
+                .reduce(f64::max);
+            Some(fit::compare_serial_fractions(t, &f.serial_fraction, best))
+        }
+        _ => None,
+    };
+    StrongAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        points: s.points.clone(),
+        measured,
+        fit,
+        timed_serial,
+        serial_comparison,
+    }
+}
+
+/// The cost model a kernel's work per worker is held constant under; for an external
+/// program, the one of the weak rule its config names (linear or sqrt).
+fn cost_class(kernel: &KernelOrProgram, rule: Option<WeakRule>) -> ComplexityClass {
+    match (kernel.kernel(), rule) {
+        (Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread), _) => {
+            ComplexityClass::N2
+        }
+        (
+            Some(
+                KernelKind::CellList
+                | KernelKind::Verlet
+                | KernelKind::ClusterPair
+                | KernelKind::Fmm,
+            ),
+            _,
+        ) => ComplexityClass::N,
+        (Some(KernelKind::Octree), _) => ComplexityClass::NLogN,
+        (None, Some(WeakRule::Sqrt)) => ComplexityClass::N2,
+        (None, _) => ComplexityClass::N,
+    }
+}
+
+fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
+    let real: Vec<Point> = s
+        .points
+        .iter()
+        .filter(|p| !p.oversubscribed)
+        .cloned()
+        .collect();
+    let fit = Fitted::of(fit_weak_points(&real, &s.key.kernel, rule));
+    let measured = match fit_weak_points(&s.points, &s.key.kernel, rule) {
+        Ok(f) => f.efficiency,
+        Err(_) => fit
+            .fit
+            .as_ref()
+            .map(|f| f.efficiency.clone())
+            .unwrap_or_default(),
+    };
+    WeakAnalysis {
+        series: s.key.clone(),
+        label: s.key.label(),
+        rule,
+        points: s.points.clone(),
+        measured,
+        fit,
+    }
+}
+
+fn fit_weak_points(
+    points: &[Point],
+    kernel: &KernelOrProgram,
+    rule: Option<WeakRule>,
+) -> Result<WeakFit, fit::FitError> {
+    if rule == Some(WeakRule::Time) {
+        // n is fixed and the simulated time grows with p: the time of the scaled work is the
+        // step time times the time factor.
+        let data = samples_by(points, |p| p.p() as f64, |p| p.time_factor as f64);
+        fit::fit_weak(&data, fit::DEFAULT_SEED)
+    } else {
+        let mut data: Vec<WeakSamples> = Vec::new();
+        for p in points {
+            match data.iter_mut().find(|w| w.p == p.p() as f64) {
+                Some(w) => w.values.extend(&p.samples),
+                None => data.push(WeakSamples {
+                    p: p.p() as f64,
+                    n: p.n as f64,
+                    values: p.samples.clone(),
+                }),
+            }
+        }
+        fit::fit_weak_with_n(&data, cost_class(kernel, rule), fit::DEFAULT_SEED)
+    }
+}
+
+/// "galaxy (f64, 1 thread): octree θ=0.5 is faster above n ≈ 574, naive below."
+pub(crate) fn crossover_sentence(x: &Crossover) -> String {
+    let head = format!(
+        "{} ({}, {} thread{})",
+        x.scenario,
+        x.precision,
+        x.threads,
+        if x.threads == 1 { "" } else { "s" }
+    );
+    match x.n {
+        Some(n) => format!(
+            "{head}: {} is faster above n ≈ {n:.0}, {} below.",
+            x.faster_above, x.faster_below
+        ),
+        None => format!(
+            "{head}: {} is faster than {} over the whole measured range.",
+            x.faster_above, x.faster_below
+        ),
+    }
+}

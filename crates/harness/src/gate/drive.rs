@@ -1,0 +1,441 @@
+//! A gate run from start to verdict: compare two files, or measure this build along the
+//! decided [`route`](super::route) and judge it. The command line parses its arguments into a
+//! [`Request`], calls [`run`], prints the [`Outcome`].
+
+use super::ab::{self, AbPlan};
+use super::route::{self, Route, short};
+use super::{
+    AB_JUDGE, AB_THRESHOLD, FILE_JUDGE, FILE_THRESHOLD, GateOptions, GateReport, Judged,
+    NormalizationChoice, base_build, compare,
+};
+use crate::experiment::estimate::{self, Done};
+use crate::experiment::runner::{SweepOptions, run_sweep_wall};
+use crate::units::WallTime;
+use nbody_engine::output::provenance::utc_now;
+use nbody_records::config::SweepConfig;
+use nbody_records::locate;
+use nbody_records::plan::Case;
+use nbody_records::results::ResultsFile;
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::time::Duration;
+
+/// How far the two builds' reference workload may differ (median over all samples) before the
+/// A/B gate stops normalising by it. In 20 A/B runs of `configs/ci.toml` on the 2-vCPU AMD EPYC
+/// of 2026-12-01 (same reference code on both sides) the ratio stayed within 0.998-1.005.
+const REFERENCE_TOLERANCE: f64 = 0.05;
+
+/// What a gate run is asked to do (the command's options).
+#[derive(Clone, Debug)]
+pub struct Request {
+    pub baseline: PathBuf,
+    pub current: Option<PathBuf>,
+    pub against: Option<String>,
+    pub config: Option<PathBuf>,
+    pub rounds: usize,
+    pub timeout: Option<f64>,
+    pub out: Option<PathBuf>,
+    pub threshold: Option<f64>,
+    pub normalize: NormalizationChoice,
+    /// The ratio cases are judged on [default: each mode's, `AB_JUDGE` or `FILE_JUDGE`].
+    pub judge: Option<Judged>,
+    pub force: bool,
+    pub fail_on_work_change: bool,
+}
+
+/// A gate run's report and where its measurements were kept.
+pub struct Outcome {
+    pub report: GateReport,
+    pub kept_in: Option<PathBuf>,
+}
+
+impl Outcome {
+    /// 1 for a regression, 2 for an incomplete comparison, else 0 ([`GateReport::exit_code`]).
+    pub fn exit_code(&self) -> i32 {
+        self.report.exit_code()
+    }
+
+    /// Why the comparison is incomplete, for the error stream: `None` when it is complete.
+    pub fn incomplete(&self) -> Option<String> {
+        if self.report.missing.is_empty() {
+            return None;
+        }
+        let why: Vec<String> = self
+            .report
+            .missing
+            .iter()
+            .map(|m| format!("{} ({})", m.key, m.reason))
+            .collect();
+        Some(format!(
+            "{} baseline case(s) could not be compared, which is not a pass: {}; run the \
+             baseline's config to completion (sweep --resume), or refresh the baseline if the \
+             cases were removed on purpose",
+            why.len(),
+            super::save::listed(&why)
+        ))
+    }
+}
+
+/// Runs the gate `request` asks for; `say` gets its progress lines.
+pub fn run(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Result<Outcome> {
+    let outcome = match &request.current {
+        Some(current) => compare_files(request, current)?,
+        None => measure_and_judge(request, say)?,
+    };
+    if outcome.report.cases.is_empty() {
+        anyhow::bail!("the gate compared no case: nothing was judged, which is not a pass");
+    }
+    Ok(outcome)
+}
+
+fn options(request: &Request, default_threshold: f64, default_judge: Judged) -> GateOptions {
+    GateOptions {
+        threshold: request.threshold.unwrap_or(default_threshold),
+        force: request.force,
+        normalization: request.normalize,
+        fail_on_work_change: request.fail_on_work_change,
+        judge: request.judge.unwrap_or(default_judge),
+        ..GateOptions::default()
+    }
+}
+
+/// `--current`: two files, judged as they are.
+fn compare_files(request: &Request, current: &Path) -> anyhow::Result<Outcome> {
+    let root = Path::new("results");
+    let current = ResultsFile::load(&locate::find_results(current, root)?)?;
+    let baseline = if route::is_baseline_folder(&request.baseline) {
+        let here = super::RunInfo::of(&current);
+        let chosen = super::baselines::choose(&request.baseline, &here)?;
+        ResultsFile::load(&chosen.path)?
+    } else {
+        ResultsFile::load(&locate::find_results(&request.baseline, root)?)?
+    };
+    Ok(Outcome {
+        report: compare(
+            &baseline,
+            &current,
+            &options(request, FILE_THRESHOLD, FILE_JUDGE),
+        )?,
+        kept_in: None,
+    })
+}
+
+fn measure_and_judge(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Result<Outcome> {
+    let reference = route::find_reference(&request.baseline, request.against.as_deref())?;
+    let (config, text) = route::config_to_sweep(request.config.as_deref(), &reference, say)?;
+    let out = checked_out_dir(request)?;
+    // Every refusal comes before anything long: the route, and what it needs, is checked
+    // before a sweep or a build starts.
+    let route = route::route(request.against.as_deref(), reference, say)?;
+    let planned = match route {
+        Route::Fast { path, baseline } => {
+            fast_path_fits(&config)?;
+            Planned::Fast { path, baseline }
+        }
+        Route::AB { rev } => Planned::AB(prepare_a_b(request, &rev, &config, &text, say)?),
+    };
+    let out = match out {
+        Some(dir) => {
+            std::fs::create_dir_all(&dir)
+                .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+            dir
+        }
+        None => locate::new_run_dir(Path::new("results"), "gate", &utc_now())?,
+    };
+    let judged = match planned {
+        Planned::AB(prepared) => a_b(request, &prepared, &config, &text, &out, say),
+        Planned::Fast { path, baseline } => {
+            fast_path(request, &path, &baseline, &config, &text, &out, say)
+        }
+    };
+    match judged {
+        Ok(report) => {
+            let json = super::render(&report, super::Format::Json);
+            nbody_engine::output::write_atomic(&out.join("gate.json"), json.as_bytes())?;
+            Ok(Outcome {
+                report,
+                kept_in: Some(out),
+            })
+        }
+        Err(e) => {
+            // A gate that failed before measuring leaves no empty run directory behind.
+            let _ = std::fs::remove_dir(&out);
+            Err(e)
+        }
+    }
+}
+
+/// `--out DIR`, refused when it holds an earlier gate's files (`None`: a new run directory).
+fn checked_out_dir(request: &Request) -> anyhow::Result<Option<PathBuf>> {
+    let Some(dir) = &request.out else {
+        return Ok(None);
+    };
+    // What a gate keeps is never overwritten: each run needs its own directory.
+    if let Some(kept) = ["gate.json", "base.json", "current.json", "results.json"]
+        .iter()
+        .map(|f| dir.join(f))
+        .find(|f| f.exists())
+    {
+        anyhow::bail!(
+            "--out {}: {} is there from an earlier gate run; name a new directory",
+            dir.display(),
+            kept.display()
+        );
+    }
+    Ok(Some(dir.clone()))
+}
+
+/// The fast path compares the config's own samples: refused up front when they are too few
+/// for a CI (an A/B run takes enough of its own).
+fn fast_path_fits(config: &SweepConfig) -> anyhow::Result<()> {
+    let min = super::MIN_CI_SAMPLES;
+    if config.measure.samples < min {
+        anyhow::bail!(
+            "config `{}` takes {} samples per case, and the gate judges a case on at least {min} \
+             per side (fewer cannot support a 95% CI); raise measure.samples",
+            config.name,
+            config.measure.samples
+        );
+    }
+    Ok(())
+}
+
+/// A route with everything it needs checked.
+enum Planned {
+    Fast {
+        path: PathBuf,
+        baseline: Box<ResultsFile>,
+    },
+    AB(PreparedAB),
+}
+
+/// An A/B run checked and planned before anything is built.
+struct PreparedAB {
+    repo: PathBuf,
+    rev: String,
+    commit: String,
+    cases: Vec<ab::OneCase>,
+    /// Estimated seconds of one build's one round of each case, by case key.
+    round_s: HashMap<String, f64>,
+}
+
+/// Checks everything an A/B run of `rev` needs that does not take the base build (the rounds,
+/// the config's one-case forms, the revision's presence), estimates it and says how long it
+/// will take.
+fn prepare_a_b(
+    request: &Request,
+    rev: &str,
+    config: &SweepConfig,
+    text: &str,
+    say: &mut dyn FnMut(&str),
+) -> anyhow::Result<PreparedAB> {
+    let cases = ab::prepare(config, text, request.rounds)?;
+    let repo = base_build::repository_root(&std::env::current_dir()?)?;
+    let commit = base_build::resolve(&repo, rev)?;
+    // The estimate of the interleaved run: the config with the A/B run's rounds and samples.
+    let mut measured = config.clone();
+    measured.measure.rounds = request.rounds;
+    measured.measure.samples = ab::samples_per_round(config, request.rounds) * request.rounds;
+    let planned: Vec<Case> = cases.iter().map(|c| c.case.clone()).collect();
+    let probed = estimate::probe(&measured, &planned)?;
+    let logical = nbody_engine::run::logical_cpus();
+    let est = estimate::estimate(&measured, &probed.cases, &Done::default(), false, logical);
+    let round_s: HashMap<String, f64> = est
+        .cases
+        .iter()
+        .map(|c| (c.case.key(), c.wall_s / request.rounds as f64))
+        .collect();
+    let build = if base_build::is_cached(&repo, &commit) {
+        "the base binary is cached".to_string()
+    } else {
+        format!(
+            "a release build of the base revision comes first (minutes; stopped after {})",
+            crate::children::supervised::seconds(base_build::BUILD_LIMIT)
+        )
+    };
+    let unestimated = cases.len().saturating_sub(est.cases.len());
+    say(&format!(
+        "A/B against {rev} ({}): {} cases x {} rounds x 2 builds, estimated {} of \
+         measurement{}; {build}",
+        short(&commit),
+        cases.len(),
+        request.rounds,
+        WallTime(2.0 * est.total_s + estimate::calibration_s(1)),
+        if unestimated > 0 {
+            format!(" besides {unestimated} external program case(s)")
+        } else {
+            String::new()
+        }
+    ));
+    Ok(PreparedAB {
+        repo,
+        rev: rev.to_string(),
+        commit,
+        cases,
+        round_s,
+    })
+}
+
+/// The baseline file comes from this machine class: sweep this build and compare. If the
+/// sweep's own calibrations find the machine's speed too far from the baseline's, the sweep
+/// is not judged against it: A/B instead.
+fn fast_path(
+    request: &Request,
+    path: &Path,
+    baseline: &ResultsFile,
+    config: &SweepConfig,
+    text: &str,
+    out: &Path,
+    say: &mut dyn FnMut(&str),
+) -> anyhow::Result<GateReport> {
+    let planned = nbody_records::plan::cases(config);
+    let probed = estimate::probe(config, &planned)?;
+    let logical = nbody_engine::run::logical_cpus();
+    let est = estimate::estimate(config, &probed.cases, &Done::default(), true, logical);
+    say(&format!(
+        "sweeping {} with this build (estimated {}), to compare with {} (same machine class)",
+        config.name,
+        WallTime(est.total_s),
+        path.display()
+    ));
+    let sweep = SweepOptions {
+        run_dir: Some(out.to_path_buf()),
+        calibrate: true,
+        ..Default::default()
+    };
+    let mut quiet = crate::experiment::runner::Silent;
+    let report = run_sweep_wall(config, text, &sweep, &mut quiet)?;
+    let current = ResultsFile::load(&report.path)?;
+    let rates = (
+        super::calibrated_rate(baseline),
+        super::calibrated_rate(&current),
+    );
+    if let (Some(b), Some(c)) = rates
+        && let Some(why) = super::rates_differ(b, c)
+    {
+        let rev = baseline.metadata.git_commit.clone();
+        say(&format!(
+            "during the sweep, {why}; measuring the baseline's revision {} and this build side \
+             by side (A/B) instead (the sweep stays in {})",
+            short(&rev),
+            out.display()
+        ));
+        let prepared = prepare_a_b(request, &rev, config, text, say)?;
+        return a_b(request, &prepared, config, text, out, say);
+    }
+    let judged = compare(
+        baseline,
+        &current,
+        &options(request, FILE_THRESHOLD, FILE_JUDGE),
+    )?;
+    say(&format!("results kept in {}", out.display()));
+    Ok(judged)
+}
+
+/// Builds the prepared revision (or takes it from the cache), measures both builds
+/// interleaved, and judges.
+fn a_b(
+    request: &Request,
+    prepared: &PreparedAB,
+    config: &SweepConfig,
+    text: &str,
+    out: &Path,
+    say: &mut dyn FnMut(&str),
+) -> anyhow::Result<GateReport> {
+    let started = std::time::Instant::now();
+    let (rev, commit) = (&prepared.rev, &prepared.commit);
+    let base = base_build::base_binary(&prepared.repo, commit, say)?;
+    if base.built {
+        say(&format!("base built in {:.0} s", base.build_s));
+    }
+    let current: PathBuf = std::env::current_exe()
+        .map_err(|e| anyhow::anyhow!("cannot find this program's binary: {e}"))?;
+    say("calibrating the machine...");
+    let calibration = nbody_calibrate::calibrate(&[1]);
+    // Scratch of this process only: nothing else in `out` is removed.
+    let work = out.join(format!(".scratch-{}", std::process::id()));
+    let limit = |case: &Case| match request.timeout {
+        Some(s) => Duration::from_secs_f64(s),
+        None => ab::child_limit(
+            config,
+            case,
+            request.rounds,
+            prepared.round_s.get(&case.key()).copied(),
+        ),
+    };
+    let plan = AbPlan {
+        config,
+        config_text: text,
+        cases: &prepared.cases,
+        base: &base,
+        current: &current,
+        rounds: request.rounds,
+        work: &work,
+        limit: &limit,
+    };
+    let measured = ab::measure(&plan, say);
+    let _ = std::fs::remove_dir_all(&work);
+    let mut results = measured?;
+    for file in [&mut results.base, &mut results.current] {
+        file.calibration.start = Some(calibration.clone());
+    }
+    results.base.save(&out.join("base.json"))?;
+    results.current.save(&out.join("current.json"))?;
+    let mut opts = options(request, AB_THRESHOLD, AB_JUDGE);
+    // Each build times its own copy of the reference workload. If that copy itself got faster
+    // or slower (another compiler, profile or SIMD dispatch), dividing by it would hide or
+    // invent a change of the kernels: then judge raw times, which interleaving keeps fair.
+    let (rb, rc) = (
+        ab::median_reference(&results.base),
+        ab::median_reference(&results.current),
+    );
+    let reference_moved = match (rb, rc) {
+        (Some(b), Some(c)) if b > 0.0 => ((c / b) - 1.0).abs() > REFERENCE_TOLERANCE,
+        _ => false,
+    };
+    if reference_moved && opts.normalization == NormalizationChoice::Auto {
+        opts.normalization = NormalizationChoice::None;
+    }
+    let mut report = compare(&results.base, &results.current, &opts)?;
+    if reference_moved {
+        report.warnings.push(format!(
+            "the reference workload itself takes {:.3}x as long in this build as in the base, \
+             so the builds differ in more than their kernels; the cases are judged on raw \
+             times (both builds measured interleaved)",
+            rc.unwrap_or(0.0) / rb.unwrap_or(1.0)
+        ));
+    }
+    for (file, which) in [(&results.base, "base"), (&results.current, "current")] {
+        if file.metadata.rustc_version != results.current.metadata.rustc_version {
+            report.warnings.push(format!(
+                "the {which} build was compiled by `{}`, this one by `{}`",
+                file.metadata.rustc_version, results.current.metadata.rustc_version
+            ));
+        }
+    }
+    // Both builds share the one calibration, so the warning about a baseline measured under
+    // more load than the current run does not apply; the load itself is still worth a word.
+    report
+        .warnings
+        .retain(|w| !w.starts_with("the baseline was measured while other processes"));
+    if let Some(busy) = calibration
+        .background_cpus
+        .filter(|&b| b >= super::BUSY_BASELINE_CPUS)
+    {
+        report.warnings.push(format!(
+            "other processes used {busy:.1} CPUs while the gate calibrated; both builds were \
+             measured under that load, interleaved"
+        ));
+    }
+    say(&format!(
+        "A/B against {} ({}): {} rounds per build, measured in {:.0} s, {:.0} s in all; \
+         results kept in {}",
+        rev,
+        short(commit),
+        request.rounds,
+        results.measure_s,
+        started.elapsed().as_secs_f64(),
+        out.display()
+    ));
+    Ok(report)
+}

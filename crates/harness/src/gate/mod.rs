@@ -1,0 +1,411 @@
+//! The regression gate: two sweep results files in, a typed verdict per case out.
+//!
+//! [`compare`] is a pure function from a baseline and a current [`ResultsFile`] to a
+//! [`GateReport`]; [`render`] turns the report into text, Markdown (for a CI job summary) or
+//! JSON. The rules:
+//!
+//! - cases are matched by their key; a baseline case the current run did not measure is
+//!   reported as missing (and the gate exits 2), a case only in the current run as extra;
+//! - times are normalised by a measurement of the machine taken in the same run (see
+//!   [`Normalization`]), so a uniformly slower machine is not a slower kernel;
+//! - the statistic is the ratio current / baseline of the normalised medians (and of the raw
+//!   ones), with a bootstrap 95% CI from the raw samples and one-sided p-values against
+//!   `1 ± threshold` from the same replicates; a case regressed only when its p-value passes
+//!   Holm's step-down over all the cases ([`family`]), improved by the same rule below, else
+//!   it is unchanged;
+//! - the deterministic work counters of the initial state are compared exactly, and a change
+//!   is reported as such;
+//! - results from another machine (CPU model, logical CPUs), build (SIMD level, profile) or
+//!   config are refused unless forced.
+
+pub mod ab;
+pub mod base_build;
+pub mod baselines;
+mod checks;
+mod compare;
+pub mod drive;
+pub mod family;
+mod render;
+pub mod route;
+pub mod save;
+pub mod study;
+#[cfg(test)]
+mod tests;
+
+pub use checks::{
+    BUSY_BASELINE_CPUS, RATE_TOLERANCE, background_cpus, calibrated_rate, prefix, rates_differ,
+};
+pub use compare::{check_threshold, compare, judge_pair};
+pub use family::Tails;
+pub use render::{Format, render};
+
+use nbody_records::results::ResultsFile;
+use serde::Serialize;
+use thiserror::Error;
+
+/// Default threshold of an A/B run (both builds interleaved in one run), and the ratio it
+/// judges: from the gate's noise study (docs/explanation/gate.md, results/gate-study/), the
+/// smallest candidate with no false alarm on unchanged code, quiet or beside a spinning
+/// process. Interleaving keeps raw times fair, and the reference workload only adds its own
+/// noise there (the normalised ratio missed slowdowns the raw one caught).
+pub const AB_THRESHOLD: f64 = 0.03;
+pub const AB_JUDGE: Judged = Judged::Raw;
+/// Default threshold against a baseline file measured at another time, and the ratio it
+/// judges: the raw ratio alone gave false alarms beside a spinning process, the normalised
+/// and the raw one both none; 0.10 leaves room for the drift between days the study could not
+/// see.
+pub const FILE_THRESHOLD: f64 = 0.10;
+pub const FILE_JUDGE: Judged = Judged::Both;
+/// Default rounds of every case per build in an A/B run (even: each build goes first as often).
+pub const AB_ROUNDS: usize = 4;
+
+/// Largest `--threshold`: 1.0 flags a case only once it is surely more than twice the
+/// baseline (and no improvement can be claimed, 1 − 1 = 0); a larger one judges nothing.
+pub const MAX_THRESHOLD: f64 = 1.0;
+
+/// Fewest positive samples per side a case's 95% CI is judged on. The bootstrap resamples
+/// each side's samples; with n samples the resampled median is the smallest sample in
+/// P(Binomial(n, 1/n) > n/2) of the resamples: 26% for n = 3, 5% for n = 4 or 5, 0.9% for
+/// n = 6. Only from 6 on does the 2.5% tail fall inside the data, so that the interval comes
+/// from the spread of the samples rather than being pinned to their extremes (with one
+/// sample per side it is the single ratio, e.g. [1.500, 1.500]).
+pub const MIN_CI_SAMPLES: usize = 6;
+
+/// Schema of the JSON rendering of a [`GateReport`].
+pub(crate) const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
+
+/// How to compare.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GateOptions {
+    /// Relative change a case must exceed, at the family-wise confidence, to count (0.10 = 10%).
+    pub threshold: f64,
+    /// Compare results from another machine, build or config anyway (with warnings).
+    pub force: bool,
+    pub normalization: NormalizationChoice,
+    /// A change of the work counters makes the gate fail too (exit 1).
+    pub fail_on_work_change: bool,
+    /// Which ratio a case is judged on.
+    pub judge: Judged,
+    /// Bootstrap resamples per case, and the seed they start from (with the case key mixed in).
+    pub resamples: usize,
+    pub seed: u64,
+}
+
+impl Default for GateOptions {
+    fn default() -> Self {
+        GateOptions {
+            threshold: 0.10,
+            force: false,
+            normalization: NormalizationChoice::Auto,
+            fail_on_work_change: false,
+            judge: Judged::Both,
+            resamples: 4000,
+            seed: 0x9a7e,
+        }
+    }
+}
+
+/// Which normalisation to use; `Auto` takes the best one both files have.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum NormalizationChoice {
+    /// The reference workload if both runs timed it for the case, else the calibration, else none.
+    Auto,
+    Reference,
+    Calibration,
+    None,
+}
+
+/// The ratio a case is judged on. The normalised ratio cancels the machine's speed and
+/// load, but the reference workload can speed up more than the kernels (a run on a quieter
+/// machine than its baseline's then reads slower); the raw ratio is fair only between runs
+/// measured side by side. `Both` claims a change only when both ratios show it (an
+/// intersection-union test, at the same level): the rule the gate's noise study chose
+/// (docs/explanation/gate.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Judged {
+    Normalized,
+    Raw,
+    Both,
+}
+
+/// What the case's times were divided by before comparing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Normalization {
+    /// Each sample by the reference workload timed right before it, on the same threads, for
+    /// about as long (`measure.reference_s`): tracks the share of the machine the case got.
+    Reference,
+    /// Every sample by the time of the sweep's calibrated FMA rate (mean of the start and end
+    /// calibrations): tracks the machine's speed at the start and end of the sweep only.
+    Calibration,
+    /// Raw seconds per step.
+    None,
+}
+
+impl Normalization {
+    pub fn describe(self) -> &'static str {
+        match self {
+            Normalization::Reference => "the reference workload timed before each sample",
+            Normalization::Calibration => "the sweep's calibrated FMA rate",
+            Normalization::None => "nothing (raw times)",
+        }
+    }
+}
+
+/// The verdict on one case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// Slower by more than the threshold, with the family-wise error of [`family`]: the
+    /// case's p-value for "at most 1 + threshold" passed Holm's step-down over the cases.
+    Regressed,
+    /// Faster by more than the threshold, by the same rule below 1 − threshold.
+    Improved,
+    Unchanged,
+}
+
+impl Verdict {
+    pub fn name(self) -> &'static str {
+        match self {
+            Verdict::Regressed => "regressed",
+            Verdict::Improved => "improved",
+            Verdict::Unchanged => "unchanged",
+        }
+    }
+}
+
+/// One case measured in both runs.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CaseComparison {
+    pub key: String,
+    pub verdict: Verdict,
+    pub normalization: Normalization,
+    /// Raw median seconds per step in each run.
+    pub(crate) baseline_median_s: f64,
+    pub(crate) current_median_s: f64,
+    /// Ratio of the raw medians, for reference.
+    pub(crate) raw_ratio: f64,
+    /// Ratio current / baseline of the normalised medians: the statistic.
+    pub ratio: f64,
+    /// Bootstrap 95% confidence interval of `ratio` (of the case alone).
+    pub ci95: [f64; 2],
+    /// Bootstrap 95% confidence interval of `raw_ratio`.
+    pub raw_ci95: [f64; 2],
+    /// One-sided p-values the verdict comes from (of the ratio the gate judges on).
+    pub p: family::Tails,
+    /// Those of the normalised ratio and of the raw ratio alone.
+    pub p_normalized: family::Tails,
+    pub p_raw: family::Tails,
+    /// Samples in each run.
+    pub samples: [usize; 2],
+    /// Deterministic work counters that differ between the runs.
+    pub work_changes: Vec<WorkChange>,
+    /// Whether the kernels' work counters were compared (both runs recorded them).
+    pub(crate) work_compared: bool,
+    /// Anything that weakens the comparison (incomplete case, failed sanity check, ...).
+    pub notes: Vec<String>,
+}
+
+/// A work counter of the initial state that differs.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct WorkChange {
+    pub counter: String,
+    pub baseline: u64,
+    pub current: u64,
+}
+
+/// A baseline case that could not be compared, or a check of it that could compare nothing
+/// (too few samples for a CI, work counters asked for but absent): the gate exits 2.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize)]
+pub struct MissingCase {
+    pub key: String,
+    pub reason: String,
+}
+
+/// Where a results file comes from.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunInfo {
+    pub git_commit: String,
+    pub git_dirty: bool,
+    pub started: String,
+    pub host: String,
+    pub cpu_model: Option<String>,
+    pub cpu_signature: Option<String>,
+    pub logical_cpus: Option<usize>,
+}
+
+impl RunInfo {
+    /// Why the two runs are not known to come from one machine class (CPU model, CPU
+    /// signature, logical CPU count), or `None` when they are. A run that did not record a
+    /// CPU signature is of an unknown class: its timings cannot be trusted to match.
+    pub fn machine_class_differs(&self, other: &RunInfo) -> Option<String> {
+        let show = |v: &Option<String>| v.clone().unwrap_or_else(|| "not recorded".into());
+        if self.cpu_model != other.cpu_model {
+            return Some(format!(
+                "CPU model `{}` there, `{}` here",
+                show(&self.cpu_model),
+                show(&other.cpu_model)
+            ));
+        }
+        if self.cpu_signature.is_none() || self.cpu_signature != other.cpu_signature {
+            return Some(format!(
+                "CPU signature `{}` there, `{}` here",
+                show(&self.cpu_signature),
+                show(&other.cpu_signature)
+            ));
+        }
+        if self.logical_cpus != other.logical_cpus {
+            let show = |v: Option<usize>| v.map_or("not recorded".into(), |n| n.to_string());
+            return Some(format!(
+                "{} logical CPUs there, {} here",
+                show(self.logical_cpus),
+                show(other.logical_cpus)
+            ));
+        }
+        None
+    }
+
+    /// From a results file's JSON, read field by field so that a file this build can no
+    /// longer load still says where it comes from; `None` without a commit.
+    pub fn from_json(value: &serde_json::Value) -> Option<RunInfo> {
+        let text = |v: &serde_json::Value| v.as_str().map(str::to_string);
+        let meta = &value["metadata"];
+        let cal = [&value["calibration"]["start"], &value["calibration"]["end"]]
+            .into_iter()
+            .find(|c| c.is_object());
+        let field = |name: &str| cal.and_then(|c| text(&c[name]));
+        Some(RunInfo {
+            git_commit: text(&meta["git_commit"])?,
+            git_dirty: meta["git_dirty"].as_bool().unwrap_or(false),
+            started: text(&meta["started"]).unwrap_or_default(),
+            host: text(&meta["host"]).unwrap_or_default(),
+            cpu_model: field("cpu_model"),
+            cpu_signature: field("cpu_signature"),
+            logical_cpus: cal
+                .and_then(|c| c["logical_cpus"].as_u64())
+                .map(|n| n as usize),
+        })
+    }
+
+    pub fn of(file: &ResultsFile) -> RunInfo {
+        let cal = file
+            .calibration
+            .start
+            .as_ref()
+            .or(file.calibration.end.as_ref());
+        RunInfo {
+            git_commit: file.metadata.git_commit.clone(),
+            git_dirty: file.metadata.git_dirty,
+            started: file.metadata.started.clone(),
+            host: file.metadata.host.clone(),
+            cpu_model: cal.map(|c| c.cpu_model.clone()),
+            cpu_signature: cal.and_then(|c| c.cpu_signature.clone()),
+            logical_cpus: cal.map(|c| c.logical_cpus),
+        }
+    }
+}
+
+/// The result of a gate run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct GateReport {
+    pub schema: String,
+    pub threshold: f64,
+    pub fail_on_work_change: bool,
+    pub baseline: RunInfo,
+    pub current: RunInfo,
+    /// Cases measured in both runs, in the baseline's order.
+    pub cases: Vec<CaseComparison>,
+    pub missing: Vec<MissingCase>,
+    /// Cases only the current run measured.
+    pub extra: Vec<String>,
+    pub warnings: Vec<String>,
+    /// Which ratio the cases were judged on.
+    pub judged_on: Judged,
+    /// Family-wise error of the run's regressions (Holm's step-down over its cases).
+    pub family_alpha: f64,
+}
+
+impl GateReport {
+    pub fn count(&self, verdict: Verdict) -> usize {
+        self.cases.iter().filter(|c| c.verdict == verdict).count()
+    }
+
+    pub(crate) fn work_changed(&self) -> usize {
+        self.cases
+            .iter()
+            .filter(|c| !c.work_changes.is_empty())
+            .count()
+    }
+
+    /// Whether the gate fails on this report's findings (regressions, and work changes when
+    /// asked), ignoring missing cases.
+    pub fn failed(&self) -> bool {
+        self.count(Verdict::Regressed) > 0 || (self.fail_on_work_change && self.work_changed() > 0)
+    }
+
+    /// 1 when something regressed (whatever else the run found: a regression is never
+    /// hidden behind another exit code), else 2 when baseline cases could not be compared
+    /// (an incomplete comparison is not a pass), else 0.
+    pub fn exit_code(&self) -> i32 {
+        if self.failed() {
+            1
+        } else if !self.missing.is_empty() {
+            2
+        } else {
+            0
+        }
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum GateError {
+    #[error(
+        "--threshold must be a number from 0 to {max} (got {0:?}); 0.10 means 10%, {max} a \
+         doubling",
+        max = MAX_THRESHOLD
+    )]
+    BadThreshold(f64),
+    #[error(
+        "the {which} results have no machine calibration (swept with --no-calibration), so \
+         the machine cannot be checked; sweep again with calibration, or pass --force"
+    )]
+    UnknownMachine { which: &'static str },
+    #[error(
+        "the baseline comes from another machine: {what} `{baseline}` there, `{current}` here; \
+         timings are only comparable on the same machine class. Run the gate without --current \
+         to measure the baseline's revision and this build side by side here (A/B), refresh the \
+         baseline on this machine (scripts/refresh-baseline.sh), or pass --force to compare \
+         anyway"
+    )]
+    OtherMachine {
+        what: &'static str,
+        baseline: String,
+        current: String,
+    },
+    #[error(
+        "the baseline was built differently: {what} `{baseline}` in the baseline, `{current}` \
+         now; rebuild the same way, refresh the baseline, or pass --force"
+    )]
+    OtherBuild {
+        what: &'static str,
+        baseline: String,
+        current: String,
+    },
+    #[error(
+        "the two runs used different configs (they differ in {differences}); sweep the \
+         baseline's config (its text is in the file's config_text), refresh the baseline, or \
+         pass --force to compare the cases they share"
+    )]
+    OtherConfig { differences: String },
+    #[error(
+        "case {key}: normalisation `{wanted}` is not available in both files ({why}); use \
+         --normalize auto"
+    )]
+    NormalizationUnavailable {
+        key: String,
+        wanted: &'static str,
+        why: &'static str,
+    },
+}

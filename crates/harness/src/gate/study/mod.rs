@@ -1,0 +1,200 @@
+//! The gate's noise study: many gate decisions on unchanged code (A/A) and with one kernel
+//! made slower on purpose, on this machine, so that the gate's false-alarm rate and power are
+//! measured figures of its own machine class rather than claims.
+//!
+//! One long interleaved run is cut into disjoint blocks; each block holds, for every case of
+//! the gate's config, the rounds one gate decision takes of two sides measured alike (A and
+//! B: the same code) and of the slowed kernel's cases at each slowdown (the test-only knob).
+//! From a block come an A/B decision (A against B, or against B with the slowed kernel's
+//! cases replaced) and a fast-path decision (B, or B slowed, against this class's committed
+//! baseline, measured in another process at another time, as CI's sweep is). Both sides are
+//! measured in this process, one round of a case after the other in alternating order, as the
+//! A/B driver alternates its two builds' child processes. [`decide`] judges every block under
+//! each candidate rule and threshold; the summary is written per machine class to
+//! `results/gate-study/`, and docs/explanation/gate.md's table is generated from it.
+
+pub mod decide;
+#[cfg(feature = "test-slowdown")]
+mod measure;
+pub mod run;
+pub mod table;
+
+#[cfg(feature = "test-slowdown")]
+pub use measure::measure_blocks;
+
+use clap::ValueEnum;
+use nbody_calibrate::Calibration;
+use nbody_engine::kernels::KernelKind;
+use nbody_records::results::{CaseRecord, Metadata};
+use serde::{Deserialize, Serialize};
+
+/// Schema of a study file.
+pub const STUDY_SCHEMA: &str = "nbody-bench/gate-study/v1";
+
+/// The slowdowns the study measures (factors of the slowed kernel's force computation).
+pub const SLOWDOWNS: [f64; 3] = [1.05, 1.10, 1.25];
+
+/// What else runs on the machine while the study measures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Load {
+    /// Nothing of the study's own.
+    Quiet,
+    /// A second process spinning on one CPU for the whole run.
+    Spin,
+}
+
+/// What one block measured: per case, the rounds of each side.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Block {
+    /// Wall time the block took, seconds.
+    pub wall_s: f64,
+    /// Side A's and B's records of every case, in the config's case order.
+    pub a: Vec<CaseRecord>,
+    pub b: Vec<CaseRecord>,
+    /// For each slowdown of [`SLOWDOWNS`], the slowed kernel's cases' records (the others are
+    /// B's: the knob changes nothing else).
+    pub slowed: Vec<Vec<CaseRecord>>,
+}
+
+/// One measuring run of the study: its conditions and raw blocks (kept in the run
+/// directory; the study file keeps the summary).
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RawStudy {
+    pub schema: String,
+    pub metadata: Metadata,
+    pub calibration: Calibration,
+    pub load: Load,
+    /// Both sides measured at the same moment, one per CPU.
+    pub duet: bool,
+    pub slowed_kernel: KernelKind,
+    /// The gate's config the blocks measured (the class's baseline's).
+    pub config: nbody_records::config::SweepConfig,
+    pub rounds: usize,
+    pub samples_per_round: usize,
+    pub blocks: Vec<Block>,
+}
+
+/// The study file of one machine class (`results/gate-study/<class>.json`): what the gate's
+/// noise study measured there, run by run, summarised.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StudyFile {
+    pub schema: String,
+    pub cpu_model: String,
+    pub cpu_signature: Option<String>,
+    pub logical_cpus: usize,
+    pub simd: String,
+    /// The gate's config the decisions were made on, and the baseline file the fast-path
+    /// decisions compared with (none: no fast-path decisions).
+    pub config_name: String,
+    pub baseline: Option<String>,
+    pub runs: Vec<StudyRun>,
+}
+
+/// One measuring run of the study, summarised.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct StudyRun {
+    pub started: String,
+    pub git_commit: String,
+    pub git_dirty: bool,
+    pub load: Load,
+    pub duet: bool,
+    pub slowed_kernel: KernelKind,
+    pub blocks: usize,
+    pub rounds: usize,
+    pub samples_per_round: usize,
+    /// Median wall time of one block (all its sides), seconds.
+    pub block_wall_s: f64,
+    /// Median wall time of measuring one decision's two sides (A and B), seconds.
+    pub decision_measure_s: f64,
+    pub tallies: Vec<decide::Tally>,
+    pub widths: Vec<decide::Widths>,
+    /// What each slowdown of the force computation made of the slowed kernel's step.
+    #[serde(default)]
+    pub step_ratios: Vec<decide::StepRatio>,
+}
+
+impl StudyRun {
+    /// The summary of a measured run.
+    pub fn of(raw: &RawStudy, baseline: Option<&nbody_records::results::ResultsFile>) -> Self {
+        let (tallies, widths, step_ratios) = decide::tally(raw, baseline);
+        let walls: Vec<f64> = raw.blocks.iter().map(|b| b.wall_s).collect();
+        let block_wall_s = nbody_engine::stats::median(&walls).unwrap_or(f64::NAN);
+        // The two sides' share of a block: A and B of every case against the slowed sides.
+        let sides = |b: &Block| {
+            let count = |records: &[CaseRecord]| records.len() as f64;
+            let slowed: f64 = b.slowed.iter().map(|s| count(s)).sum();
+            let ab = count(&b.a) + count(&b.b);
+            ab / (ab + slowed).max(1.0)
+        };
+        let decision: Vec<f64> = raw.blocks.iter().map(|b| b.wall_s * sides(b)).collect();
+        StudyRun {
+            started: raw.metadata.started.clone(),
+            git_commit: raw.metadata.git_commit.clone(),
+            git_dirty: raw.metadata.git_dirty,
+            load: raw.load,
+            duet: raw.duet,
+            slowed_kernel: raw.slowed_kernel,
+            blocks: raw.blocks.len(),
+            rounds: raw.rounds,
+            samples_per_round: raw.samples_per_round,
+            block_wall_s,
+            decision_measure_s: nbody_engine::stats::median(&decision).unwrap_or(f64::NAN),
+            tallies,
+            widths,
+            step_ratios,
+        }
+    }
+
+    /// The median step ratio of the slowed kernel's cases at `slowdown` (A/B, normalised).
+    pub fn step_ratio(&self, slowdown: f64) -> Option<f64> {
+        self.step_ratios
+            .iter()
+            .find(|s| s.mode == decide::Mode::Ab && s.slowdown == slowdown)
+            .map(|s| s.normalized)
+    }
+
+    /// Its tally of `mode`, `rule`, `threshold` and `slowdown`.
+    pub fn tally(
+        &self,
+        mode: decide::Mode,
+        rule: crate::gate::Judged,
+        threshold: f64,
+        slowdown: f64,
+    ) -> Option<&decide::Tally> {
+        self.tallies.iter().find(|t| {
+            t.mode == mode && t.rule == rule && t.threshold == threshold && t.slowdown == slowdown
+        })
+    }
+}
+
+impl StudyFile {
+    /// Reads a study file; an error names the path and what is wrong.
+    pub fn load(path: &std::path::Path) -> Result<StudyFile, String> {
+        let text =
+            nbody_engine::input::read_text(path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let file: StudyFile =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        if file.schema != STUDY_SCHEMA {
+            return Err(format!(
+                "{}: schema `{}`, this build reads `{STUDY_SCHEMA}`",
+                path.display(),
+                file.schema
+            ));
+        }
+        Ok(file)
+    }
+
+    /// The class's name as the baseline files spell it, e.g. `AuthenticAMD-26-2-1-2cpu`.
+    pub fn class(&self) -> String {
+        crate::gate::baselines::class_name(self.cpu_signature.as_deref(), Some(self.logical_cpus))
+    }
+
+    /// Adds `run`, replacing an earlier run of the same load and mode (duet or not).
+    pub fn put(&mut self, run: StudyRun) {
+        self.runs
+            .retain(|r| !(r.load == run.load && r.duet == run.duet));
+        self.runs.push(run);
+        self.runs.sort_by_key(|r| (r.duet, r.load == Load::Spin));
+    }
+}

@@ -1,0 +1,54 @@
+//! What one round of a case measured, as the results file keeps it: every raw value (samples,
+//! phases, work, the physics checks), and for external programs and MPI runs their own records.
+
+use nbody_engine::engine::PhaseTimes;
+use nbody_engine::kernels::WorkCounters;
+use serde::{Deserialize, Serialize};
+
+/// What one round measured. Times are per step.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RoundOutcome {
+    pub steps_per_sample: u64,
+    /// Mean step time of each sample, seconds.
+    pub samples_s: Vec<f64>,
+    /// Every timed step, nanoseconds.
+    #[serde(skip)]
+    pub step_ns: Vec<u64>,
+    pub steps: u64,
+    pub warmup_steps: u64,
+    /// Seconds per step in each phase (means over the timed steps).
+    pub phases: PhaseTimes,
+    /// Work over the timed steps.
+    pub work: WorkCounters,
+    /// Interacting pairs in the final configuration.
+    pub pairs_interacting: u64,
+    /// Relative energy drift from the start of the warm-up to the end of the samples; `None`
+    /// (`null`) where nothing measured it: an external program, a job that ended without its
+    /// round, an MPI run of a system whose initial energy is zero.
+    pub energy_drift: Option<f64>,
+    /// Median and max relative force error against an f64 direct sum, when asked.
+    pub force_error: Option<[f64; 2]>,
+    /// Particles actually simulated (fewer than asked only with `allow_fewer`).
+    pub n: usize,
+    /// Cost of one clock reading relative to the median step (the timing overhead).
+    pub clock_overhead: f64,
+    /// Mean wall time of one repetition of the reference workload on the case's threads, timed
+    /// right before each sample (one value per sample, in the same order), seconds; empty when
+    /// not asked.
+    #[serde(default)]
+    pub reference_s: Vec<f64>,
+    /// Work of one force computation on the initial state (built from the seed, before the
+    /// warm-up): the same in every run of the same code, whatever the timing.
+    #[serde(default)]
+    pub initial_work: Option<WorkCounters>,
+    /// Ranks, decomposition and per-rank statistics of a case run under an MPI launcher.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub mpi: Option<nbody_engine::decomp::stats::MpiReport>,
+    /// Every run of an external program (`[[external]]`) with its times or its error.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub external: Option<super::external::ExternalRound>,
+    /// The batch job that ran the round (`[scheduler]`), or that ended without measuring it:
+    /// then the round has no samples.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub job: Option<super::scheduler::JobRecord>,
+}
