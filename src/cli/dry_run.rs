@@ -5,9 +5,9 @@
 
 use crate::cli::args::SweepArgs;
 use nbody_harness::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
-use nbody_harness::units::{Duration, WallTime};
+use nbody_harness::render::sweep_tables;
+use nbody_harness::units::WallTime;
 use nbody_records::config::SweepConfig;
-use nbody_records::plan::cases;
 use nbody_records::results::ResultsFile;
 use std::io::{BufRead, IsTerminal, Write};
 use std::path::Path;
@@ -99,6 +99,8 @@ fn done_in(results: ResultsFile) -> Done {
     }
 }
 
+/// The dry run's output: the plan's heading and table, then what the estimate rests on and
+/// what a real run would do.
 fn print_plan(
     args: &SweepArgs,
     config: &SweepConfig,
@@ -108,90 +110,39 @@ fn print_plan(
     path: Option<&Path>,
 ) {
     let m = &config.measure;
-    let external: Vec<_> = cases(config)
-        .into_iter()
-        .filter(|c| c.kernel.is_external())
-        .collect();
-    let all = est.cases.len() + external.len();
+    let external = sweep_tables::external_cases(config).len();
+    let all = est.cases.len() + external;
     outln!(
         "dry run of sweep `{}` ({}): {all} case{}{}, {} rounds of {} samples in all; nothing is \
          measured or written",
         config.name,
         args.config.display(),
         if all == 1 { "" } else { "s" },
-        if external.is_empty() {
+        if external == 0 {
             String::new()
         } else {
             format!(
-                " ({} of the built-in kernels, {} of external programs)",
-                est.cases.len(),
-                external.len()
+                " ({} of the built-in kernels, {external} of external programs)",
+                est.cases.len()
             )
         },
         m.rounds,
         m.samples
     );
-    outln!(
-        "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
-        "case",
-        "n",
-        "p",
-        "ranks",
-        "theta",
-        "rounds",
-        "samples",
-        "step (est.)",
-        "case (est.)"
-    );
-    for c in &est.cases {
-        let theta = c.case.theta.map_or("-".to_string(), |t| t.to_string());
+    outln!("{}", sweep_tables::plan(config, est).text().trim_end());
+    if external > 0 {
         outln!(
-            "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
-            c.case.key(),
-            c.case.n,
-            c.case.threads,
-            c.case.ranks,
-            theta,
-            c.rounds,
-            c.samples,
-            Duration(c.step_s),
-            WallTime(c.wall_s)
+            "\n{external} external case{} not in the estimate: each sample runs the program once, \
+             for as long as it takes (up to its timeout_s)",
+            if external == 1 { " is" } else { "s are" }
         );
     }
-    for c in &external {
-        // Not estimated: the steps of one run stand where the step time would.
-        let steps = config
-            .external
-            .iter()
-            .find(|e| e.name == c.kernel.name())
-            .map_or("-".to_string(), |e| {
-                format!(
-                    "{} steps",
-                    nbody_harness::experiment::external::run::steps(e, c)
-                )
-            });
-        outln!(
-            "{:<52} {:>9} {:>4} {:>5} {:>6} {:>6} {:>7} {:>12} {:>10}",
-            c.key(),
-            c.n,
-            c.threads,
-            c.ranks,
-            c.theta.map_or("-".to_string(), |t| t.to_string()),
-            m.rounds,
-            m.samples,
-            steps,
-            "external"
-        );
-    }
-    if !external.is_empty() {
-        outln!(
-            "\n{} external case{} not in the estimate: each sample runs the program once, for as \
-             long as it takes (up to its timeout_s)",
-            external.len(),
-            if external.len() == 1 { " is" } else { "s are" }
-        );
-    }
-    let cases_s = est.total_s - est.calibration_s;
+    print_estimate(est, probed, logical);
+    print_consequences(args, config, est, path);
+}
+
+/// What the estimate rests on (the probe) and what it comes to.
+fn print_estimate(est: &Estimate, probed: &Probed, logical: usize) {
     outln!(
         "\nprobe took {:.2} s ({} kernel set-up{} on one thread at n <= {PROBE_MAX_N}, scaled to \
          each case's n by the kernel's complexity class and to its threads by +{:.1} per extra \
@@ -204,16 +155,21 @@ fn print_plan(
     outln!(
         "estimated wall time: {} (cases {}, calibration {})",
         WallTime(est.total_s),
-        WallTime(cases_s),
+        WallTime(est.total_s - est.calibration_s),
         WallTime(est.calibration_s)
     );
+}
+
+/// What a real run would do: resume, stop at the budget, ask, and where it would write.
+fn print_consequences(args: &SweepArgs, config: &SweepConfig, est: &Estimate, path: Option<&Path>) {
+    let m = &config.measure;
     if let (Some(_), Some(path)) = (&args.resume, path) {
         outln!(
             "(--resume: only the rounds {} does not hold yet)",
             path.display()
         );
     }
-    if m.budget_s > 0.0 && cases_s > m.budget_s {
+    if m.budget_s > 0.0 && est.total_s - est.calibration_s > m.budget_s {
         outln!(
             "measure.budget_s = {}: the sweep stops starting cases after that; --resume continues",
             m.budget_s

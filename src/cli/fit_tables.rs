@@ -1,6 +1,7 @@
 //! The readable tables `fit` prints.
 
 use nbody_harness::fit::{CiMethod, ComplexityClass, Input, PowerFit, StrongFit, WeakFit};
+use nbody_harness::render::tables::{Align, Table};
 use nbody_harness::units::{Duration, Number, WithCi};
 
 fn r2(r2: Option<f64>) -> String {
@@ -32,33 +33,7 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         fit.ci_method,
         fit.resamples,
     );
-    outln!(
-        "\n{:>6} {:>11}  {:<28} {:<28} Karp-Flatt e(p)",
-        "p",
-        "median",
-        "speedup [95% CI]",
-        "efficiency"
-    );
-    for pt in &fit.points {
-        let e = fit
-            .karp_flatt
-            .iter()
-            .find(|k| k.p == pt.p)
-            .map_or("-".to_string(), |k| WithCi::of(&k.e, Number).to_string());
-        let ceiling = match (pt.ceiling, pt.speedup_vs_ceiling) {
-            (Some(c), Some(rel)) => format!("  {} of ceiling {c:.2}x", WithCi::of(&rel, Number)),
-            _ => String::new(),
-        };
-        let line = format!(
-            "{:>6} {:>11}  {:<28} {:<28} {:<28}{ceiling}",
-            pt.p,
-            Duration(pt.median_s),
-            WithCi::of(&pt.speedup, Number),
-            WithCi::of(&pt.efficiency, Number),
-            e
-        );
-        outln!("{}", line.trim_end());
-    }
+    outln!("\n{}", strong_points(fit).text().trim_end());
     outln!();
     outln!(
         "serial fraction f   {}{}",
@@ -91,6 +66,43 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         trend.verdict.name(),
         trend.meaning
     );
+    print_overhead(fit);
+    print_notes(&fit.notes);
+}
+
+/// Each thread count: its median, speedup, efficiency, Karp-Flatt e(p) and the speedup over
+/// the calibrated ceiling.
+fn strong_points(fit: &StrongFit) -> Table {
+    let r = Align::Right;
+    let header = [
+        "p",
+        "median",
+        "speedup [95% CI]",
+        "efficiency",
+        "Karp-Flatt e(p)",
+        "of the ceiling",
+    ];
+    let mut t = Table::new(header).aligned([r, r, r, r, r, Align::Default]);
+    for pt in &fit.points {
+        let e = fit.karp_flatt.iter().find(|k| k.p == pt.p);
+        let ceiling = match (pt.ceiling, pt.speedup_vs_ceiling) {
+            (Some(c), Some(rel)) => format!("{} of {c:.2}x", WithCi::of(&rel, Number)),
+            _ => String::new(),
+        };
+        t.row([
+            pt.p.to_string(),
+            Duration(pt.median_s).to_string(),
+            WithCi::of(&pt.speedup, Number).to_string(),
+            WithCi::of(&pt.efficiency, Number).to_string(),
+            e.map_or("-".to_string(), |k| WithCi::of(&k.e, Number).to_string()),
+            ceiling,
+        ]);
+    }
+    t
+}
+
+/// The overhead terms tried beside Amdahl's law, and the one kept.
+fn print_overhead(fit: &StrongFit) {
     let loo: Vec<String> = fit
         .overhead
         .candidates
@@ -116,7 +128,6 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
             loo.join(", ")
         ),
     }
-    print_notes(&fit.notes);
 }
 
 pub fn print_weak(file: &str, fit: &WeakFit) {
@@ -128,27 +139,26 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
         fit.ci_method,
         fit.resamples,
     );
-    outln!(
-        "\n{:>6} {:>11}  {:<28} {:<28} n (work per worker ratio)",
+    let r = Align::Right;
+    let header = [
         "p",
         "median",
         "efficiency T1/T(p)",
-        "scaled speedup"
-    );
+        "scaled speedup",
+        "n (work per worker ratio)",
+    ];
+    let mut table = Table::new(header).aligned([r, r, r, r, Align::Default]);
     for (i, input) in fit.inputs.iter().enumerate() {
-        let work = fit
-            .work_per_worker
-            .as_ref()
-            .map_or(String::new(), |w| format!("{} ({:.3})", w[i].n, w[i].ratio));
-        let line = format!(
-            "{:>6} {:>11}  {:<28} {:<28} {work}",
-            input.x,
-            Duration(input.median),
-            WithCi::of(&fit.efficiency[i].e, Number),
-            WithCi::of(&fit.scaled_speedup[i].s, Number),
-        );
-        outln!("{}", line.trim_end());
+        let work = fit.work_per_worker.as_ref();
+        table.row([
+            input.x.to_string(),
+            Duration(input.median).to_string(),
+            WithCi::of(&fit.efficiency[i].e, Number).to_string(),
+            WithCi::of(&fit.scaled_speedup[i].s, Number).to_string(),
+            work.map_or(String::new(), |w| format!("{} ({:.3})", w[i].n, w[i].ratio)),
+        ]);
     }
+    outln!("\n{}", table.text().trim_end());
     outln!();
     outln!(
         "serial fraction     alpha = {}{}  (S = p - alpha (p - 1))",
@@ -179,15 +189,13 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         fit.ci_method,
         fit.resamples,
     );
-    outln!("\n{:>12} {:>11} {:>8}", "n", "median", "samples");
+    let r = Align::Right;
+    let mut table = Table::new(["n", "median", "samples"]).aligned([r, r, r]);
     for input in &fit.inputs {
-        outln!(
-            "{:>12} {:>11} {:>8}",
-            input.x,
-            Duration(input.median),
-            input.samples
-        );
+        let median = Duration(input.median).to_string();
+        table.row([input.x.to_string(), median, input.samples.to_string()]);
     }
+    outln!("\n{}", table.text().trim_end());
     outln!();
     outln!(
         "exponent k          {}  (T = c*n^k)",
@@ -216,12 +224,8 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         sel.loo_smape_percent,
         100.0 * sel.support
     );
-    outln!(
-        "\n{:<12} {:>16} {:>16}   (leave-one-out SMAPE)",
-        "class",
-        "c*g(n)",
-        "a + c*g(n)"
-    );
+    let header = ["class", "c*g(n)", "a + c*g(n)", "(leave-one-out SMAPE)"];
+    let mut table = Table::new(header).aligned([Align::Default, r, r, Align::Default]);
     for class in ComplexityClass::ALL {
         let cell = |with_constant: bool| {
             fit.candidates
@@ -237,13 +241,14 @@ pub fn print_power(file: &str, fit: &PowerFit) {
                 })
                 .unwrap_or_else(|| "-".to_string())
         };
-        outln!(
-            "{:<12} {:>16} {:>16}",
-            class.name(),
+        table.row([
+            class.name().to_string(),
             cell(false),
-            cell(true)
-        );
+            cell(true),
+            String::new(),
+        ]);
     }
+    outln!("\n{}", table.text().trim_end());
     outln!("(in parentheses: a negative constant or coefficient; not selectable)");
     print_notes(&fit.notes);
 }

@@ -40,7 +40,6 @@ fn write_docs(out: &Path) -> anyhow::Result<i32> {
     Ok(0)
 }
 
-#[cfg(feature = "test-slowdown")]
 fn measure(args: GateStudyArgs) -> anyhow::Result<i32> {
     use nbody_records::{config::SweepConfig, locate};
     let config = match &args.config {
@@ -73,13 +72,4 @@ fn measure(args: GateStudyArgs) -> anyhow::Result<i32> {
         .map_err(|e| anyhow::anyhow!(e))?;
     out!("{}", table::markdown(&[file]));
     Ok(0)
-}
-
-#[cfg(not(feature = "test-slowdown"))]
-fn measure(_: GateStudyArgs) -> anyhow::Result<i32> {
-    anyhow::bail!(
-        "gate-study slows a kernel on purpose and needs a build with the test-slowdown \
-         feature: cargo build --release --features test-slowdown (never measure anything else \
-         with that build); --docs works in any build"
-    )
 }

@@ -49,8 +49,10 @@ mod with_mpi {
     use crate::cli::summary::print_summary;
     use crate::cli::{error_chain, kernel_params, setup, start_setup};
     use anyhow::Context;
+    use nbody_engine::decomp::check::CheckReport;
     use nbody_engine::decomp::stats::MpiReport;
     use nbody_engine::kernels::KernelKind;
+    use nbody_engine::run::RunOutcome;
     use nbody_engine::scenario::Precision;
     use nbody_harness::units::Duration;
     use nbody_mpi::mpi::{BenchOptions, DomainOptions, Mpi, MpiError, MpiSpec};
@@ -295,7 +297,21 @@ mod with_mpi {
             Precision::F64 => 1e-9,
             Precision::F32 => 1e-4,
         });
-        let o = &root.outcome;
+        print_check(&args, &root.outcome, &report, tolerance, mpi.size());
+        let ok = report.passes(tolerance) & expectations_hold(&args, &root.outcome, &report);
+        outln!("{}", if ok { "MATCH" } else { "MISMATCH" });
+        Ok(if ok { 0 } else { 1 })
+    }
+
+    /// How the distributed run compares with the serial one: particles, differences, the
+    /// tree's forces and energy, migration.
+    fn print_check(
+        args: &MpiCheckArgs,
+        o: &RunOutcome,
+        report: &CheckReport,
+        tolerance: f64,
+        ranks: usize,
+    ) {
         outln!(
             "{} / {} / {}: n = {}, {} steps, {} ranks",
             o.scenario,
@@ -303,7 +319,7 @@ mod with_mpi {
             args.decomp.name(),
             o.n,
             args.steps + args.mpi.warmup_steps,
-            mpi.size()
+            ranks
         );
         outln!(
             "particles         {} distributed, {} serial, ids complete: {}, id sum {} (expected {})",
@@ -338,6 +354,10 @@ mod with_mpi {
             report.migrated,
             report.far_migrated
         );
+    }
+
+    /// The `--expect-*` flags, each said when it does not hold; whether all hold.
+    fn expectations_hold(args: &MpiCheckArgs, o: &RunOutcome, report: &CheckReport) -> bool {
         let (owned, rebalances): (Vec<u64>, u64) = o
             .mpi
             .as_ref()
@@ -349,7 +369,7 @@ mod with_mpi {
             })
             .unwrap_or_default();
         outln!("owned at the end  {owned:?}, {rebalances} rebalance(s)");
-        let mut ok = report.passes(tolerance);
+        let mut ok = true;
         if args.expect_empty_rank && !owned.contains(&0) {
             outln!("FAIL: every rank owns particles (--expect-empty-rank)");
             ok = false;
@@ -368,8 +388,7 @@ mod with_mpi {
             );
             ok = false;
         }
-        outln!("{}", if ok { "MATCH" } else { "MISMATCH" });
-        Ok(if ok { 0 } else { 1 })
+        ok
     }
 
     pub fn bench(args: MpiBenchArgs) -> anyhow::Result<i32> {

@@ -19,5 +19,12 @@ pub fn report(args: ReportArgs) -> anyhow::Result<i32> {
     for e in &generated.figure_errors {
         eprintln!("warning: figure not drawn: {e}");
     }
+    for (region, figures) in &generated.kept_figures {
+        eprintln!(
+            "warning: the kept region `{region}` holds figures written by hand ({}); a number \
+             belongs in a generated section, where it follows the results",
+            figures.join(" ")
+        );
+    }
     Ok(0)
 }

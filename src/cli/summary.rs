@@ -3,6 +3,7 @@
 use nbody_engine::run::RunOutcome;
 use nbody_harness::units::Duration;
 
+/// The run's measurements, one labelled line each.
 pub fn print_summary(r: &RunOutcome) {
     let t = &r.timing;
     outln!(
@@ -61,6 +62,19 @@ pub fn print_summary(r: &RunOutcome) {
         pct(ph.boundary),
         pct(ph.output)
     );
+    print_work(r);
+    outln!(
+        "energy            {:.6e} -> {:.6e}, relative drift {:+.3e}",
+        r.energy.initial.total(),
+        r.energy.last.total(),
+        r.energy.rel_drift
+    );
+}
+
+/// The work per step: pair checks, tree nodes, cells, pairs in range, and the neighbour list
+/// when the kernel keeps one.
+fn print_work(r: &RunOutcome) {
+    let t = &r.timing;
     let c = &r.counters;
     out!(
         "work per step     {:.4e} pair checks",
@@ -105,10 +119,4 @@ pub fn print_summary(r: &RunOutcome) {
             Duration::from_ns(t.per_step_ns.mean / r.n.max(1) as f64),
         );
     }
-    outln!(
-        "energy            {:.6e} -> {:.6e}, relative drift {:+.3e}",
-        r.energy.initial.total(),
-        r.energy.last.total(),
-        r.energy.rel_drift
-    );
 }

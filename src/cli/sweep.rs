@@ -1,8 +1,8 @@
 use crate::cli::args::SweepArgs;
 use nbody_engine::output::provenance::utc_now;
 use nbody_harness::experiment::progress;
-use nbody_harness::experiment::runner::{SweepOptions, run_sweep_wall};
-use nbody_harness::units::Duration;
+use nbody_harness::experiment::runner::{self, SweepOptions, SweepReport, run_sweep_wall};
+use nbody_harness::render::sweep_tables;
 use nbody_records::config::SweepConfig;
 use nbody_records::locate;
 use nbody_records::results::ResultsFile;
@@ -22,32 +22,76 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
     let (config, text) = SweepConfig::load(&config_path)?;
     // A config read from a pipe has no directory: its {config_dir} is the current one.
     let from_pipe = nbody_engine::input::is_pipe(&config_path);
-    let target = where_to_write(&args, &config)?;
-    let existing = match &target {
-        Target::Out => Some(nbody_harness::experiment::runner::results_path(
-            &config,
-            args.out.as_deref(),
-        )),
-        Target::Existing(dir) => Some(dir.join("results.json")),
-        Target::New => None,
-    };
     let config_dir = config_path
         .parent()
         .filter(|p| !p.as_os_str().is_empty() && !from_pipe)
         .map(Path::to_path_buf);
+    let target = where_to_write(&args, &config)?;
+    if let Some(code) = dry_run(&args, &config, &target, &config_dir)? {
+        return Ok(code);
+    }
+    let options = options(&args, &config, target, config_dir)?;
+    let mut observer = progress::for_stderr();
+    let report = run_sweep_wall(&config, &text, &options, observer.as_mut()).inspect_err(|_| {
+        // A new run directory that never received results is not a run: leave nothing.
+        if let Some(dir) = &options.run_dir
+            && !options.resume
+        {
+            let _ = std::fs::remove_dir(dir);
+        }
+    })?;
+    let results = ResultsFile::load(&report.path)?;
+    outln!("{}", sweep_tables::cases(&results).text().trim_end());
+    let speedups = sweep_tables::speedups(&results);
+    if !speedups.is_empty() {
+        outln!(
+            "\n{}",
+            sweep_tables::speedups_table(&speedups).text().trim_end()
+        );
+    }
+    outln!(
+        "\n{} cases, {} rounds measured in this run; results in {}",
+        report.cases,
+        report.rounds_measured,
+        report.path.display()
+    );
+    analyze_and_record(&args, &results, &report.path)?;
+    Ok(report_failures(&args, &results, &report))
+}
+
+/// The checks a dry run makes before printing the plan (what the sweep checks before its
+/// first case: a program that cannot start, an `initial` file that cannot be read or lacks an
+/// n), and the plan itself; `Some(exit code)` when the command ends there.
+fn dry_run(
+    args: &SweepArgs,
+    config: &SweepConfig,
+    target: &Target,
+    config_dir: &Option<PathBuf>,
+) -> anyhow::Result<Option<i32>> {
+    let existing = match target {
+        Target::Out => Some(runner::results_path(config, args.out.as_deref())),
+        Target::Existing(dir) => Some(dir.join("results.json")),
+        Target::New => None,
+    };
     if args.dry_run {
-        // What the sweep checks before its first case, the dry run checks too: a program that
-        // cannot start, an `initial` file that cannot be read or lacks an n.
         let options = SweepOptions {
             out: args.out.clone(),
             config_dir: config_dir.clone(),
             ..Default::default()
         };
-        nbody_harness::experiment::runner::check_before_running(&config, &options)?;
+        runner::check_before_running(config, &options)?;
     }
-    if let Some(code) = super::dry_run::before_sweep(&args, &config, existing.as_deref())? {
-        return Ok(code);
-    }
+    super::dry_run::before_sweep(args, config, existing.as_deref())
+}
+
+/// The runner's options: where the results go (a new run directory is claimed here) and
+/// what the arguments ask for.
+fn options(
+    args: &SweepArgs,
+    config: &SweepConfig,
+    target: Target,
+    config_dir: Option<PathBuf>,
+) -> anyhow::Result<SweepOptions> {
     let (resume, run_dir) = match target {
         Target::Out => (args.resume.is_some(), None),
         Target::Existing(dir) => {
@@ -59,7 +103,7 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
             (false, Some(dir))
         }
     };
-    let options = SweepOptions {
+    Ok(SweepOptions {
         resume,
         force: args.force,
         fresh: args.fresh,
@@ -68,48 +112,39 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         calibrate: !args.no_calibration,
         config_dir,
         nbody_bench: None,
-    };
-    let mut observer = progress::for_stderr();
-    let report = run_sweep_wall(&config, &text, &options, observer.as_mut()).inspect_err(|_| {
-        // A new run directory that never received results is not a run: leave nothing.
-        if let Some(dir) = &options.run_dir
-            && !resume
-        {
-            let _ = std::fs::remove_dir(dir);
-        }
-    })?;
-    let results = ResultsFile::load(&report.path)?;
-    print_table(&results);
-    print_speedups(&results);
-    outln!(
-        "\n{} cases, {} rounds measured in this run; results in {}",
-        report.cases,
-        report.rounds_measured,
-        report.path.display()
-    );
+    })
+}
+
+/// The analysis beside the results, and with `--record` the history's new records.
+fn analyze_and_record(args: &SweepArgs, results: &ResultsFile, path: &Path) -> anyhow::Result<()> {
     // The analysis is a convenience on top of the measurements: if it fails, the results
     // are already saved and `analyze` can be run again.
-    let dir = super::analyze::default_dir(&report.path);
-    match super::analyze::run(&results, &report.path, &dir) {
+    let dir = super::analyze::default_dir(path);
+    match super::analyze::run(results, path, &dir) {
         Ok(written) => super::analyze::print_written(&written),
         Err(e) => eprintln!(
             "warning: analysis failed ({}); the results are saved, retry with `nbody-bench analyze {}`",
             super::error_chain(&e),
-            report.path.display()
+            path.display()
         ),
     }
     if let Some(history) = &args.record {
-        let appended = super::history::append_results(history, &results, "sweep");
+        let appended = super::history::append_results(history, results, "sweep");
         let appended = anyhow::Context::with_context(appended, || {
             format!(
                 "the results are saved in {p}; record them with `nbody-bench history record {p}`",
-                p = report.path.display()
+                p = path.display()
             )
         })?;
         for (to, count) in appended {
             eprintln!("{count} records appended to {}", to.display());
         }
     }
+    Ok(())
+}
+
+/// The failed and unfinished cases, said with what to do; the exit status.
+fn report_failures(args: &SweepArgs, results: &ResultsFile, report: &SweepReport) -> i32 {
     let failed: Vec<_> = results.cases.iter().filter(|c| c.failed()).collect();
     for c in &failed {
         let reasons = c.failures();
@@ -133,16 +168,16 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
             }
         );
     }
-    if !failed.is_empty() {
-        eprintln!(
-            "{} of {} cases failed; every failure is kept in {}",
-            failed.len(),
-            results.cases.len(),
-            report.path.display()
-        );
-        return Ok(FAILED_CASES);
+    if failed.is_empty() {
+        return 0;
     }
-    Ok(0)
+    eprintln!(
+        "{} of {} cases failed; every failure is kept in {}",
+        failed.len(),
+        results.cases.len(),
+        report.path.display()
+    );
+    FAILED_CASES
 }
 
 /// The exit status of a sweep with a case whose every sample failed.
@@ -214,106 +249,6 @@ fn where_to_write(args: &SweepArgs, config: &SweepConfig) -> anyhow::Result<Targ
                 );
             }
             Ok(Target::New)
-        }
-    }
-}
-
-fn print_table(results: &ResultsFile) {
-    outln!(
-        "{:<52} {:>11} {:>23} {:>11} {:>10} {:>6}",
-        "case",
-        "per step",
-        "95% CI",
-        "ns/p-step",
-        "pairs/s",
-        "sanity"
-    );
-    for c in &results.cases {
-        let Some(s) = &c.summary else {
-            let what = if c.failed() {
-                "FAILED: no sample succeeded"
-            } else {
-                "not measured"
-            };
-            outln!("{:<52} {what}", c.key);
-            continue;
-        };
-        outln!(
-            "{:<52} {:>11} {:>23} {:>11.1} {:>10} {:>6}{}",
-            c.key,
-            Duration(s.median_s),
-            format!("[{}, {}]", Duration(s.ci95_s[0]), Duration(s.ci95_s[1])),
-            s.ns_per_particle_step,
-            // An external program counts no pairs and checks no energy: "–", not 0 or "ok".
-            s.pair_evals_per_s
-                .map_or("–".to_string(), |r| format!("{r:.2e}")),
-            match s.sanity_ok {
-                Some(true) => "ok",
-                Some(false) => "DRIFT",
-                None => "–",
-            },
-            if c.oversubscribed {
-                "  (oversubscribed)"
-            } else {
-                ""
-            }
-        );
-    }
-}
-
-/// Speedup of every multi-thread case over its one-thread twin, raw and relative to the
-/// calibrated hardware ceiling (the throughput ratio of an embarrassingly parallel loop).
-fn print_speedups(results: &ResultsFile) {
-    let ceiling = |p: usize| {
-        results
-            .calibration
-            .start
-            .as_ref()
-            .and_then(|c| c.ceiling(p))
-    };
-    let mut lines = Vec::new();
-    for c in results.cases.iter().filter(|c| c.case.threads > 1) {
-        let mut one = c.case.clone();
-        one.threads = 1;
-        let base = results
-            .cases
-            .iter()
-            .find(|o| o.case == one)
-            .and_then(|o| o.summary.as_ref());
-        let (Some(base), Some(s)) = (base, c.summary.as_ref()) else {
-            continue;
-        };
-        if s.median_s <= 0.0 {
-            continue;
-        }
-        let speedup = base.median_s / s.median_s;
-        let relative = match ceiling(c.case.threads) {
-            Some(h) if h > 0.0 => format!("{:>6.2}  (ceiling {h:.2}x)", speedup / h),
-            _ => "     -".to_string(),
-        };
-        lines.push(format!(
-            "{:<52} {:>7.2}x {:>6.2} {}{}",
-            c.key,
-            speedup,
-            speedup / c.case.threads as f64,
-            relative,
-            if c.oversubscribed {
-                "  oversubscribed: not a parallel measurement"
-            } else {
-                ""
-            }
-        ));
-    }
-    if !lines.is_empty() {
-        outln!(
-            "\n{:<52} {:>8} {:>6} {:>6}",
-            "speedup over the same case on 1 thread",
-            "raw",
-            "eff.",
-            "/ceiling"
-        );
-        for l in lines {
-            outln!("{l}");
         }
     }
 }

@@ -1,6 +1,6 @@
 use super::{kernel_params, setup};
 use crate::cli::args::ValidateArgs;
-use nbody_engine::kernels::KernelKind;
+use nbody_engine::kernels::{KernelKind, KernelParams};
 use nbody_engine::scenario::ScenarioKind;
 use nbody_engine::validate::{ScenarioCheck, ValidateJob, validate_setup};
 use nbody_harness::units::WallTime;
@@ -22,47 +22,63 @@ pub fn validate(args: ValidateArgs) -> anyhow::Result<i32> {
     let params = kernel_params(&args.kernel_args, None)?;
     let mut results: Vec<ScenarioCheck> = Vec::new();
     for &scenario in &scenarios {
-        let mut s = setup(scenario, &args.system);
-        if args.scenario.is_none()
-            && args.system.density.is_some()
-            && scenario.defaults().density.is_none()
-        {
-            // --density applies to the scenarios that have one.
-            s.density = None;
-        }
-        s.validate()?;
-        // The trees and the Verlet list hold the most memory of the kernels checked, the O(n²)
-        // direct sums take the time: the f64 reference and the three quadratic kernels, one
-        // force computation each.
-        for kernel in [
-            KernelKind::Octree,
-            KernelKind::Fmm,
-            KernelKind::Verlet,
-            KernelKind::PerThread,
-        ] {
-            nbody_engine::run::check_memory(&s, kernel, &params, args.kernel_args.threads, 1)?;
-        }
-        if !args.yes {
-            refuse_long_check(&s, params, args.kernel_args.threads)?;
-        }
-        let job = ValidateJob {
-            params,
-            threads: args.kernel_args.threads,
-            want_dump: args.dump.is_some(),
-        };
-        let check = validate_setup(&s, job)??;
-        if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
-            let path = dump_file(path, scenarios.len(), scenario);
-            nbody_engine::output::write_atomic(&path, text.as_bytes())?;
-            if !args.json {
-                outln!("forces written to {}", path.display());
-            }
-        }
-        if !args.json {
-            print_check(&check);
-        }
-        results.push(check);
+        results.push(check_scenario(&args, scenario, scenarios.len(), params)?);
     }
+    print_verdict(&args, &results)
+}
+
+/// One scenario's check of every kernel against the reference, with its memory and time
+/// guards, its forces dumped with `--dump`; `count` is the number of scenarios checked.
+fn check_scenario(
+    args: &ValidateArgs,
+    scenario: ScenarioKind,
+    count: usize,
+    params: KernelParams,
+) -> anyhow::Result<ScenarioCheck> {
+    let mut s = setup(scenario, &args.system);
+    if args.scenario.is_none()
+        && args.system.density.is_some()
+        && scenario.defaults().density.is_none()
+    {
+        // --density applies to the scenarios that have one.
+        s.density = None;
+    }
+    s.validate()?;
+    // The trees and the Verlet list hold the most memory of the kernels checked, the O(n²)
+    // direct sums take the time: the f64 reference and the three quadratic kernels, one
+    // force computation each.
+    for kernel in [
+        KernelKind::Octree,
+        KernelKind::Fmm,
+        KernelKind::Verlet,
+        KernelKind::PerThread,
+    ] {
+        nbody_engine::run::check_memory(&s, kernel, &params, args.kernel_args.threads, 1)?;
+    }
+    if !args.yes {
+        refuse_long_check(&s, params, args.kernel_args.threads)?;
+    }
+    let job = ValidateJob {
+        params,
+        threads: args.kernel_args.threads,
+        want_dump: args.dump.is_some(),
+    };
+    let check = validate_setup(&s, job)??;
+    if let (Some(path), Some(text)) = (&args.dump, &check.dump) {
+        let path = dump_file(path, count, scenario);
+        nbody_engine::output::write_atomic(&path, text.as_bytes())?;
+        if !args.json {
+            outln!("forces written to {}", path.display());
+        }
+    }
+    if !args.json {
+        print_check(&check);
+    }
+    Ok(check)
+}
+
+/// The kernels that failed or were skipped, as JSON or a line; the exit status.
+fn print_verdict(args: &ValidateArgs, results: &[ScenarioCheck]) -> anyhow::Result<i32> {
     let failed: Vec<String> = results
         .iter()
         .flat_map(|c| {

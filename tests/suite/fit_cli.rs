@@ -91,10 +91,14 @@ fn amdahl_recovers_a_serial_fraction_of_0_1() {
         "serial fraction f",
         "max speedup 1/f",
         "Karp-Flatt trend",
-        "    16 ",
     ] {
         assert!(stdout.contains(want), "table lacks {want:?}:\n{stdout}");
     }
+    // A row per thread count, the largest too.
+    assert!(
+        stdout.lines().any(|l| l.trim_start().starts_with("16 ")),
+        "no row of p = 16:\n{stdout}"
+    );
 }
 
 #[test]

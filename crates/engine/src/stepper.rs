@@ -9,6 +9,7 @@
 use crate::boundary::BoundaryError;
 use crate::engine::{Energy, PhaseTimes, Simulation};
 use crate::kernels::CompiledKernels;
+use crate::kernels::decorator::{KernelDecorator, Plain};
 use crate::kernels::{KernelKind, KernelParams, WorkCounters};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -46,38 +47,30 @@ pub fn stepper(
     kernel: KernelKind,
     params: &KernelParams,
 ) -> Result<Result<Box<dyn Stepper>, RunError>, SetupError> {
-    setup.dispatch(Build {
-        kernel,
-        params,
-        #[cfg(feature = "test-slowdown")]
-        slowdown: 1.0,
-    })
+    decorated_stepper(setup, kernel, params, Plain)
 }
 
-/// [`stepper`] with each timed force computation made `slowdown` times as long
-/// ([`crate::kernels::repeated`]): a genuinely slower build for the regression gate's tests.
-#[cfg(feature = "test-slowdown")]
-pub fn slowed_stepper(
+/// [`stepper`] with the kernel passed through `decorator`.
+pub fn decorated_stepper<Dc: KernelDecorator>(
     setup: &Setup,
     kernel: KernelKind,
     params: &KernelParams,
-    slowdown: f64,
+    decorator: Dc,
 ) -> Result<Result<Box<dyn Stepper>, RunError>, SetupError> {
     setup.dispatch(Build {
         kernel,
         params,
-        slowdown,
+        decorator,
     })
 }
 
-struct Build<'a> {
+struct Build<'a, Dc> {
     kernel: KernelKind,
     params: &'a KernelParams,
-    #[cfg(feature = "test-slowdown")]
-    slowdown: f64,
+    decorator: Dc,
 }
 
-impl SystemJob for Build<'_> {
+impl<Dc: KernelDecorator> SystemJob for Build<'_, Dc> {
     type Output = Result<Box<dyn Stepper>, RunError>;
 
     fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
@@ -86,8 +79,7 @@ impl SystemJob for Build<'_> {
     ) -> Self::Output {
         let law = system.law;
         let kernel = self.kernel.build::<T, L, D>(law, self.params)?;
-        #[cfg(feature = "test-slowdown")]
-        let kernel = crate::kernels::repeated::repeated(kernel, self.slowdown);
+        let kernel = self.decorator.decorate(kernel);
         Ok(Box::new(WithLaw {
             sim: Simulation::new(system, kernel),
             law,

@@ -445,6 +445,15 @@ pub fn keys() -> Vec<super::config_keys::Key> {
     .keys()
 }
 
+/// A config error of the file at `path`: `key` and what is wrong with it.
+fn invalid(path: &Path) -> impl Fn(&str, String) -> ConfigError + '_ {
+    move |key, problem| ConfigError::Invalid {
+        path: path.into(),
+        key: key.into(),
+        problem,
+    }
+}
+
 impl SweepConfig {
     /// Reads, parses and validates a config file.
     pub fn load(path: &Path) -> Result<(SweepConfig, String), ConfigError> {
@@ -466,14 +475,32 @@ impl SweepConfig {
         Ok(config)
     }
 
+    /// Checks the config theme by theme; the order of the steps decides which problem is
+    /// reported when there are several.
     fn validate(&self, path: &Path) -> Result<(), ConfigError> {
-        let bad = |key: &str, problem: String| ConfigError::Invalid {
-            path: path.into(),
-            key: key.into(),
-            problem,
-        };
-        // The name becomes a directory name under the output directory: a plain file name,
-        // never `.`, `..` or a hidden name that would escape or hide from `--out`.
+        self.validate_name(path)?;
+        self.validate_subjects(path)?;
+        self.validate_external(path)?;
+        if self.initial.is_some() {
+            self.validate_initial(path)?;
+        }
+        self.validate_coverage(path)?;
+        self.validate_lists(path)?;
+        self.validate_sizes(path)?;
+        if let Some(mpi) = &self.mpi {
+            self.validate_mpi(mpi, path)?;
+        }
+        if let Some(s) = &self.scheduler {
+            let bad = invalid(path);
+            s.validate().map_err(|(key, problem)| bad(&key, problem))?;
+        }
+        self.validate_measure(path)?;
+        self.validate_unique(path)
+    }
+
+    /// The name becomes a directory name under the output directory: a plain file name,
+    /// never `.`, `..` or a hidden name that would escape or hide from `--out`.
+    fn validate_name(&self, path: &Path) -> Result<(), ConfigError> {
         if self.name.is_empty()
             || self.name.starts_with('.')
             || !self
@@ -481,7 +508,7 @@ impl SweepConfig {
                 .chars()
                 .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
         {
-            return Err(bad(
+            return Err(invalid(path)(
                 "name",
                 format!(
                     "is `{}`: it must be a plain file name of letters, digits, '-', '_' and '.', \
@@ -490,6 +517,12 @@ impl SweepConfig {
                 ),
             ));
         }
+        Ok(())
+    }
+
+    /// Something to measure: at least one scenario, and a kernel or an external program.
+    fn validate_subjects(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = invalid(path);
         if self.scenarios.is_empty() {
             return Err(bad(
                 "scenarios",
@@ -504,10 +537,13 @@ impl SweepConfig {
                     .into(),
             ));
         }
-        self.validate_external(path)?;
-        if self.initial.is_some() {
-            self.validate_initial(path)?;
-        }
+        Ok(())
+    }
+
+    /// Every scenario has a kernel (or an external program) to run it, and every kernel a
+    /// scenario it applies to.
+    fn validate_coverage(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = invalid(path);
         for &s in &self.scenarios {
             let external = self
                 .external
@@ -533,6 +569,13 @@ impl SweepConfig {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The lists of case parameters: threads, seeds, theta, multipole, skin and order, each
+    /// with values in range and, for theta and skin, a kernel that runs them.
+    fn validate_lists(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = invalid(path);
         if self.threads.is_empty()
             || self
                 .threads
@@ -593,6 +636,13 @@ impl SweepConfig {
                 format!("must be a non-empty list of expansion orders from 1 to {max_order}"),
             ));
         }
+        Ok(())
+    }
+
+    /// The sizes the study runs: `weak` for a weak study (which takes no `n`), valid counts
+    /// `n` otherwise, and a strong study's reference of one thread.
+    fn validate_sizes(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = invalid(path);
         match (&self.study, &self.weak) {
             (Study::Weak, None) => {
                 return Err(bad(
@@ -613,31 +663,7 @@ impl SweepConfig {
             }
             (Study::Weak, Some(_)) => {}
             (_, Some(_)) => return Err(bad("weak", "only applies to study = \"weak\"".into())),
-            (_, None) => match &self.n {
-                None => {
-                    return Err(bad(
-                        "n",
-                        "is required: a list such as [1000, 2000] or { from, to, factor }".into(),
-                    ));
-                }
-                Some(Counts::List(v)) if v.is_empty() => {
-                    return Err(bad("n", "is empty; list at least one count".into()));
-                }
-                Some(Counts::List(v)) if v.contains(&0) => {
-                    return Err(bad("n", "must not contain 0".into()));
-                }
-                Some(Counts::Range(r))
-                    if r.from == 0
-                        || r.to < r.from
-                        || !(r.factor > 1.0 && r.factor.is_finite()) =>
-                {
-                    return Err(bad(
-                        "n",
-                        "range needs 1 <= from <= to and factor > 1".into(),
-                    ));
-                }
-                Some(_) => {}
-            },
+            (_, None) => self.validate_counts(path)?,
         }
         if self.study == Study::Strong && !self.threads.contains(&1) {
             return Err(bad(
@@ -645,12 +671,37 @@ impl SweepConfig {
                 "must include 1 for a strong-scaling study (speedups are relative to it)".into(),
             ));
         }
-        if let Some(mpi) = &self.mpi {
-            self.validate_mpi(mpi, path)?;
+        Ok(())
+    }
+
+    /// The particle counts `n` of a study that is not weak: given, non-empty, without 0.
+    fn validate_counts(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = invalid(path);
+        match &self.n {
+            None => Err(bad(
+                "n",
+                "is required: a list such as [1000, 2000] or { from, to, factor }".into(),
+            )),
+            Some(Counts::List(v)) if v.is_empty() => {
+                Err(bad("n", "is empty; list at least one count".into()))
+            }
+            Some(Counts::List(v)) if v.contains(&0) => Err(bad("n", "must not contain 0".into())),
+            Some(Counts::Range(r))
+                if r.from == 0 || r.to < r.from || !(r.factor > 1.0 && r.factor.is_finite()) =>
+            {
+                Err(bad(
+                    "n",
+                    "range needs 1 <= from <= to and factor > 1".into(),
+                ))
+            }
+            Some(_) => Ok(()),
         }
-        if let Some(s) = &self.scheduler {
-            s.validate().map_err(|(key, problem)| bad(&key, problem))?;
-        }
+    }
+
+    /// The `[measure]` table: samples shared by the rounds, and durations and the energy
+    /// drift in range.
+    fn validate_measure(&self, path: &Path) -> Result<(), ConfigError> {
+        let bad = invalid(path);
         let m = &self.measure;
         if m.samples == 0 || m.rounds == 0 || m.rounds > m.samples {
             return Err(bad(
@@ -674,7 +725,7 @@ impl SweepConfig {
                 "must be a finite number > 0".into(),
             ));
         }
-        self.validate_unique(path)
+        Ok(())
     }
 
     /// Every value of a list gives its own cases, so a value listed twice would plan one case

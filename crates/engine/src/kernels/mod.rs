@@ -11,6 +11,7 @@ mod cell_list;
 mod cluster_pair;
 mod compiled;
 mod counting_sort;
+pub mod decorator;
 mod fmm;
 pub mod footprint;
 #[cfg(target_arch = "x86_64")]

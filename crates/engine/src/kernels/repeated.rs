@@ -5,9 +5,24 @@
 //! integrates, slows a little less). The regression gate's tests use it (through the
 //! harness's `NBODY_BENCH_TEST_SLOWDOWN`) to have a genuinely slower build to find.
 
+use super::decorator::KernelDecorator;
 use super::{ForceKernel, ForceReport, KernelKind};
 use crate::real::Real;
 use crate::state::{Field, State};
+
+/// Each timed force computation `.0` times as long: the decorator a stepper is built with
+/// (`stepper::decorated_stepper`) to be a genuinely slower build for the gate's tests.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Repeat(pub f64);
+
+impl KernelDecorator for Repeat {
+    fn decorate<T: Real, const D: usize>(
+        self,
+        kernel: Box<dyn ForceKernel<T, D>>,
+    ) -> Box<dyn ForceKernel<T, D>> {
+        repeated(kernel, self.0)
+    }
+}
 
 /// `inner` made `factor` times as slow when `factor` > 1, else `inner` itself.
 pub fn repeated<T: Real, const D: usize>(

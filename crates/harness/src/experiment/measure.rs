@@ -2,12 +2,11 @@
 //! phase timers, work counters and physics sanity.
 
 use super::reference::time_reference;
-#[cfg(feature = "test-slowdown")]
-use super::slowdown::TestSlowdown;
+use super::slowdown::{self, TestSlowdown};
 use nbody_engine::clock::{Clock, clock_cost};
 use nbody_engine::run::RunError;
 use nbody_engine::scenario::{Setup, SetupError};
-use nbody_engine::stepper::{Stepper, stepper};
+use nbody_engine::stepper::Stepper;
 use nbody_records::plan::Case;
 use nbody_records::round::RoundOutcome;
 
@@ -29,7 +28,6 @@ pub(crate) struct RoundSpec {
     /// Seconds of the reference workload to time before each sample (0 = none).
     pub reference_s: f64,
     /// The test-only slowdown knob, if set (see `experiment::slowdown`).
-    #[cfg(feature = "test-slowdown")]
     #[serde(skip)]
     pub slowdown: Option<TestSlowdown>,
 }
@@ -46,7 +44,6 @@ impl RoundSpec {
             steps_per_sample: None,
             force_error_sample: 0,
             reference_s: 0.0,
-            #[cfg(feature = "test-slowdown")]
             slowdown: None,
         }
     }
@@ -62,15 +59,7 @@ pub(crate) fn measure_round<C: Clock>(
     clock: &C,
 ) -> Result<Result<RoundOutcome, RunError>, SetupError> {
     let params = case.kernel_params();
-    #[cfg(feature = "test-slowdown")]
-    let built = match spec.slowdown {
-        Some(knob) => {
-            nbody_engine::stepper::slowed_stepper(setup, kernel, &params, knob.factor_for(kernel))
-        }
-        None => stepper(setup, kernel, &params),
-    };
-    #[cfg(not(feature = "test-slowdown"))]
-    let built = stepper(setup, kernel, &params);
+    let built = slowdown::stepper(spec.slowdown, setup, kernel, &params);
     Ok(built?.and_then(|mut sim| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(case.threads)

@@ -14,12 +14,10 @@ pub mod progress;
 pub mod reference;
 pub mod runner;
 pub mod skin;
-#[cfg(feature = "test-slowdown")]
 pub mod slowdown;
 pub mod slurm;
 
-// The gate study's measuring loop (built with the test-only slowdown) sets cases up as sweeps do.
-#[cfg(feature = "test-slowdown")]
+// The gate study's measuring loop sets cases up as sweeps do.
 pub(crate) use case_round::case_setup;
 
 /// The cargo features of this build that change what it measures, as results files record
@@ -27,7 +25,7 @@ pub(crate) use case_round::case_setup;
 pub fn cargo_features() -> Vec<&'static str> {
     [
         ("mpi", cfg!(feature = "mpi")),
-        ("test-slowdown", cfg!(feature = "test-slowdown")),
+        ("test-slowdown", slowdown::ENABLED),
     ]
     .into_iter()
     .filter_map(|(name, on)| on.then_some(name))

@@ -4,7 +4,6 @@
 use super::case_round::{case_setup, measure_case};
 use super::lock::WriterLock;
 use super::measure::RoundSpec;
-#[cfg(feature = "test-slowdown")]
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
 use super::slurm;
 use nbody_engine::clock::Clock;
@@ -80,7 +79,6 @@ pub enum SweepError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
-    #[cfg(feature = "test-slowdown")]
     #[error("{0}")]
     Slowdown(String),
     #[error(
@@ -174,7 +172,6 @@ pub fn run_sweep<C: Clock>(
     if config.scheduler.is_some() {
         slurm::check_available()?;
     }
-    #[cfg(feature = "test-slowdown")]
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
@@ -186,24 +183,8 @@ pub fn run_sweep<C: Clock>(
     let _writer = WriterLock::acquire(&path)?;
     let mut results = open(config, config_text, options, &path)?;
     if let Some(initial) = initial {
-        // A resumed sweep goes on from the same bodies, or not at all.
-        if let Some(before) = results.metadata.initial.as_ref()
-            && before.fnv1a != initial.record.fnv1a
-            && !options.force
-        {
-            return Err(SweepError::Mismatch {
-                path: path.clone(),
-                what: "file of bodies",
-                detail: format!(
-                    "{} had fingerprint {}, now {}",
-                    initial.record.path, before.fnv1a, initial.record.fnv1a
-                ),
-            });
-        }
-        context.initial = Some(keep_initial(&path, &initial)?);
-        results.metadata.initial = Some(initial.record);
+        context.initial = Some(adopt_initial(&mut results, initial, &path, options.force)?);
     }
-    #[cfg(feature = "test-slowdown")]
     if let Some(s) = slowdown {
         observer.message(&format!(
             "warning: {SLOWDOWN_ENV}={s} is set: {} runs {} times per step (test-only)",
@@ -211,6 +192,61 @@ pub fn run_sweep<C: Clock>(
             s.factor
         ));
     }
+    add_cases(config, &mut results, observer);
+    let thread_counts = thread_counts(&results);
+    let sweep = Sweep {
+        config,
+        options,
+        clock,
+        path: &path,
+        context: &context,
+        slowdown,
+    };
+    sweep.prepare(&mut results, &thread_counts, observer)?;
+    let (measured, stopped) = sweep.measure_rounds(&mut results, observer)?;
+    if options.calibrate && !stopped {
+        results.calibration.end = sweep.calibrate("end", &thread_counts, observer)?;
+        results.save(&path)?;
+    }
+    observer.finish();
+    Ok(SweepReport {
+        path,
+        rounds_measured: measured,
+        cases: results.cases.len(),
+        incomplete: results.cases.iter().filter(|c| !c.is_complete()).count(),
+    })
+}
+
+/// Takes the config's file of bodies into the results and keeps the sweep's own copy of it;
+/// the copy's path. A resumed sweep goes on from the same bodies, or not at all (unless
+/// `force`).
+fn adopt_initial(
+    results: &mut ResultsFile,
+    initial: Initial,
+    path: &Path,
+    force: bool,
+) -> Result<PathBuf, SweepError> {
+    if let Some(before) = results.metadata.initial.as_ref()
+        && before.fnv1a != initial.record.fnv1a
+        && !force
+    {
+        return Err(SweepError::Mismatch {
+            path: path.into(),
+            what: "file of bodies",
+            detail: format!(
+                "{} had fingerprint {}, now {}",
+                initial.record.path, before.fnv1a, initial.record.fnv1a
+            ),
+        });
+    }
+    let copy = keep_initial(path, &initial)?;
+    results.metadata.initial = Some(initial.record);
+    Ok(copy)
+}
+
+/// Adds the planned cases the results do not hold yet (a resumed file has the others), and
+/// warns about the cases that use more threads than the machine has logical CPUs.
+fn add_cases(config: &SweepConfig, results: &mut ResultsFile, observer: &mut dyn Observer) {
     let logical = nbody_engine::run::logical_cpus();
     let rounds = config.measure.rounds;
     for case in cases(config) {
@@ -230,127 +266,168 @@ pub fn run_sweep<C: Clock>(
             oversubscribed.len()
         ));
     }
-    let thread_counts: Vec<usize> = {
-        let mut t: Vec<usize> = results.cases.iter().map(|c| c.case.threads).collect();
-        t.sort_unstable();
-        t.dedup();
-        t
-    };
-    if options.calibrate && results.calibration.start.is_none() {
-        observer.message("calibrating the machine...");
-        let cal = calibrate(
-            config,
-            &context,
-            &path,
-            "start",
-            &thread_counts,
-            options.resume,
-            observer,
-        )?;
-        if let Some(cal) = &cal {
-            observer.message(&cal.summary());
-        }
-        results.calibration.start = cal;
-    }
-    if results.metadata.externals.is_empty() && !config.external.is_empty() {
-        results.metadata.externals = config
-            .external
-            .iter()
-            .map(|e| super::external::version_line(e, &context))
-            .collect();
-    }
-    results.save(&path)?;
+}
 
-    let total: usize = results.cases.len() * rounds;
-    let done: usize = results
-        .cases
-        .iter()
-        .map(|c| c.rounds_done.min(rounds))
-        .sum();
-    observer.start(total, done);
-    let started = clock.now();
-    let mut measured = 0;
-    let mut stopped = false;
-    'rounds: for round in 0..rounds {
-        // Alternate the direction of each round so no case always runs first or last.
-        let mut order: Vec<usize> = (0..results.cases.len()).collect();
-        if round % 2 == 1 {
-            order.reverse();
-        }
-        for i in order {
-            if results.cases[i].rounds_done > round {
-                continue;
-            }
-            let budget = config.measure.budget_s;
-            if budget > 0.0 && (clock.now() - started).as_secs_f64() >= budget {
-                observer.message(
-                    "time budget reached; run again with --resume to measure the remaining cases",
-                );
-                stopped = true;
-                break 'rounds;
-            }
-            if !observer.keep_going() {
-                stopped = true;
-                break 'rounds;
-            }
-            let record = &results.cases[i];
-            let spec = RoundSpec {
-                samples: samples_in_round(config.measure.samples, rounds, round),
-                warmup_s: config.measure.warmup_s,
-                min_sample_s: config.measure.min_sample_s,
-                // A round no job measured chose nothing.
-                steps_per_sample: (record.rounds_done > 0 && record.steps_per_sample > 0)
-                    .then_some(record.steps_per_sample),
-                force_error_sample: config.measure.force_error_sample,
-                reference_s: config.measure.reference_s,
-                #[cfg(feature = "test-slowdown")]
-                slowdown,
-            };
-            let outcome = match &config.scheduler {
-                Some(scheduler) => {
-                    let job = JobRound {
-                        scheduler,
-                        results: &path,
-                        config,
-                        context: &context,
-                        resume: options.resume,
-                    };
-                    job.measure(&record.case, round, &spec, observer)?
-                }
-                None => measure_case(&record.case, &spec, clock, config, &context).map_err(
-                    |source| SweepError::Case {
-                        key: record.key.clone(),
-                        source,
-                    },
-                )?,
-            };
-            report_external(&record.key, &outcome, observer);
-            let record = &mut results.cases[i];
-            record.add_round(outcome, config.measure.max_energy_drift);
-            results.save(&path)?;
-            measured += 1;
-            observer.round_done(&results.cases[i], round);
-        }
-    }
-    if options.calibrate && !stopped {
-        results.calibration.end = calibrate(
-            config,
-            &context,
-            &path,
-            "end",
-            &thread_counts,
-            options.resume,
+/// The cases' thread counts, each once and in increasing order: what the calibrations measure.
+fn thread_counts(results: &ResultsFile) -> Vec<usize> {
+    let mut t: Vec<usize> = results.cases.iter().map(|c| c.case.threads).collect();
+    t.sort_unstable();
+    t.dedup();
+    t
+}
+
+/// A sweep whose results file is open and locked: what its calibrations and rounds read.
+struct Sweep<'a, C: Clock> {
+    config: &'a SweepConfig,
+    options: &'a SweepOptions,
+    clock: &'a C,
+    /// The results file.
+    path: &'a Path,
+    context: &'a super::external::Context,
+    slowdown: Option<TestSlowdown>,
+}
+
+impl<C: Clock> Sweep<'_, C> {
+    /// [`calibrate`] for this sweep, at its start or end (`when`).
+    fn calibrate(
+        &self,
+        when: &str,
+        threads: &[usize],
+        observer: &mut dyn Observer,
+    ) -> Result<Option<nbody_calibrate::Calibration>, SweepError> {
+        calibrate(
+            self.config,
+            self.context,
+            self.path,
+            when,
+            threads,
+            self.options.resume,
             observer,
-        )?;
-        results.save(&path)?;
+        )
     }
-    observer.finish();
-    Ok(SweepReport {
-        path,
-        rounds_measured: measured,
-        cases: results.cases.len(),
-        incomplete: results.cases.iter().filter(|c| !c.is_complete()).count(),
-    })
+
+    /// Readies the results for the first round: the calibration at the start (unless the file
+    /// has one) and the external programs' versions, saved before anything is measured.
+    fn prepare(
+        &self,
+        results: &mut ResultsFile,
+        thread_counts: &[usize],
+        observer: &mut dyn Observer,
+    ) -> Result<(), SweepError> {
+        if self.options.calibrate && results.calibration.start.is_none() {
+            observer.message("calibrating the machine...");
+            let cal = self.calibrate("start", thread_counts, observer)?;
+            if let Some(cal) = &cal {
+                observer.message(&cal.summary());
+            }
+            results.calibration.start = cal;
+        }
+        if results.metadata.externals.is_empty() && !self.config.external.is_empty() {
+            results.metadata.externals = self
+                .config
+                .external
+                .iter()
+                .map(|e| super::external::version_line(e, self.context))
+                .collect();
+        }
+        results.save(self.path)?;
+        Ok(())
+    }
+
+    /// Measures the rounds not measured yet, case after case in interleaved rounds, saving the
+    /// results after each; the rounds measured, and whether the sweep stopped before the end
+    /// (its time budget reached, or the observer stopped it).
+    fn measure_rounds(
+        &self,
+        results: &mut ResultsFile,
+        observer: &mut dyn Observer,
+    ) -> Result<(usize, bool), SweepError> {
+        let rounds = self.config.measure.rounds;
+        let total: usize = results.cases.len() * rounds;
+        let done: usize = results
+            .cases
+            .iter()
+            .map(|c| c.rounds_done.min(rounds))
+            .sum();
+        observer.start(total, done);
+        let started = self.clock.now();
+        let mut measured = 0;
+        for round in 0..rounds {
+            // Alternate the direction of each round so no case always runs first or last.
+            let mut order: Vec<usize> = (0..results.cases.len()).collect();
+            if round % 2 == 1 {
+                order.reverse();
+            }
+            for i in order {
+                if results.cases[i].rounds_done > round {
+                    continue;
+                }
+                let budget = self.config.measure.budget_s;
+                if budget > 0.0 && (self.clock.now() - started).as_secs_f64() >= budget {
+                    observer.message(
+                        "time budget reached; run again with --resume to measure the remaining cases",
+                    );
+                    return Ok((measured, true));
+                }
+                if !observer.keep_going() {
+                    return Ok((measured, true));
+                }
+                let record = &results.cases[i];
+                let outcome = self.measure_round(record, round, observer)?;
+                report_external(&record.key, &outcome, observer);
+                let record = &mut results.cases[i];
+                record.add_round(outcome, self.config.measure.max_energy_drift);
+                results.save(self.path)?;
+                measured += 1;
+                observer.round_done(&results.cases[i], round);
+            }
+        }
+        Ok((measured, false))
+    }
+
+    /// Measures one round of a case: in this process, or as a batch job with a `[scheduler]`.
+    fn measure_round(
+        &self,
+        record: &CaseRecord,
+        round: usize,
+        observer: &mut dyn Observer,
+    ) -> Result<nbody_records::round::RoundOutcome, SweepError> {
+        let spec = self.round_spec(record, round);
+        match &self.config.scheduler {
+            Some(scheduler) => {
+                let job = JobRound {
+                    scheduler,
+                    results: self.path,
+                    config: self.config,
+                    context: self.context,
+                    resume: self.options.resume,
+                };
+                job.measure(&record.case, round, &spec, observer)
+            }
+            None => measure_case(&record.case, &spec, self.clock, self.config, self.context)
+                .map_err(|source| SweepError::Case {
+                    key: record.key.clone(),
+                    source,
+                }),
+        }
+    }
+
+    /// How a round of the case is measured: its share of the samples, and the steps per
+    /// sample the case's earlier rounds chose.
+    fn round_spec(&self, record: &CaseRecord, round: usize) -> RoundSpec {
+        let measure = &self.config.measure;
+        RoundSpec {
+            samples: samples_in_round(measure.samples, measure.rounds, round),
+            warmup_s: measure.warmup_s,
+            min_sample_s: measure.min_sample_s,
+            // A round no job measured chose nothing.
+            steps_per_sample: (record.rounds_done > 0 && record.steps_per_sample > 0)
+                .then_some(record.steps_per_sample),
+            force_error_sample: measure.force_error_sample,
+            reference_s: measure.reference_s,
+            slowdown: self.slowdown,
+        }
+    }
 }
 
 /// The share of `samples` taken in `round`: equal parts, the remainder in the first rounds.

@@ -4,12 +4,25 @@
 //! computation (the engine's `kernels::repeated`), so `naive:1.2` is a 20 % slower force
 //! computation.
 //!
-//! Not for measurements: it exists only in a build with the `test-slowdown` feature (CI's, for
-//! the gate's tests), where a sweep that applies it says so. When the variable is unset it costs
-//! nothing: it is read once per sweep, and no kernel is wrapped.
+//! Not for measurements: it is read only in a build with the `test-slowdown` feature (CI's, for
+//! the gate's tests), where a sweep that applies it says so; this module is the one place that
+//! feature is looked at in the harness. When the variable is unset it costs nothing: it is read
+//! once per sweep, and no kernel is wrapped.
 
-use nbody_engine::kernels::KernelKind;
+use nbody_engine::kernels::{KernelKind, KernelParams};
+use nbody_engine::run::RunError;
+use nbody_engine::scenario::{Setup, SetupError};
+use nbody_engine::stepper::Stepper;
 use std::fmt;
+
+/// Whether this build has the knob (the `test-slowdown` feature): without it the variable is
+/// never read and no kernel is slowed.
+pub const ENABLED: bool = cfg!(feature = "test-slowdown");
+
+/// Why a command that slows a kernel on purpose refuses in a build without the knob.
+pub const NOT_ENABLED: &str = "this slows a kernel on purpose and needs a build with the \
+    test-slowdown feature: cargo build --release --features test-slowdown (never measure \
+    anything else with that build)";
 
 /// The environment variable the knob is read from.
 pub(crate) const SLOWDOWN_ENV: &str = "NBODY_BENCH_TEST_SLOWDOWN";
@@ -31,8 +44,11 @@ impl fmt::Display for TestSlowdown {
 }
 
 impl TestSlowdown {
-    /// The knob from the environment: `None` when unset or empty.
+    /// The knob from the environment: `None` when unset or empty, and in a build without it.
     pub(crate) fn from_env() -> Result<Option<TestSlowdown>, String> {
+        if !ENABLED {
+            return Ok(None);
+        }
         match std::env::var(SLOWDOWN_ENV) {
             Ok(v) if !v.trim().is_empty() => Self::parse(&v).map(Some),
             _ => Ok(None),
@@ -70,6 +86,23 @@ impl TestSlowdown {
             1.0
         }
     }
+}
+
+/// The stepper of `kernel` on the system of `setup`, its force computations slowed when
+/// `knob` names it (the engine's `kernels::repeated`, compiled with the feature only).
+pub(crate) fn stepper(
+    knob: Option<TestSlowdown>,
+    setup: &Setup,
+    kernel: KernelKind,
+    params: &KernelParams,
+) -> Result<Result<Box<dyn Stepper>, RunError>, SetupError> {
+    #[cfg(feature = "test-slowdown")]
+    if let Some(knob) = knob {
+        let repeat = nbody_engine::kernels::repeated::Repeat(knob.factor_for(kernel));
+        return nbody_engine::stepper::decorated_stepper(setup, kernel, params, repeat);
+    }
+    let _ = knob;
+    nbody_engine::stepper::stepper(setup, kernel, params)
 }
 
 #[cfg(test)]

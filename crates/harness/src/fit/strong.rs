@@ -5,11 +5,13 @@
 //! fitted on relative residuals. Every interval comes from one bootstrap run, so the speedup
 //! intervals carry the noise of both T1 and T(p).
 
-use super::bootstrap::{bootstrap, estimate, percentile_ci};
+use super::bootstrap::{Replicates, bootstrap, estimate, percentile_ci};
 use super::karp_flatt::{self, KarpFlattPoint, KarpFlattTrend};
 use super::linear::{self, Goodness};
-use super::overhead::{self, OverheadSelection, OverheadTermFit};
-use super::{CiMethod, Estimate, FitError, Input, RESAMPLES, Samples, XRule, clamp_unit, prepare};
+use super::overhead::{self, OverheadCandidate, OverheadSelection, OverheadTerm, OverheadTermFit};
+use super::{
+    CiMethod, Data, Estimate, FitError, Input, RESAMPLES, Samples, XRule, clamp_unit, prepare,
+};
 use serde::Serialize;
 
 const MODEL: &str = "strong scaling";
@@ -103,95 +105,22 @@ pub fn fit_strong(
     seed: u64,
 ) -> Result<StrongFit, FitError> {
     let data = prepare(MODEL, samples, XRule::AtLeastOne, 2)?;
-    if data.xs[0] != 1.0 {
-        return Err(FitError::NoBaseline {
-            model: MODEL,
-            measured: list(&data.xs),
-        });
-    }
-    for &(p, ratio) in ceiling {
-        if !(p.is_finite() && p >= 1.0 && ratio.is_finite() && ratio > 0.0) {
-            return Err(FitError::BadCeiling {
-                model: MODEL,
-                p,
-                ratio,
-            });
-        }
-    }
+    check_inputs(&data.xs, ceiling)?;
     let ps = &data.xs;
-    let amdahl = |times: &[f64]| -> Option<(f64, f64)> {
-        let [a, b, _] = overhead::fit(None, ps, times)?;
-        (a + b > 0.0).then(|| (a + b, a / (a + b)))
-    };
-    let (t1, f_raw) = amdahl(&data.medians).ok_or(FitError::Degenerate {
+    let (t1, f_raw) = amdahl(ps, &data.medians).ok_or(FitError::Degenerate {
         model: MODEL,
         why: "Amdahl's law gives no positive T1",
     })?;
     let (candidates, kept) = overhead::select(ps, &data.medians);
     let kept_abc = overhead::fit(kept, ps, &data.medians).expect("selection fitted it");
-    let fitted: Vec<f64> = ps
-        .iter()
-        .map(|&p| overhead::time(kept, kept_abc, p))
-        .collect();
-    let above_one: Vec<f64> = ps[1..].to_vec();
-    let kf_of = |speedups: &[f64]| -> Vec<f64> {
-        (1..ps.len())
-            .map(|i| karp_flatt::karp_flatt(ps[i], speedups[i]))
-            .collect()
-    };
-    let speedups_of = |t: &[f64]| -> Vec<f64> { t.iter().map(|tp| t[0] / tp).collect() };
-
-    let params = if kept.is_some() { 3 } else { 2 };
-    let reps = bootstrap(MODEL, &data, &fitted, params, seed, |t| {
-        let (t1, f) = amdahl(t)?;
-        let speedups = speedups_of(t);
-        let kf_slope = karp_flatt::slope(&above_one, &kf_of(&speedups));
-        let overhead = match kept {
-            Some(term) => {
-                let [a, b, c] = overhead::fit(Some(term), ps, t)?;
-                // A replicate's serial fraction is a fraction: clamped like Amdahl's.
-                Some((c, clamp_unit(a / (a + b)).0))
-            }
-            None => None,
-        };
-        Some(Replicate {
-            speedups,
-            t1,
-            f,
-            kf_slope,
-            overhead,
-        })
-    })?;
+    let reps = bootstrap_replicates(&data, kept, kept_abc, seed)?;
     let fits = &reps.fits;
 
+    let above_one: Vec<f64> = ps[1..].to_vec();
     let speedups = speedups_of(&data.medians);
-    let points = (0..ps.len())
-        .map(|i| {
-            let p = ps[i];
-            let speedup = estimate(speedups[i], fits.iter().map(|r| r.speedups[i]));
-            let ceiling = ceiling.iter().find(|(cp, _)| *cp == p).map(|&(_, r)| r);
-            StrongPoint {
-                p,
-                median_s: data.medians[i],
-                samples: data.values[i].len(),
-                speedup,
-                efficiency: speedup.map(|s| s / p),
-                ceiling,
-                speedup_vs_ceiling: ceiling.map(|c| speedup.map(|s| s / c)),
-            }
-        })
-        .collect();
-    let kf_point = kf_of(&speedups);
-    let karp_flatt = (1..ps.len())
-        .map(|i| KarpFlattPoint {
-            p: ps[i],
-            e: estimate(
-                kf_point[i - 1],
-                fits.iter()
-                    .map(|r| karp_flatt::karp_flatt(ps[i], r.speedups[i])),
-            ),
-        })
-        .collect();
+    let points = strong_points(&data, &speedups, fits, ceiling);
+    let kf_point = karp_flatt_values(ps, &speedups);
+    let karp_flatt = karp_flatt_points(ps, &kf_point, fits);
     let karp_flatt_trend = karp_flatt::trend(
         karp_flatt::slope(&above_one, &kf_point),
         fits.iter().filter_map(|r| r.kf_slope),
@@ -205,20 +134,7 @@ pub fn fit_strong(
         .iter()
         .map(|p| t1 * (f_raw + (1.0 - f_raw) / p))
         .collect();
-    let overhead = OverheadSelection {
-        candidates,
-        kept: kept.map(|term| OverheadTermFit {
-            term,
-            coefficient: estimate(
-                kept_abc[2],
-                fits.iter().filter_map(|r| r.overhead.map(|o| o.0)),
-            ),
-            serial_fraction: estimate(
-                kept_abc[0] / (kept_abc[0] + kept_abc[1]),
-                fits.iter().filter_map(|r| r.overhead.map(|o| o.1)),
-            ),
-        }),
-    };
+    let overhead = overhead_selection(candidates, kept, kept_abc, fits);
     let notes = notes(ps, ceiling, &unclamped, clamped, &overhead);
     Ok(StrongFit {
         inputs: data.inputs(),
@@ -241,6 +157,148 @@ pub fn fit_strong(
         notes,
         replicates: fits.iter().map(|r| [r.t1, clamp_unit(r.f).0]).collect(),
     })
+}
+
+/// Refuses samples without a p = 1 baseline (the sorted `ps` start elsewhere) and ceiling
+/// entries that are not a finite p ≥ 1 with a finite positive ratio.
+fn check_inputs(ps: &[f64], ceiling: &[(f64, f64)]) -> Result<(), FitError> {
+    if ps[0] != 1.0 {
+        return Err(FitError::NoBaseline {
+            model: MODEL,
+            measured: list(ps),
+        });
+    }
+    for &(p, ratio) in ceiling {
+        if !(p.is_finite() && p >= 1.0 && ratio.is_finite() && ratio > 0.0) {
+            return Err(FitError::BadCeiling {
+                model: MODEL,
+                p,
+                ratio,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Amdahl's `(T1, f)` fitted to the times at `ps`; `None` when the fit fails or gives no
+/// positive T1.
+fn amdahl(ps: &[f64], times: &[f64]) -> Option<(f64, f64)> {
+    let [a, b, _] = overhead::fit(None, ps, times)?;
+    (a + b > 0.0).then(|| (a + b, a / (a + b)))
+}
+
+/// The speedups `T1 / T(p)` of times whose first entry is at p = 1.
+fn speedups_of(t: &[f64]) -> Vec<f64> {
+    t.iter().map(|tp| t[0] / tp).collect()
+}
+
+/// The Karp-Flatt serial fraction e(p) at every p > 1, from the speedups at every p.
+fn karp_flatt_values(ps: &[f64], speedups: &[f64]) -> Vec<f64> {
+    (1..ps.len())
+        .map(|i| karp_flatt::karp_flatt(ps[i], speedups[i]))
+        .collect()
+}
+
+/// Bootstraps Amdahl's law, the speedups, the Karp-Flatt slope and the kept overhead model
+/// (`kept_abc` its point fit, whose predictions drive residual resampling).
+fn bootstrap_replicates(
+    data: &Data,
+    kept: Option<OverheadTerm>,
+    kept_abc: [f64; 3],
+    seed: u64,
+) -> Result<Replicates<Replicate>, FitError> {
+    let ps = &data.xs;
+    let fitted: Vec<f64> = ps
+        .iter()
+        .map(|&p| overhead::time(kept, kept_abc, p))
+        .collect();
+    let above_one: Vec<f64> = ps[1..].to_vec();
+    let params = if kept.is_some() { 3 } else { 2 };
+    bootstrap(MODEL, data, &fitted, params, seed, |t| {
+        let (t1, f) = amdahl(ps, t)?;
+        let speedups = speedups_of(t);
+        let kf_slope = karp_flatt::slope(&above_one, &karp_flatt_values(ps, &speedups));
+        let overhead = match kept {
+            Some(term) => {
+                let [a, b, c] = overhead::fit(Some(term), ps, t)?;
+                // A replicate's serial fraction is a fraction: clamped like Amdahl's.
+                Some((c, clamp_unit(a / (a + b)).0))
+            }
+            None => None,
+        };
+        Some(Replicate {
+            speedups,
+            t1,
+            f,
+            kf_slope,
+            overhead,
+        })
+    })
+}
+
+/// Per measured p: the median time, the speedup and efficiency with their intervals from the
+/// replicates, and the hardware ceiling when given at that p.
+fn strong_points(
+    data: &Data,
+    speedups: &[f64],
+    fits: &[Replicate],
+    ceiling: &[(f64, f64)],
+) -> Vec<StrongPoint> {
+    let ps = &data.xs;
+    (0..ps.len())
+        .map(|i| {
+            let p = ps[i];
+            let speedup = estimate(speedups[i], fits.iter().map(|r| r.speedups[i]));
+            let ceiling = ceiling.iter().find(|(cp, _)| *cp == p).map(|&(_, r)| r);
+            StrongPoint {
+                p,
+                median_s: data.medians[i],
+                samples: data.values[i].len(),
+                speedup,
+                efficiency: speedup.map(|s| s / p),
+                ceiling,
+                speedup_vs_ceiling: ceiling.map(|c| speedup.map(|s| s / c)),
+            }
+        })
+        .collect()
+}
+
+/// e(p) at every p > 1 (`kf_point` from the medians) with its interval from the replicates.
+fn karp_flatt_points(ps: &[f64], kf_point: &[f64], fits: &[Replicate]) -> Vec<KarpFlattPoint> {
+    (1..ps.len())
+        .map(|i| KarpFlattPoint {
+            p: ps[i],
+            e: estimate(
+                kf_point[i - 1],
+                fits.iter()
+                    .map(|r| karp_flatt::karp_flatt(ps[i], r.speedups[i])),
+            ),
+        })
+        .collect()
+}
+
+/// The overhead candidates and the kept model's coefficient and serial fraction with their
+/// intervals from the replicates.
+fn overhead_selection(
+    candidates: Vec<OverheadCandidate>,
+    kept: Option<OverheadTerm>,
+    kept_abc: [f64; 3],
+    fits: &[Replicate],
+) -> OverheadSelection {
+    OverheadSelection {
+        candidates,
+        kept: kept.map(|term| OverheadTermFit {
+            term,
+            coefficient: estimate(
+                kept_abc[2],
+                fits.iter().filter_map(|r| r.overhead.map(|o| o.0)),
+            ),
+            serial_fraction: estimate(
+                kept_abc[0] / (kept_abc[0] + kept_abc[1]),
+                fits.iter().filter_map(|r| r.overhead.map(|o| o.1)),
+            ),
+        }),
+    }
 }
 
 fn list(xs: &[f64]) -> String {

@@ -47,10 +47,31 @@ fn draw_contents(
     root: &Area,
     plot: &mut Plot,
     chart: &Chart,
-    (x, y): (&ResolvedAxis, &ResolvedAxis),
+    axes: (&ResolvedAxis, &ResolvedAxis),
 ) -> Result<bool, String> {
-    let on_axes = |p: &&Point| x.contains(p.x) && y.contains(p.y);
-    let (xs, ys) = plot.plotting_area().get_pixel_range();
+    draw_regions(root, plot, chart, axes)?;
+    let mut drew = draw_bands(plot, chart, axes)?;
+    drew |= draw_lines(plot, chart, axes)?;
+    draw_error_bars(root, plot, chart, axes)?;
+    drew |= draw_markers(plot, chart, axes)?;
+    draw_point_labels(root, plot, chart, axes)?;
+    Ok(drew)
+}
+
+/// Whether a point lies on both axes (points off them are not drawn).
+fn on_axes(p: &Point, (x, y): (&ResolvedAxis, &ResolvedAxis)) -> bool {
+    x.contains(p.x) && y.contains(p.y)
+}
+
+/// Shades each region's span of x over the full height, its label at the top left when any
+/// of it fits the span.
+fn draw_regions(
+    root: &Area,
+    plot: &mut Plot,
+    chart: &Chart,
+    (x, y): (&ResolvedAxis, &ResolvedAxis),
+) -> DrawResult {
+    let (_, ys) = plot.plotting_area().get_pixel_range();
     let note = anchored(NOTE_SIZE, HPos::Left, VPos::Top).color(&MUTED_COLOR);
     for r in &chart.regions {
         let ends = (x.clamp(r.x_from.min(r.x_to)), x.clamp(r.x_from.max(r.x_to)));
@@ -73,7 +94,16 @@ fn draw_contents(
                 .map_err(err)?;
         }
     }
+    Ok(())
+}
 
+/// Fills each band between its low and high edges, one polygon per run of x on the axis;
+/// returns whether any was drawn.
+fn draw_bands(
+    plot: &mut Plot,
+    chart: &Chart,
+    (x, y): (&ResolvedAxis, &ResolvedAxis),
+) -> Result<bool, String> {
     let mut drew = false;
     for (i, band) in chart.bands.iter().enumerate() {
         let shade = series_color(i, band.color).mix(BAND_ALPHA).filled();
@@ -92,13 +122,28 @@ fn draw_contents(
             drew = true;
         }
     }
+    Ok(drew)
+}
+
+/// Draws the reference lines, then every series' line (all but marker-only series) through
+/// its runs of points on the axes; returns whether any series line was drawn.
+fn draw_lines(
+    plot: &mut Plot,
+    chart: &Chart,
+    axes: (&ResolvedAxis, &ResolvedAxis),
+) -> Result<bool, String> {
+    let (x, y) = axes;
     for h in chart.hlines.iter().filter(|h| y.contains(h.y)) {
         let color = rgb(palette::color(h.color.unwrap_or(REFERENCE_INDEX)));
         line(plot, vec![(x.lo, h.y), (x.hi, h.y)], color, h.dashed)?;
     }
+    let mut drew = false;
     for (i, s) in chart.series.iter().enumerate() {
         if s.style != SeriesStyle::Markers {
-            let points = s.points.iter().map(|p| on_axes(&p).then_some((p.x, p.y)));
+            let points = s
+                .points
+                .iter()
+                .map(|p| on_axes(p, axes).then_some((p.x, p.y)));
             for run in runs(points) {
                 line(
                     plot,
@@ -110,6 +155,16 @@ fn draw_contents(
             }
         }
     }
+    Ok(drew)
+}
+
+/// Draws every point's vertical error bar with caps, cut at the y axis' ends.
+fn draw_error_bars(
+    root: &Area,
+    plot: &mut Plot,
+    chart: &Chart,
+    (x, y): (&ResolvedAxis, &ResolvedAxis),
+) -> DrawResult {
     for (i, s) in chart.series.iter().enumerate() {
         // 2 px: a 1 px line on whole-pixel coordinates is smeared over two pixels at half strength.
         let style = series_color(i, s.color).stroke_width(2);
@@ -133,11 +188,22 @@ fn draw_contents(
             root.draw(&PathElement::new(bar, style)).map_err(err)?;
         }
     }
+    Ok(())
+}
+
+/// Draws the markers of the series that have them at their points on the axes; returns
+/// whether any was drawn.
+fn draw_markers(
+    plot: &mut Plot,
+    chart: &Chart,
+    axes: (&ResolvedAxis, &ResolvedAxis),
+) -> Result<bool, String> {
+    let mut drew = false;
     for (i, s) in chart.series.iter().enumerate() {
         if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
             let color = series_color(i, s.color);
             let marker = palette::marker(s.color.unwrap_or(i));
-            let shown: Vec<&Point> = s.points.iter().filter(on_axes).collect();
+            let shown: Vec<&Point> = s.points.iter().filter(|p| on_axes(p, axes)).collect();
             let markers = shown.iter().map(|p| {
                 let hollow = p.hollow;
                 Glyph(
@@ -153,11 +219,22 @@ fn draw_contents(
             drew |= !shown.is_empty();
         }
     }
+    Ok(drew)
+}
 
-    // Point labels go above right of the marker, or above left where they would leave the plot.
+/// Writes each labelled point's label above right of its marker, or above left where it would
+/// leave the plot.
+fn draw_point_labels(
+    root: &Area,
+    plot: &mut Plot,
+    chart: &Chart,
+    axes: (&ResolvedAxis, &ResolvedAxis),
+) -> DrawResult {
+    let (xs, _) = plot.plotting_area().get_pixel_range();
     let right = anchored(NOTE_SIZE, HPos::Left, VPos::Bottom);
     let left = anchored(NOTE_SIZE, HPos::Right, VPos::Bottom);
-    for p in chart.series.iter().flat_map(|s| &s.points).filter(on_axes) {
+    let points = chart.series.iter().flat_map(|s| &s.points);
+    for p in points.filter(|p| on_axes(p, axes)) {
         let Some(label) = &p.label else { continue };
         let (px, py) = plot.backend_coord(&(p.x, p.y));
         let fits = px + 7 + page::width(root, label, &right) as i32 <= xs.end;
@@ -168,7 +245,7 @@ fn draw_contents(
         };
         root.draw_text(label, style, (at, py - 5)).map_err(err)?;
     }
-    Ok(drew)
+    Ok(())
 }
 
 /// A solid or dashed line through `points`.

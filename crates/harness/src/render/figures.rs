@@ -4,7 +4,7 @@
 //! its caption.
 
 use crate::analysis::groups::{Point, workers_noun};
-use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis};
+use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis, ThetaAnalysis, WeakAnalysis};
 use crate::plot::figures::{
     self as fig, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
@@ -98,16 +98,28 @@ fn time_of(p: &Point) -> (f64, [f64; 2]) {
     (p.median_s, p.ci95_s)
 }
 
+/// Every figure of the analysis, in drawing order: cost vs n, strong scaling, weak scaling,
+/// phases and percentiles per scenario, then octree accuracy.
 fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
     let cap = caption(a);
     let mut out = Vec::new();
-    // Cost vs n: one figure per scenario, precision and parallelism.
+    out.extend(cost_figures(a, &cap));
+    out.extend(strong_figures(a, &cap));
+    out.extend(weak_figures(a, &cap));
+    out.extend(scenario_figures(a, &cap));
+    out.extend(octree_accuracy_figure(a, &cap));
+    out
+}
+
+/// Cost vs n: one figure per scenario, precision and parallelism.
+fn cost_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
+    let mut out = Vec::new();
     for same in a.cost_groups() {
         let k = &same[0].series;
         let (scenario, precision) = (k.scenario.name(), k.precision.name());
         let (threads, ranks) = (k.threads.unwrap_or(1), k.ranks.unwrap_or(1));
         let series: Vec<KernelSeries> = same.iter().map(|c| time_series(c)).collect();
-        let mut chart = fig::time_per_step(&series, &cap);
+        let mut chart = fig::time_per_step(&series, cap);
         chart.title = format!(
             "{scenario} ({precision}, {threads} thread{}): time per step vs n",
             if threads == 1 { "" } else { "s" }
@@ -117,107 +129,129 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
             Drawing::Chart(chart),
         ));
     }
-    // Strong scaling: one set per scenario, n and precision.
+    out
+}
+
+/// Strong scaling: speedup, efficiency and (when fitted) Karp-Flatt, one set per scenario, n
+/// and precision.
+fn strong_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
+    let mut out = Vec::new();
     for same in a.strong_groups() {
         let k = &same[0].series;
         let (scenario, n) = (k.scenario.name(), k.n.unwrap_or(0));
         let stem = format!("{scenario}-n{n}-{}", k.precision.name());
         let title = format!("{scenario} n={n}");
-        let ceiling: Vec<(f64, f64)> = same
-            .iter()
-            .flat_map(|s| {
-                s.measured
-                    .iter()
-                    .filter_map(|p| p.ceiling.map(|c| (p.p, c)))
-            })
-            .fold(Vec::new(), |mut acc, pc| {
-                if !acc.iter().any(|a: &(f64, f64)| a.0 == pc.0) {
-                    acc.push(pc);
-                }
-                acc
-            });
+        let ceiling = hardware_ceiling(&same);
         let speed: Vec<KernelSeries> = same.iter().map(|s| speedup_series(s)).collect();
         let workers = workers_noun(
             same.iter()
                 .flat_map(|s| &s.points)
                 .map(|c| (c.threads, c.ranks)),
         );
-        let mut chart = fig::speedup(&speed, &ceiling, workers, &cap);
+        let mut chart = fig::speedup(&speed, &ceiling, workers, cap);
         chart.title = format!("{title}: speedup vs {workers}");
         out.push((format!("speedup-{stem}"), Drawing::Chart(chart)));
-        let eff: Vec<KernelSeries> = same
-            .iter()
-            .map(|s| {
-                let m: Vec<Measured> = s
-                    .measured
-                    .iter()
-                    .map(|p| {
-                        Measured::with_ci(
-                            p.p,
-                            p.efficiency.estimate,
-                            p.efficiency.ci95[0],
-                            p.efficiency.ci95[1],
-                        )
-                        .oversubscribed(oversubscribed_at(&s.points, p.p))
-                    })
-                    .collect();
-                KernelSeries::new(s.label.clone(), m)
-            })
-            .collect();
-        let mut chart = fig::efficiency(&eff, workers, &cap);
+        let eff: Vec<KernelSeries> = same.iter().map(|s| efficiency_series(s)).collect();
+        let mut chart = fig::efficiency(&eff, workers, cap);
         chart.title = format!("{title}: parallel efficiency");
         out.push((format!("efficiency-{stem}"), Drawing::Chart(chart)));
-        let kf: Vec<KernelSeries> = same
-            .iter()
-            .filter_map(|s| {
-                let f = s.fit.fit.as_ref()?;
-                let m = f
-                    .karp_flatt
-                    .iter()
-                    .map(|k| {
-                        Measured::with_ci(k.p, k.e.estimate, k.e.ci95[0], k.e.ci95[1])
-                            .oversubscribed(oversubscribed_at(&s.points, k.p))
-                    })
-                    .collect();
-                Some(KernelSeries::new(
-                    format!("{} ({})", s.label, f.karp_flatt_trend.verdict.name()),
-                    m,
-                ))
-            })
-            .collect();
+        let kf: Vec<KernelSeries> = same.iter().filter_map(|s| karp_flatt_series(s)).collect();
         if kf.iter().any(|k| !k.measured.is_empty()) {
-            let mut chart = fig::karp_flatt(&kf, workers, &cap);
+            let mut chart = fig::karp_flatt(&kf, workers, cap);
             chart.title = format!("{title}: Karp-Flatt serial fraction e(p)");
             out.push((format!("karp-flatt-{stem}"), Drawing::Chart(chart)));
         }
     }
-    // Weak scaling: one figure per scenario.
+    out
+}
+
+/// The hardware ceiling of a strong-scaling group: one (p, ceiling) per worker count, the
+/// first series that has one at that p giving it.
+fn hardware_ceiling(same: &[&StrongAnalysis]) -> Vec<(f64, f64)> {
+    same.iter()
+        .flat_map(|s| {
+            s.measured
+                .iter()
+                .filter_map(|p| p.ceiling.map(|c| (p.p, c)))
+        })
+        .fold(Vec::new(), |mut acc, pc| {
+            if !acc.iter().any(|a: &(f64, f64)| a.0 == pc.0) {
+                acc.push(pc);
+            }
+            acc
+        })
+}
+
+/// A strong-scaling series' measured parallel efficiency vs p.
+fn efficiency_series(s: &StrongAnalysis) -> KernelSeries {
+    let m: Vec<Measured> = s
+        .measured
+        .iter()
+        .map(|p| {
+            Measured::with_ci(
+                p.p,
+                p.efficiency.estimate,
+                p.efficiency.ci95[0],
+                p.efficiency.ci95[1],
+            )
+            .oversubscribed(oversubscribed_at(&s.points, p.p))
+        })
+        .collect();
+    KernelSeries::new(s.label.clone(), m)
+}
+
+/// A strong-scaling series' Karp-Flatt serial fraction vs p, labelled with its trend's
+/// verdict; `None` when the series has no fit.
+fn karp_flatt_series(s: &StrongAnalysis) -> Option<KernelSeries> {
+    let f = s.fit.fit.as_ref()?;
+    let m = f
+        .karp_flatt
+        .iter()
+        .map(|k| {
+            Measured::with_ci(k.p, k.e.estimate, k.e.ci95[0], k.e.ci95[1])
+                .oversubscribed(oversubscribed_at(&s.points, k.p))
+        })
+        .collect();
+    Some(KernelSeries::new(
+        format!("{} ({})", s.label, f.karp_flatt_trend.verdict.name()),
+        m,
+    ))
+}
+
+/// Weak scaling: one efficiency figure per scenario.
+fn weak_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
+    let mut out = Vec::new();
     for same in a.weak_groups() {
         let scenario = same[0].series.scenario.name();
-        let series: Vec<KernelSeries> = same
-            .iter()
-            .map(|o| {
-                let m: Vec<Measured> = o
-                    .measured
-                    .iter()
-                    .map(|e| {
-                        Measured::with_ci(e.p, e.e.estimate, e.e.ci95[0], e.e.ci95[1])
-                            .oversubscribed(oversubscribed_at(&o.points, e.p))
-                    })
-                    .collect();
-                KernelSeries::new(o.label.clone(), m)
-            })
-            .collect();
+        let series: Vec<KernelSeries> = same.iter().map(|o| weak_series(o)).collect();
         let workers = workers_noun(
             same.iter()
                 .flat_map(|o| &o.points)
                 .map(|c| (c.threads, c.ranks)),
         );
-        let mut chart = fig::weak_efficiency(&series, workers, &cap);
+        let mut chart = fig::weak_efficiency(&series, workers, cap);
         chart.title = format!("{scenario}: weak-scaling efficiency T(1)/T(p)");
         out.push((format!("weak-efficiency-{scenario}"), Drawing::Chart(chart)));
     }
-    // Phase breakdown and step-time percentiles per scenario, at each case's largest n.
+    out
+}
+
+/// A weak-scaling series' measured efficiency T(1)/T(p) vs p.
+fn weak_series(o: &WeakAnalysis) -> KernelSeries {
+    let m: Vec<Measured> = o
+        .measured
+        .iter()
+        .map(|e| {
+            Measured::with_ci(e.p, e.e.estimate, e.e.ci95[0], e.e.ci95[1])
+                .oversubscribed(oversubscribed_at(&o.points, e.p))
+        })
+        .collect();
+    KernelSeries::new(o.label.clone(), m)
+}
+
+/// Phase breakdown and step-time percentiles per scenario, at each case's largest n.
+fn scenario_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
+    let mut out = Vec::new();
     for scenario in a.scenarios() {
         let cases = a.representative_cases(scenario);
         let scen = scenario.name();
@@ -231,63 +265,59 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
                 phases: phase_list(c),
             })
             .collect();
-        let mut bars = fig::phase_breakdown(&phases, &cap);
+        let mut bars = fig::phase_breakdown(&phases, cap);
         bars.title = format!("{scen}: time per step by phase");
         out.push((format!("phases-{}", slug(scen)), Drawing::Bars(bars)));
-        // A code timed per run (an external program) has no step times: it is left out and
-        // named under the figure, never drawn at zero.
-        let (timed, untimed): (Vec<&&Point>, Vec<&&Point>) =
-            cases.iter().partition(|c| c.step_ns.is_some());
-        let rows: Vec<Percentiles> = timed
-            .iter()
-            .filter_map(|c| {
-                let s = c.step_ns.as_ref()?;
-                Some(Percentiles {
-                    kernel: case_label(c),
-                    p50: s.p50 as f64 * 1e-9,
-                    p90: s.p90 as f64 * 1e-9,
-                    p99: s.p99 as f64 * 1e-9,
-                    max: s.max as f64 * 1e-9,
-                })
-            })
-            .collect();
-        if rows.is_empty() {
-            continue;
+        if let Some(chart) = percentiles_chart(&cases, scen, cap) {
+            out.push((format!("percentiles-{}", slug(scen)), Drawing::Chart(chart)));
         }
-        let mut note = cap.clone();
-        if !untimed.is_empty() {
-            let mut programs: Vec<&str> = untimed.iter().map(|c| c.case.kernel.name()).collect();
-            programs.dedup();
-            note = format!(
-                "not drawn: {} (timed per run, not per step)\n{cap}",
-                programs.join(", ")
-            );
-        }
-        let mut chart = fig::step_percentiles(&rows, &note);
-        chart.title = format!("{scen}: step-time percentiles at each case's largest n");
-        out.push((format!("percentiles-{}", slug(scen)), Drawing::Chart(chart)));
     }
-    // Octree accuracy vs cost.
+    out
+}
+
+/// The step-time percentiles of a scenario's cases; `None` when no case has step times.
+/// A code timed per run (an external program) has no step times: it is left out and named
+/// under the figure, never drawn at zero.
+fn percentiles_chart(cases: &[&Point], scen: &str, cap: &str) -> Option<Chart> {
+    let (timed, untimed): (Vec<&&Point>, Vec<&&Point>) =
+        cases.iter().partition(|c| c.step_ns.is_some());
+    let rows: Vec<Percentiles> = timed
+        .iter()
+        .filter_map(|c| {
+            let s = c.step_ns.as_ref()?;
+            Some(Percentiles {
+                kernel: case_label(c),
+                p50: s.p50 as f64 * 1e-9,
+                p90: s.p90 as f64 * 1e-9,
+                p99: s.p99 as f64 * 1e-9,
+                max: s.max as f64 * 1e-9,
+            })
+        })
+        .collect();
+    if rows.is_empty() {
+        return None;
+    }
+    let mut note = cap.to_string();
+    if !untimed.is_empty() {
+        let mut programs: Vec<&str> = untimed.iter().map(|c| c.case.kernel.name()).collect();
+        programs.dedup();
+        note = format!(
+            "not drawn: {} (timed per run, not per step)\n{cap}",
+            programs.join(", ")
+        );
+    }
+    let mut chart = fig::step_percentiles(&rows, &note);
+    chart.title = format!("{scen}: step-time percentiles at each case's largest n");
+    Some(chart)
+}
+
+/// Octree accuracy vs cost: one figure of every θ sweep with points, if any.
+fn octree_accuracy_figure(a: &Analysis, cap: &str) -> Option<(String, Drawing)> {
     let sweeps: Vec<ThetaSweep> = a
         .theta
         .iter()
         .map(|t| ThetaSweep {
-            // One series per code and expansion order.
-            name: {
-                let mut name = format!("{} ", t.series.kernel.name());
-                name.push_str(&format!(
-                    "{} n={}",
-                    t.series.scenario.name(),
-                    t.series.n.unwrap_or(0)
-                ));
-                if t.series.multipole != Multipole::Monopole {
-                    name.push_str(&format!(" {}", t.series.multipole.name()));
-                }
-                if let Some(p) = t.series.order {
-                    name.push_str(&format!(" order {p}"));
-                }
-                name
-            },
+            name: theta_sweep_name(t),
             points: t
                 .points
                 .iter()
@@ -302,13 +332,31 @@ fn figures(a: &Analysis) -> Vec<(String, Drawing)> {
         })
         .filter(|s| !s.points.is_empty())
         .collect();
-    if !sweeps.is_empty() {
-        out.push((
-            "octree-accuracy".into(),
-            Drawing::Chart(fig::octree_accuracy(&sweeps, &cap)),
-        ));
+    if sweeps.is_empty() {
+        return None;
     }
-    out
+    Some((
+        "octree-accuracy".into(),
+        Drawing::Chart(fig::octree_accuracy(&sweeps, cap)),
+    ))
+}
+
+/// An accuracy series' name, one series per code and expansion order:
+/// "octree galaxy n=20000 quadrupole", "fmm galaxy n=20000 order 4".
+fn theta_sweep_name(t: &ThetaAnalysis) -> String {
+    let mut name = format!("{} ", t.series.kernel.name());
+    name.push_str(&format!(
+        "{} n={}",
+        t.series.scenario.name(),
+        t.series.n.unwrap_or(0)
+    ));
+    if t.series.multipole != Multipole::Monopole {
+        name.push_str(&format!(" {}", t.series.multipole.name()));
+    }
+    if let Some(p) = t.series.order {
+        name.push_str(&format!(" order {p}"));
+    }
+    name
 }
 
 /// What a point of an accuracy series was run at: "θ=0.5", or for a member of an external

@@ -6,6 +6,7 @@
 pub mod figures;
 pub mod runs;
 pub mod summary;
+pub mod sweep_tables;
 pub mod tables;
 
 use crate::analysis::Analysis;

@@ -80,6 +80,34 @@ impl Table {
     }
 }
 
+impl Table {
+    /// The header and the rows as aligned text for a terminal: each column as wide as its
+    /// widest cell (in characters), right-aligned columns padded on the left, one space between
+    /// columns, no trailing spaces.
+    pub fn text(&self) -> String {
+        let mut widths = vec![0; self.header.len()];
+        for r in std::iter::once(&self.header).chain(&self.rows) {
+            for (w, c) in widths.iter_mut().zip(r) {
+                *w = (*w).max(c.chars().count());
+            }
+        }
+        let mut out = String::new();
+        for r in std::iter::once(&self.header).chain(&self.rows) {
+            let mut line = String::new();
+            for ((c, w), a) in r.iter().zip(&widths).zip(&self.align) {
+                let pad = " ".repeat(w - c.chars().count());
+                match a {
+                    Align::Default => line += &format!("{c}{pad} "),
+                    Align::Right => line += &format!("{pad}{c} "),
+                }
+            }
+            out += line.trim_end();
+            out.push('\n');
+        }
+        out
+    }
+}
+
 /// One line of cells: `| a | b |`, an empty cell as `| |`.
 fn line(cells: &[String]) -> String {
     let mut md = String::new();
@@ -527,6 +555,16 @@ mod tests {
         assert_eq!(
             t.markdown(),
             "| case | time |\n|---|---:|\n| `a` | 1.000 ms |\n| `b` | – |\n"
+        );
+    }
+
+    #[test]
+    fn as_text_each_column_is_as_wide_as_its_widest_cell() {
+        let mut t = Table::new(["case", "time"]).aligned([Align::Default, Align::Right]);
+        t.row(["lj-box/naive", "1.000 ms"]).row(["a", "–"]);
+        assert_eq!(
+            t.text(),
+            "case             time\nlj-box/naive 1.000 ms\na                   –\n"
         );
     }
 

@@ -75,6 +75,9 @@ pub struct Generated {
     pub sweeps: usize,
     pub figures: usize,
     pub figure_errors: Vec<String>,
+    /// Figures written by hand in a kept region, by region: each belongs in a generated
+    /// section (a number in a kept region goes stale when the results change).
+    pub kept_figures: Vec<(String, Vec<String>)>,
 }
 
 /// The results files under `dir`: `dir/<name>/results.json`, sorted by name.
@@ -154,6 +157,7 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
         sweeps: sweeps.len(),
         figures: sweeps.iter().map(|s| s.figures.len()).sum(),
         figure_errors,
+        kept_figures: keep::figures(&kept),
     })
 }
 

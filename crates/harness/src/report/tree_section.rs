@@ -4,7 +4,7 @@
 //! the centrally concentrated cloud.
 
 use super::keep::region;
-use crate::analysis::tree_comm::{TREE_DECOMPS, TreeComm};
+use crate::analysis::tree_comm::{TREE_DECOMPS, Transport, TreeComm};
 use crate::render::tables::{self, Table};
 use crate::units::{Bytes, Duration, WithCi};
 use std::fmt::Write;
@@ -32,6 +32,18 @@ pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
          (octants keeps the octants of the root cube, the bisection balances).\n",
         t.n_per_rank, t.theta, t.leaf_size
     );
+    md.push_str(&counted_table(t).markdown());
+    md.push('\n');
+    for tr in &t.transports {
+        transport(md, tr);
+    }
+    md.push_str(&region("distributed-tree", no_notes));
+}
+
+/// Counted bytes per step per rank count: allgather, octants (mean and max, with the body
+/// imbalance) and tree, and tree's share of allgather's bytes. A rank count missing one of the
+/// decompositions is left out.
+fn counted_table(t: &TreeComm) -> Table {
     let mut table = Table::new([
         "ranks",
         "n",
@@ -62,79 +74,87 @@ pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
             },
         ]);
     }
-    md.push_str(&table.markdown());
+    table
+}
+
+/// One transport: its α-β fit and the table of predicted against measured communication, or
+/// why the fit failed (then no table).
+fn transport(md: &mut String, tr: &Transport) {
+    let _ = write!(
+        md,
+        "**{}**, α-β from the ping-pong of `{}`",
+        tr.name, tr.bench
+    );
+    match &tr.alpha_beta.fit {
+        Some(f) => {
+            let _ = writeln!(
+                md,
+                ": α = {:.3} [{:.3}, {:.3}] µs, β = {:.4} [{:.4}, {:.4}] ns/byte. Predicted \
+                 transfer per step (latencies × α + counted bytes × β, 95% band of the fit) next \
+                 to the sweep `{}` run on the same transport: per step, the mean over ranks of \
+                 the bytes sent, of the time inside MPI, and of its transfer part (that time \
+                 less the estimated wait for slower ranks, which the model does not predict); \
+                 error = measured transfer ÷ predicted − 1. * = oversubscribed: every time \
+                 then includes waiting for a CPU.\n",
+                f.alpha.estimate * 1e6,
+                f.alpha.ci95[0] * 1e6,
+                f.alpha.ci95[1] * 1e6,
+                f.beta.estimate * 1e9,
+                f.beta.ci95[0] * 1e9,
+                f.beta.ci95[1] * 1e9,
+                tr.sweep.as_deref().unwrap_or("(none)")
+            );
+        }
+        None => {
+            let _ = writeln!(
+                md,
+                ": the fit failed ({}).\n",
+                tr.alpha_beta.error.as_deref().unwrap_or("")
+            );
+            return;
+        }
+    }
+    md.push_str(&transport_table(tr).markdown());
     md.push('\n');
-    for tr in &t.transports {
-        let _ = write!(
-            md,
-            "**{}**, α-β from the ping-pong of `{}`",
-            tr.name, tr.bench
-        );
-        match &tr.alpha_beta.fit {
-            Some(f) => {
-                let _ = writeln!(
-                    md,
-                    ": α = {:.3} [{:.3}, {:.3}] µs, β = {:.4} [{:.4}, {:.4}] ns/byte. Predicted \
-                     transfer per step (latencies × α + counted bytes × β, 95% band of the fit) next \
-                     to the sweep `{}` run on the same transport: per step, the mean over ranks of \
-                     the bytes sent, of the time inside MPI, and of its transfer part (that time \
-                     less the estimated wait for slower ranks, which the model does not predict); \
-                     error = measured transfer ÷ predicted − 1. * = oversubscribed: every time \
-                     then includes waiting for a CPU.\n",
-                    f.alpha.estimate * 1e6,
-                    f.alpha.ci95[0] * 1e6,
-                    f.alpha.ci95[1] * 1e6,
-                    f.beta.estimate * 1e9,
-                    f.beta.ci95[0] * 1e9,
-                    f.beta.ci95[1] * 1e9,
-                    tr.sweep.as_deref().unwrap_or("(none)")
-                );
-            }
-            None => {
-                let _ = writeln!(
-                    md,
-                    ": the fit failed ({}).\n",
-                    tr.alpha_beta.error.as_deref().unwrap_or("")
-                );
+}
+
+/// Per decomposition and rank count above one: counted and measured bytes, predicted and
+/// measured time, the error and the compute imbalance. Unmeasured rank counts above 8 are
+/// left out except 128, to keep the table short.
+fn transport_table(tr: &Transport) -> Table {
+    let mut table = Table::new([
+        "decomposition",
+        "ranks",
+        "bytes counted",
+        "bytes measured",
+        "predicted transfer/step",
+        "measured in MPI/step",
+        "of it transfer",
+        "error",
+        "compute imbalance",
+    ]);
+    for d in TREE_DECOMPS {
+        for r in tr.rows.iter().filter(|r| r.decomp == d && r.ranks > 1) {
+            let measured = r.measured_s.is_some();
+            if !measured && r.ranks > 8 && r.ranks != 128 {
                 continue;
             }
+            table.row([
+                d.name().to_string(),
+                format!("{}{}", r.ranks, tables::over(r.oversubscribed)),
+                Bytes(r.predicted_bytes).to_string(),
+                r.measured_bytes
+                    .map_or("–".into(), |b| Bytes(b).to_string()),
+                WithCi::new(r.predicted_s, r.predicted_ci95, Duration).to_string(),
+                r.measured_s.map_or("–".into(), |s| Duration(s).to_string()),
+                r.measured_transfer_s
+                    .map_or("–".into(), |s| Duration(s).to_string()),
+                r.error()
+                    .map_or("–".into(), |e| format!("{:+.0}%", 100.0 * e)),
+                r.compute_imbalance
+                    .map_or("–".into(), |i| format!("{i:.3}")),
+            ]);
         }
-        let mut table = Table::new([
-            "decomposition",
-            "ranks",
-            "bytes counted",
-            "bytes measured",
-            "predicted transfer/step",
-            "measured in MPI/step",
-            "of it transfer",
-            "error",
-            "compute imbalance",
-        ]);
-        for d in TREE_DECOMPS {
-            for r in tr.rows.iter().filter(|r| r.decomp == d && r.ranks > 1) {
-                let measured = r.measured_s.is_some();
-                if !measured && r.ranks > 8 && r.ranks != 128 {
-                    continue;
-                }
-                table.row([
-                    d.name().to_string(),
-                    format!("{}{}", r.ranks, tables::over(r.oversubscribed)),
-                    Bytes(r.predicted_bytes).to_string(),
-                    r.measured_bytes
-                        .map_or("–".into(), |b| Bytes(b).to_string()),
-                    WithCi::new(r.predicted_s, r.predicted_ci95, Duration).to_string(),
-                    r.measured_s.map_or("–".into(), |s| Duration(s).to_string()),
-                    r.measured_transfer_s
-                        .map_or("–".into(), |s| Duration(s).to_string()),
-                    r.error()
-                        .map_or("–".into(), |e| format!("{:+.0}%", 100.0 * e)),
-                    r.compute_imbalance
-                        .map_or("–".into(), |i| format!("{i:.3}")),
-                ]);
-            }
-        }
-        md.push_str(&table.markdown());
-        md.push('\n');
     }
-    md.push_str(&region("distributed-tree", no_notes));
+    table
 }

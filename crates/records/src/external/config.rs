@@ -330,6 +330,13 @@ fn number_regex(re: &str, example: &str) -> Result<(), String> {
     }
 }
 
+/// The placeholders a case's commands and environment may use: the case's and the sweep's.
+fn case_placeholders() -> Vec<&'static str> {
+    let mut case_known: Vec<&str> = CASE_PLACEHOLDERS.to_vec();
+    case_known.extend(SWEEP_PLACEHOLDERS);
+    case_known
+}
+
 impl<'de> Deserialize<'de> for TimeSource {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
         #[derive(Deserialize)]
@@ -362,8 +369,22 @@ impl External {
 
     /// Checks everything that can be checked before a run; `(key, problem)` on failure.
     pub fn validate(&self) -> Result<(), (String, String)> {
-        let key = |k: &str| format!("external.{}.{k}", self.name);
-        let bad = |k: &str, p: String| Err((key(k), p));
+        self.validate_name()?;
+        self.validate_commands()?;
+        self.validate_env()?;
+        self.validate_run()?;
+        self.validate_regexes()?;
+        self.validate_family()?;
+        self.validate_case_lists()
+    }
+
+    /// The failure for this entry's key `k` (`external.<name>.<k>`).
+    fn invalid(&self, k: &str, problem: String) -> Result<(), (String, String)> {
+        Err((format!("external.{}.{k}", self.name), problem))
+    }
+
+    /// The name names the cases: a plain name, and not a built-in kernel's.
+    fn validate_name(&self) -> Result<(), (String, String)> {
         if !plain_name(&self.name) {
             return Err((
                 "external.name".into(),
@@ -385,8 +406,12 @@ impl External {
                 ),
             ));
         }
-        let mut case_known: Vec<&str> = CASE_PLACEHOLDERS.to_vec();
-        case_known.extend(SWEEP_PLACEHOLDERS);
+        Ok(())
+    }
+
+    /// The commands: a program name first, no NUL byte, only the placeholders each one gets.
+    fn validate_commands(&self) -> Result<(), (String, String)> {
+        let case_known = case_placeholders();
         for (field, tokens, known) in [
             ("command", &self.command, &case_known[..]),
             ("setup", &self.setup, &case_known[..]),
@@ -394,18 +419,18 @@ impl External {
             ("version", &self.version, &SWEEP_PLACEHOLDERS[..]),
         ] {
             if field == "command" && tokens.is_empty() {
-                return bad(
+                return self.invalid(
                     field,
                     "must name a program: [\"program\", \"arg\", ...]".into(),
                 );
             }
             if tokens.first().is_some_and(|p| p.trim().is_empty()) {
-                return bad(field, "starts with an empty program name".into());
+                return self.invalid(field, "starts with an empty program name".into());
             }
             for (i, t) in tokens.iter().enumerate() {
                 // No argument of a program can hold a NUL byte: refused here, not at every run.
                 if t.contains('\0') {
-                    return bad(
+                    return self.invalid(
                         field,
                         format!(
                             "has a NUL byte in its token {} (`{}`)",
@@ -415,33 +440,44 @@ impl External {
                     );
                 }
                 if let Err(e) = placeholders::check(t, known) {
-                    return bad(field, e.to_string());
+                    return self.invalid(field, e.to_string());
                 }
             }
         }
+        Ok(())
+    }
+
+    /// The environment: valid variable names, values without NUL bytes or unknown placeholders.
+    fn validate_env(&self) -> Result<(), (String, String)> {
+        let case_known = case_placeholders();
         for (name, value) in &self.env {
             if name.is_empty() || name.contains('=') || name.contains('\0') {
-                return bad("env", format!("has an invalid variable name `{name}`"));
+                return self.invalid("env", format!("has an invalid variable name `{name}`"));
             }
             if value.contains('\0') {
-                return bad(
+                return self.invalid(
                     &format!("env.{name}"),
                     "has a NUL byte, which no environment value can hold".into(),
                 );
             }
             if let Err(e) = placeholders::check(value, &case_known) {
-                return bad(&format!("env.{name}"), e.to_string());
+                return self.invalid(&format!("env.{name}"), e.to_string());
             }
         }
+        Ok(())
+    }
+
+    /// What one run is given: its steps, its particle counts and its timeout.
+    fn validate_run(&self) -> Result<(), (String, String)> {
         match self.steps {
             Steps::Fixed(s) if s == 0 || s > MAX_STEPS => {
-                return bad(
+                return self.invalid(
                     "steps",
                     format!("must be at least 1 (and at most {MAX_STEPS})"),
                 );
             }
             Steps::Scaled(r) if !(r.work.is_finite() && r.work >= 1.0) => {
-                return bad(
+                return self.invalid(
                     "steps.work",
                     format!(
                         "is {}: it must be a finite cost of one run, at least 1",
@@ -454,7 +490,7 @@ impl External {
         if let Some(n) = &self.n
             && (n.is_empty() || n.contains(&0))
         {
-            return bad(
+            return self.invalid(
                 "n",
                 "must be a non-empty list of particle counts >= 1".into(),
             );
@@ -463,7 +499,7 @@ impl External {
             && self.timeout_s > 0.0
             && self.timeout_s <= super::MAX_TIMEOUT_S)
         {
-            return bad(
+            return self.invalid(
                 "timeout_s",
                 format!(
                     "is {}: it must be a number of seconds > 0 and at most {} (7 days)",
@@ -472,32 +508,40 @@ impl External {
                 ),
             );
         }
+        Ok(())
+    }
+
+    /// The regular expressions that read the output: valid, with the groups each one needs.
+    fn validate_regexes(&self) -> Result<(), (String, String)> {
         if let TimeSource::Regex(t) = &self.time
             && let Err(e) = number_regex(&t.regex, "Loop time of ([0-9.eE+-]+)")
         {
-            return bad("time.regex", e);
+            return self.invalid("time.regex", e);
         }
         for (name, phase) in &self.phases {
             if !plain_name(name) {
-                return bad(
+                return self.invalid(
                     "phases",
                     format!("has a phase named `{name}`: use letters, digits, '-', '_' and '.'"),
                 );
             }
             if let Err(e) = number_regex(&phase.regex, "phase comm ([0-9.eE+-]+)") {
-                return bad(&format!("phases.{name}.regex"), e);
+                return self.invalid(&format!("phases.{name}.regex"), e);
             }
         }
         if let Some(c) = &self.check
             && let Err(e) = regex::Regex::new(c)
         {
-            return bad("check", format!("is not a regular expression: {e}"));
+            return self.invalid("check", format!("is not a regular expression: {e}"));
         }
         if let Some(f) = &self.force_error {
             match regex::Regex::new(f) {
-                Err(e) => return bad("force_error", format!("is not a regular expression: {e}")),
+                Err(e) => {
+                    return self
+                        .invalid("force_error", format!("is not a regular expression: {e}"));
+                }
                 Ok(r) if !(2..=3).contains(&r.captures_len()) => {
-                    return bad(
+                    return self.invalid(
                         "force_error",
                         "needs one group (the median error) or two (median and largest)".into(),
                     );
@@ -505,40 +549,51 @@ impl External {
                 Ok(_) => {}
             }
         }
-        if let Some(f) = &self.family {
-            if !plain_name(f) {
-                return bad(
-                    "family",
-                    format!("is `{f}`: it must be letters, digits, '-', '_' and '.'"),
-                );
-            }
-            // A family names a series in tables and figures beside the built-in kernels' own.
-            if nbody_engine::kernels::KernelKind::ALL
-                .iter()
-                .any(|k| k.name() == f)
-            {
-                return bad(
-                    "family",
-                    format!(
-                        "is `{f}`, a built-in kernel's name: its series would read as that \
-                         kernel's; choose another"
-                    ),
-                );
-            }
-            if self.force_error.is_none() {
-                return bad(
-                    "family",
-                    "joins entries by their force error against cost: give `force_error` too"
-                        .into(),
-                );
-            }
+        Ok(())
+    }
+
+    /// The family, if any: a plain name, not a built-in kernel's, and with a force error to
+    /// join its entries by.
+    fn validate_family(&self) -> Result<(), (String, String)> {
+        let Some(f) = &self.family else {
+            return Ok(());
+        };
+        if !plain_name(f) {
+            return self.invalid(
+                "family",
+                format!("is `{f}`: it must be letters, digits, '-', '_' and '.'"),
+            );
         }
+        // A family names a series in tables and figures beside the built-in kernels' own.
+        if nbody_engine::kernels::KernelKind::ALL
+            .iter()
+            .any(|k| k.name() == f)
+        {
+            return self.invalid(
+                "family",
+                format!(
+                    "is `{f}`, a built-in kernel's name: its series would read as that \
+                     kernel's; choose another"
+                ),
+            );
+        }
+        if self.force_error.is_none() {
+            return self.invalid(
+                "family",
+                "joins entries by their force error against cost: give `force_error` too".into(),
+            );
+        }
+        Ok(())
+    }
+
+    /// The entry's own threads, ranks and scenarios, where given: non-empty lists of valid values.
+    fn validate_case_lists(&self) -> Result<(), (String, String)> {
         if let Some(t) = &self.threads
             && (t.is_empty()
                 || t.iter()
                     .any(|&t| t == 0 || t > nbody_engine::run::MAX_THREADS))
         {
-            return bad(
+            return self.invalid(
                 "threads",
                 format!(
                     "must be a non-empty list of thread counts from 1 to {}",
@@ -549,13 +604,13 @@ impl External {
         if let Some(r) = &self.ranks
             && (r.is_empty() || r.contains(&0))
         {
-            return bad(
+            return self.invalid(
                 "ranks",
                 "must be a non-empty list of rank counts >= 1".into(),
             );
         }
         if self.scenarios.as_ref().is_some_and(Vec::is_empty) {
-            return bad(
+            return self.invalid(
                 "scenarios",
                 "is empty; leave it out to use the config's".into(),
             );

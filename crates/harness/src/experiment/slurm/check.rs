@@ -69,19 +69,7 @@ fn plausible(
             round.n, case.n
         ));
     }
-    let kind = match &case.kernel {
-        KernelOrProgram::External(name) => Kind::External(
-            config
-                .external
-                .iter()
-                .find(|e| &e.name == name)
-                .ok_or_else(|| format!("the config has no [[external]] entry named `{name}`"))?,
-        ),
-        KernelOrProgram::Kernel(_) => match &config.mpi {
-            Some(launch) => Kind::Launched(launch),
-            None => Kind::InProcess,
-        },
-    };
+    let kind = kind_of(case, config)?;
     let samples = round.samples_s.len() as u128;
     let asked = spec.samples as u128;
     let exact = !matches!(kind, Kind::External(_));
@@ -98,7 +86,54 @@ fn plausible(
             "its {samples} samples of {k} steps are more than the {steps} steps it claims"
         ));
     }
-    let expected = match kind {
+    let expected = expected_steps(&kind, case, spec, k, samples, warmup)?;
+    if steps != expected.0 || expected.1.is_some_and(|w| w != warmup) {
+        return Err(format!(
+            "it claims {steps} steps after {warmup} warm-up steps where the round takes {}{}",
+            expected.0,
+            expected
+                .1
+                .map(|w| format!(" after {w}"))
+                .unwrap_or_default()
+        ));
+    }
+    if step_ns as u128 > steps {
+        return Err(format!(
+            "it times {step_ns} steps, more than the {steps} steps it claims"
+        ));
+    }
+    within_pair_bounds(case, round, steps, warmup)
+}
+
+/// How the config measures `case`: in process, under its MPI launcher, or as its external
+/// program (which must be one the config declares).
+fn kind_of<'a>(case: &Case, config: &'a SweepConfig) -> Result<Kind<'a>, String> {
+    Ok(match &case.kernel {
+        KernelOrProgram::External(name) => Kind::External(
+            config
+                .external
+                .iter()
+                .find(|e| &e.name == name)
+                .ok_or_else(|| format!("the config has no [[external]] entry named `{name}`"))?,
+        ),
+        KernelOrProgram::Kernel(_) => match &config.mpi {
+            Some(launch) => Kind::Launched(launch),
+            None => Kind::InProcess,
+        },
+    })
+}
+
+/// The timed steps and (if the kind fixes them) warm-up steps a round of `kind` takes, given
+/// its `k` steps per sample over `samples` samples; refuses step counts the kind cannot give.
+fn expected_steps(
+    kind: &Kind,
+    case: &Case,
+    spec: &RoundSpec,
+    k: u128,
+    samples: u128,
+    warmup: u128,
+) -> Result<(u128, Option<u128>), String> {
+    Ok(match kind {
         Kind::InProcess => {
             let chosen = spec.steps_per_sample.map(u128::from);
             if chosen.is_some_and(|c| c != k) || k > MAX_STEPS_PER_SAMPLE as u128 {
@@ -124,22 +159,17 @@ fn plausible(
             }
             (k * samples, Some(per_run * ext.warmup_runs as u128))
         }
-    };
-    if steps != expected.0 || expected.1.is_some_and(|w| w != warmup) {
-        return Err(format!(
-            "it claims {steps} steps after {warmup} warm-up steps where the round takes {}{}",
-            expected.0,
-            expected
-                .1
-                .map(|w| format!(" after {w}"))
-                .unwrap_or_default()
-        ));
-    }
-    if step_ns as u128 > steps {
-        return Err(format!(
-            "it times {step_ns} steps, more than the {steps} steps it claims"
-        ));
-    }
+    })
+}
+
+/// Checks the round's counts of pairs against the most its `steps + warmup` steps over the
+/// case's n particles can look at.
+fn within_pair_bounds(
+    case: &Case,
+    round: &RoundOutcome,
+    steps: u128,
+    warmup: u128,
+) -> Result<(), String> {
     // Pairs looked at: at most every ordered pair, in every image, in every step.
     let n = case.n as u128;
     let per_step = IMAGES.saturating_mul(n.saturating_mul(n));

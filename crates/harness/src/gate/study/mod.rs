@@ -14,12 +14,10 @@
 //! `results/gate-study/`, and docs/explanation/gate.md's table is generated from it.
 
 pub mod decide;
-#[cfg(feature = "test-slowdown")]
 mod measure;
 pub mod run;
 pub mod table;
 
-#[cfg(feature = "test-slowdown")]
 pub use measure::measure_blocks;
 
 use clap::ValueEnum;

@@ -5,10 +5,8 @@ use super::{Load, RawStudy, STUDY_SCHEMA, StudyFile, StudyRun};
 use crate::gate::baselines::{self, Fitness};
 use crate::gate::route::this_machine;
 use nbody_engine::kernels::KernelKind;
-#[cfg(feature = "test-slowdown")]
 use nbody_engine::output::provenance::utc_now;
 use nbody_records::config::SweepConfig;
-#[cfg(feature = "test-slowdown")]
 use nbody_records::kernel_or_program::KernelOrProgram;
 use nbody_records::results::Metadata;
 use nbody_records::results::ResultsFile;
@@ -71,8 +69,13 @@ pub fn resummarise(raw_path: &Path, baselines: &Path, out: &Path) -> anyhow::Res
 
 /// Measures and summarises; `say` hears the plan and every block. Only in a build with the
 /// `test-slowdown` feature: the study slows a kernel on purpose.
-#[cfg(feature = "test-slowdown")]
 pub fn run(options: &StudyOptions, say: &mut dyn FnMut(&str)) -> anyhow::Result<StudyPaths> {
+    if !crate::experiment::slowdown::ENABLED {
+        anyhow::bail!(
+            "gate-study: {}; --docs works in any build",
+            crate::experiment::slowdown::NOT_ENABLED
+        );
+    }
     let own = own_baseline(&options.baselines);
     let (config, baseline, baseline_name) = match (own, &options.config) {
         (_, Some((config, _))) => (config.clone(), None, None),

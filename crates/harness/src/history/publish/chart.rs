@@ -5,7 +5,7 @@
 //! tooltip), so the chart says everything without the page's script.
 
 use super::{Chart, esc, short};
-use crate::history::series::Metric;
+use crate::history::series::{Metric, Series};
 use crate::units::Duration;
 use std::fmt::Write;
 
@@ -68,29 +68,71 @@ fn ticks(lo: f64, hi: f64) -> (Vec<f64>, usize) {
     ((first..=last).map(|i| i as f64 * step).collect(), decimals)
 }
 
+/// Where a chart's values go: the value range of the y axis (in axis units) and the plot's
+/// size, with the commit count that spaces x.
+struct Frame {
+    /// Commits along x.
+    n: usize,
+    /// The y axis' ends, in axis units (padded around the intervals).
+    lo: f64,
+    hi: f64,
+    /// Seconds → axis units.
+    factor: f64,
+    /// The plot's width and height.
+    pw: f64,
+    ph: f64,
+}
+
+impl Frame {
+    /// The frame of a series whose highest interval end is `largest`: its intervals padded by
+    /// 8%, or ±5% around a single value.
+    fn of(s: &Series, largest: f64, sc: &Scale) -> Frame {
+        let mut lo = s
+            .points
+            .iter()
+            .map(|p| p.ci95[0])
+            .fold(f64::INFINITY, f64::min)
+            * sc.factor;
+        let mut hi = largest * sc.factor;
+        if !(lo.is_finite() && hi.is_finite() && hi > lo) {
+            // One point, or every interval one value: a range around it.
+            let mid = if hi.is_finite() { hi } else { 1.0 };
+            (lo, hi) = (mid * 0.95, mid * 1.05);
+        }
+        let pad = 0.08 * (hi - lo);
+        let (lo, hi) = (lo - pad, hi + pad);
+        Frame {
+            n: s.points.len(),
+            lo,
+            hi,
+            factor: sc.factor,
+            pw: WIDTH - LEFT - RIGHT,
+            ph: HEIGHT - TOP - BOTTOM,
+        }
+    }
+
+    /// The x of the i-th commit: the middle of its slot.
+    fn x(&self, i: usize) -> f64 {
+        LEFT + self.pw * (i as f64 + 0.5) / self.n.max(1) as f64
+    }
+
+    /// The y of a value in seconds (or a normalized ratio).
+    fn y(&self, v: f64) -> f64 {
+        self.y_axis(v * self.factor)
+    }
+
+    /// The y of a value already in axis units (a tick).
+    fn y_axis(&self, t: f64) -> f64 {
+        TOP + self.ph * (1.0 - (t - self.lo) / (self.hi - self.lo))
+    }
+}
+
 /// The SVG of `chart`.
 pub(super) fn svg(chart: &Chart) -> String {
     let s = &chart.series;
-    let n = s.points.len();
     let largest = s.points.iter().map(|p| p.ci95[1]).fold(0.0, f64::max);
     let sc = scale(s.metric, largest);
-    let mut lo = s
-        .points
-        .iter()
-        .map(|p| p.ci95[0])
-        .fold(f64::INFINITY, f64::min)
-        * sc.factor;
-    let mut hi = largest * sc.factor;
-    if !(lo.is_finite() && hi.is_finite() && hi > lo) {
-        // One point, or every interval one value: a range around it.
-        let mid = if hi.is_finite() { hi } else { 1.0 };
-        (lo, hi) = (mid * 0.95, mid * 1.05);
-    }
-    let pad = 0.08 * (hi - lo);
-    let (lo, hi) = (lo - pad, hi + pad);
-    let (pw, ph) = (WIDTH - LEFT - RIGHT, HEIGHT - TOP - BOTTOM);
-    let x = |i: usize| LEFT + pw * (i as f64 + 0.5) / n.max(1) as f64;
-    let y = |v: f64| TOP + ph * (1.0 - (v * sc.factor - lo) / (hi - lo));
+    let f = Frame::of(s, largest, &sc);
     let mut o = String::new();
     let _ = write!(
         o,
@@ -100,14 +142,28 @@ pub(super) fn svg(chart: &Chart) -> String {
         case = esc(&s.case),
         title = esc(&sc.title),
     );
-    // The plot's frame and the y axis: grid lines at the ticks.
+    value_axis(&mut o, &f, &sc.title);
+    commit_axis(&mut o, &f, s);
+    // The 95% band, the segments' levels, the medians.
+    interval_band(&mut o, &f, s);
+    segment_levels(&mut o, &f, chart);
+    median_line(&mut o, &f, s);
+    step_markers(&mut o, &f, chart);
+    legend(&mut o, HEIGHT - 8.0);
+    o.push_str("</svg>");
+    o
+}
+
+/// The plot's frame and the y axis: grid lines at the ticks and the axis title.
+fn value_axis(o: &mut String, f: &Frame, title: &str) {
+    let (pw, ph) = (f.pw, f.ph);
     let _ = write!(
         o,
         r#"<rect class="frame" x="{LEFT}" y="{TOP}" width="{pw}" height="{ph}"/>"#
     );
-    let (ticks, decimals) = ticks(lo, hi);
+    let (ticks, decimals) = ticks(f.lo, f.hi);
     for t in ticks {
-        let ty = TOP + ph * (1.0 - (t - lo) / (hi - lo));
+        let ty = f.y_axis(t);
         let _ = write!(
             o,
             r#"<line class="grid" x1="{LEFT}" x2="{x2:.1}" y1="{ty:.1}" y2="{ty:.1}"/><text class="tick" x="{tx:.1}" y="{ty:.1}" text-anchor="end" dominant-baseline="middle">{t:.decimals$}</text>"#,
@@ -118,10 +174,15 @@ pub(super) fn svg(chart: &Chart) -> String {
     let _ = write!(
         o,
         r#"<text class="axis" transform="translate(14 {cy:.1}) rotate(-90)" text-anchor="middle">{}</text>"#,
-        esc(&sc.title),
+        esc(title),
         cy = TOP + ph / 2.0
     );
-    // The commits along x.
+}
+
+/// The commits along x: short hashes (every k-th past [`MAX_LABELS`], and the last) and the
+/// axis title.
+fn commit_axis(o: &mut String, f: &Frame, s: &Series) {
+    let n = f.n;
     let every = n.div_ceil(MAX_LABELS).max(1);
     for (i, p) in s.points.iter().enumerate() {
         if i % every != 0 && i + 1 != n {
@@ -130,31 +191,39 @@ pub(super) fn svg(chart: &Chart) -> String {
         let _ = write!(
             o,
             r#"<text class="commit" transform="translate({:.1} {:.1}) rotate(-60)" text-anchor="end">{}</text>"#,
-            x(i) + 3.0,
-            TOP + ph + 8.0,
+            f.x(i) + 3.0,
+            TOP + f.ph + 8.0,
             esc(short(&p.commit))
         );
     }
     let _ = write!(
         o,
         r#"<text class="axis" x="{:.1}" y="{:.1}" text-anchor="middle">commit, oldest → newest</text>"#,
-        LEFT + pw / 2.0,
+        LEFT + f.pw / 2.0,
         HEIGHT - 24.0
     );
-    // The 95% band, the segments' levels, the medians.
-    if n > 0 {
+}
+
+/// The 95% band: along the upper ends, back along the lower ones (nothing without points).
+fn interval_band(o: &mut String, f: &Frame, s: &Series) {
+    if f.n > 0 {
         let mut band = String::from("M");
         for (i, p) in s.points.iter().enumerate() {
-            let _ = write!(band, "{:.1},{:.1} ", x(i), y(p.ci95[1]));
+            let _ = write!(band, "{:.1},{:.1} ", f.x(i), f.y(p.ci95[1]));
         }
         for (i, p) in s.points.iter().enumerate().rev() {
-            let _ = write!(band, "L{:.1},{:.1} ", x(i), y(p.ci95[0]));
+            let _ = write!(band, "L{:.1},{:.1} ", f.x(i), f.y(p.ci95[0]));
         }
         let _ = write!(o, r#"<path class="band" d="{}Z"/>"#, band.trim_end());
     }
+}
+
+/// Each segment's level between the steps: the level after the step that opens it, or for
+/// the first segment the level before the first step (none without steps).
+fn segment_levels(o: &mut String, f: &Frame, chart: &Chart) {
     let mut bounds = vec![0];
     bounds.extend(chart.steps.iter().map(|st| st.index));
-    bounds.push(n);
+    bounds.push(f.n);
     for (k, w) in bounds.windows(2).enumerate() {
         let level = match (
             k.checked_sub(1).map(|j| &chart.steps[j]),
@@ -167,16 +236,20 @@ pub(super) fn svg(chart: &Chart) -> String {
         let _ = write!(
             o,
             r#"<line class="level" x1="{:.1}" x2="{:.1}" y1="{ly:.1}" y2="{ly:.1}"/>"#,
-            x(w[0]) - 4.0,
-            x(w[1].saturating_sub(1)) + 4.0,
-            ly = y(level)
+            f.x(w[0]) - 4.0,
+            f.x(w[1].saturating_sub(1)) + 4.0,
+            ly = f.y(level)
         );
     }
+}
+
+/// The medians joined by a line, then a point per commit with its tooltip.
+fn median_line(o: &mut String, f: &Frame, s: &Series) {
     let line: Vec<String> = s
         .points
         .iter()
         .enumerate()
-        .map(|(i, p)| format!("{:.1},{:.1}", x(i), y(p.value)))
+        .map(|(i, p)| format!("{:.1},{:.1}", f.x(i), f.y(p.value)))
         .collect();
     let _ = write!(
         o,
@@ -196,23 +269,28 @@ pub(super) fn svg(chart: &Chart) -> String {
         let _ = write!(
             o,
             r#"<circle class="point" cx="{:.1}" cy="{:.1}" r="3.2" data-commit="{c}" data-date="{d}" data-value="{v}" data-ci="{ci}"><title>{c} ({d}): {v}, 95% interval {ci}</title></circle>"#,
-            x(i),
-            y(p.value),
+            f.x(i),
+            f.y(p.value),
             c = esc(short(&p.commit)),
             d = esc(date),
             v = esc(&v),
             ci = esc(&ci),
         );
     }
-    // The steps: a marker between their two commits, labels on alternating rows.
+}
+
+/// The steps: a marker between their two commits, labels on alternating rows (anchored
+/// inward near the plot's ends).
+fn step_markers(o: &mut String, f: &Frame, chart: &Chart) {
+    let metric = chart.series.metric;
     for (k, st) in chart.steps.iter().enumerate() {
-        let mx = (x(st.index - 1) + x(st.index)) / 2.0;
+        let mx = (f.x(st.index - 1) + f.x(st.index)) / 2.0;
         let between = format!("{}..{}", short(&st.between[0]), short(&st.between[1]));
         let size = percent(st.ratio);
         let ty = if k % 2 == 0 { TOP - 22.0 } else { TOP - 8.0 };
-        let anchor = if mx < LEFT + pw * 0.2 {
+        let anchor = if mx < LEFT + f.pw * 0.2 {
             "start"
-        } else if mx > LEFT + pw * 0.8 {
+        } else if mx > LEFT + f.pw * 0.8 {
             "end"
         } else {
             "middle"
@@ -224,16 +302,13 @@ pub(super) fn svg(chart: &Chart) -> String {
             b = esc(&between),
             ratio = st.ratio,
             y1 = ty + 3.0,
-            y2 = TOP + ph,
-            before = esc(&value(s.metric, st.before)),
-            after = esc(&value(s.metric, st.after)),
+            y2 = TOP + f.ph,
+            before = esc(&value(metric, st.before)),
+            after = esc(&value(metric, st.after)),
             lo = percent(st.ratio_ci95[0]),
             hi = percent(st.ratio_ci95[1]),
         );
     }
-    legend(&mut o, HEIGHT - 8.0);
-    o.push_str("</svg>");
-    o
 }
 
 /// The legend, one row along the bottom.

@@ -4,7 +4,7 @@
 
 use super::chart::{percent, value};
 use super::html::gate_commits;
-use super::{Chart, Page, short};
+use super::{Chart, ClassView, Page, short};
 use crate::gate::Verdict;
 use crate::history::steps::Step;
 use crate::render::tables::{Align, Table};
@@ -158,90 +158,102 @@ pub fn summary(page: &Page, base: &Base) -> String {
         if count == 0 {
             let _ = writeln!(o, "No change since `{}`.\n", base.name);
         } else {
-            let mut t = Table::new([
-                "case",
-                "between",
-                "level before → after",
-                "change",
-                "95% interval",
-            ])
-            .aligned([
-                Align::Default,
-                Align::Default,
-                Align::Default,
-                Align::Right,
-                Align::Right,
-            ]);
-            for (c, steps) in &mine {
-                let s = &c.series;
-                for st in steps {
-                    t.row([
-                        format!("`{}`", s.case.replace('|', "\\|")),
-                        format!("`{}..{}`", short(&st.between[0]), short(&st.between[1])),
-                        format!(
-                            "{} → {}",
-                            value(s.metric, st.before),
-                            value(s.metric, st.after)
-                        ),
-                        format!(
-                            "{} {}",
-                            percent(st.ratio),
-                            if st.ratio > 1.0 { "slower" } else { "faster" }
-                        ),
-                        format!(
-                            "[{}, {}]",
-                            percent(st.ratio_ci95[0]),
-                            percent(st.ratio_ci95[1])
-                        ),
-                    ]);
-                }
-            }
-            o.push_str(&t.markdown());
+            o.push_str(&steps_table(&mine).markdown());
             o.push('\n');
         }
-        let Some(g) = &class.latest_gate else {
-            o.push_str("No gate run recorded for this class.\n\n");
-            continue;
-        };
-        let count = |v: Verdict| g.cases.iter().filter(|c| c.verdict == v).count();
-        let _ = writeln!(
-            o,
-            "Latest gate run ({}, `{}`, threshold ±{}%): {} regressed, {} improved, {} unchanged{}.\n",
-            g.measured,
-            gate_commits(g),
-            100.0 * g.threshold,
-            count(Verdict::Regressed),
-            count(Verdict::Improved),
-            count(Verdict::Unchanged),
-            if g.missing.is_empty() {
-                String::new()
-            } else {
-                format!(", {} missing", g.missing.len())
-            }
-        );
-        let judged: Vec<_> = g
-            .cases
-            .iter()
-            .filter(|c| c.verdict != Verdict::Unchanged)
-            .collect();
-        if !judged.is_empty() {
-            let mut t = Table::new(["case", "verdict", "ratio", "95% interval"]).aligned([
-                Align::Default,
-                Align::Default,
-                Align::Right,
-                Align::Right,
-            ]);
-            for c in judged {
-                t.row([
-                    format!("`{}`", c.key.replace('|', "\\|")),
-                    c.verdict.name().to_string(),
-                    format!("{:.3}", c.ratio),
-                    format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),
-                ]);
-            }
-            o.push_str(&t.markdown());
-            o.push('\n');
-        }
+        latest_gate(&mut o, class);
     }
     o
+}
+
+/// One row per step found since the base in a class's charts: the case, the two commits, the
+/// levels either side, the change and its interval.
+fn steps_table(mine: &[&(&Chart, Vec<&Step>)]) -> Table {
+    let mut t = Table::new([
+        "case",
+        "between",
+        "level before → after",
+        "change",
+        "95% interval",
+    ])
+    .aligned([
+        Align::Default,
+        Align::Default,
+        Align::Default,
+        Align::Right,
+        Align::Right,
+    ]);
+    for (c, steps) in mine {
+        let s = &c.series;
+        for st in steps {
+            t.row([
+                format!("`{}`", s.case.replace('|', "\\|")),
+                format!("`{}..{}`", short(&st.between[0]), short(&st.between[1])),
+                format!(
+                    "{} → {}",
+                    value(s.metric, st.before),
+                    value(s.metric, st.after)
+                ),
+                format!(
+                    "{} {}",
+                    percent(st.ratio),
+                    if st.ratio > 1.0 { "slower" } else { "faster" }
+                ),
+                format!(
+                    "[{}, {}]",
+                    percent(st.ratio_ci95[0]),
+                    percent(st.ratio_ci95[1])
+                ),
+            ]);
+        }
+    }
+    t
+}
+
+/// A class's latest gate run: its counts of verdicts, then the cases it did not find
+/// unchanged; or that the class has none.
+fn latest_gate(o: &mut String, class: &ClassView) {
+    let Some(g) = &class.latest_gate else {
+        o.push_str("No gate run recorded for this class.\n\n");
+        return;
+    };
+    let count = |v: Verdict| g.cases.iter().filter(|c| c.verdict == v).count();
+    let _ = writeln!(
+        o,
+        "Latest gate run ({}, `{}`, threshold ±{}%): {} regressed, {} improved, {} unchanged{}.\n",
+        g.measured,
+        gate_commits(g),
+        100.0 * g.threshold,
+        count(Verdict::Regressed),
+        count(Verdict::Improved),
+        count(Verdict::Unchanged),
+        if g.missing.is_empty() {
+            String::new()
+        } else {
+            format!(", {} missing", g.missing.len())
+        }
+    );
+    let judged: Vec<_> = g
+        .cases
+        .iter()
+        .filter(|c| c.verdict != Verdict::Unchanged)
+        .collect();
+    if !judged.is_empty() {
+        let mut t = Table::new(["case", "verdict", "ratio", "95% interval"]).aligned([
+            Align::Default,
+            Align::Default,
+            Align::Right,
+            Align::Right,
+        ]);
+        for c in judged {
+            t.row([
+                format!("`{}`", c.key.replace('|', "\\|")),
+                c.verdict.name().to_string(),
+                format!("{:.3}", c.ratio),
+                format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),
+            ]);
+        }
+        o.push_str(&t.markdown());
+        o.push('\n');
+    }
 }
