@@ -90,7 +90,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         cost_series("cell-list", &large, |n| 1.4e-8 * n, 1.0),
         cost_series("octree", &large, |n| 9e-8 * n * n.log2() / 10.0, 1.08),
     ];
-    let mut rendered = vec![plot::render(
+    let mut rendered = vec![plot::draw(
         &figures::time_per_step(&cost, CAPTION),
         &dir,
         "time-per-step",
@@ -98,19 +98,19 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let kernels = scaling_kernels();
     let ceiling = [(1.0, 1.0), (2.0, 1.08)];
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::speedup(&kernels, &ceiling, "threads", CAPTION),
         &dir,
         "speedup",
     )?);
     let efficiency = ratio_series(&kernels, |p, s| s / p);
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::efficiency(&efficiency, "threads", CAPTION),
         &dir,
         "efficiency",
     )?);
     let weak = ratio_series(&kernels, |p, s| (s / p).powf(0.7));
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::weak_efficiency(&weak, "threads", CAPTION),
         &dir,
         "weak-efficiency",
@@ -123,7 +123,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 k
             })
             .collect();
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::karp_flatt(&karp, "threads", CAPTION),
         &dir,
         "karp-flatt",
@@ -176,12 +176,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             1.9e-3,
         ),
     ];
-    rendered.push(plot::render_stacked(
+    rendered.push(plot::draw_stacked(
         &figures::phase_breakdown(&phases, CAPTION),
         &dir,
         "phases",
     )?);
-    rendered.push(plot::render_stacked(
+    rendered.push(plot::draw_stacked(
         &figures::phase_shares(&phases, CAPTION),
         &dir,
         "phase-shares",
@@ -198,7 +198,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             )
         })
         .collect();
-    rendered.push(plot::render_stacked(
+    rendered.push(plot::draw_stacked(
         &figures::phase_breakdown(&many, CAPTION),
         &dir,
         "phases-many",
@@ -218,7 +218,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         pct("cell-list", 4.1e-5),
         pct("octree", 2.2e-4),
     ];
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::step_percentiles(&rows, CAPTION),
         &dir,
         "percentiles",
@@ -236,7 +236,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect(),
     };
     let sweeps = [sweep("galaxy n=100k", 1.0), sweep("coulomb n=100k", 1.7)];
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::octree_accuracy(&sweeps, CAPTION),
         &dir,
         "octree-accuracy",
@@ -257,7 +257,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .collect(),
         predicted: Curve::from_fn("model: α log₂ r + β r", &xs, model).with_band(band),
     };
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::comm_time(&comm, CAPTION),
         &dir,
         "comm",
@@ -273,7 +273,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         [(1000.0, 0.0), (2000.0, f64::NAN), (4000.0, 1e-3)],
         plot::SeriesStyle::LineMarkers,
     ));
-    rendered.push(plot::render(&edge.caption(CAPTION), &dir, "edge")?);
+    rendered.push(plot::draw(&edge.caption(CAPTION), &dir, "edge")?);
 
     let bytes = CommTimes {
         x: Axis::log("message size").unit(Unit::Bytes),
@@ -288,16 +288,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             |b| 2e-6 + b / 5e9,
         ),
     };
-    rendered.push(plot::render(
+    rendered.push(plot::draw(
         &figures::comm_time(&bytes, CAPTION),
         &dir,
         "comm-bytes",
     )?);
-    rendered.push(plot::render(
-        &figures::time_per_step(&[], ""),
-        &dir,
-        "empty",
-    )?);
+    rendered.push(plot::draw(&figures::time_per_step(&[], ""), &dir, "empty")?);
 
     for r in rendered {
         println!("{}  {}", r.svg.display(), r.png.display());

@@ -4,7 +4,7 @@
 
 use crate::cli::args::GateArgs;
 use nbody_harness::gate::drive::{self, Request};
-use nbody_harness::gate::render;
+use nbody_harness::gate::formatted;
 
 pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     if let Some(results) = &args.save_baseline {
@@ -33,7 +33,7 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
         fail_on_work_change: args.fail_on_work_change,
     };
     let outcome = drive::run(&request, &mut |line| eprintln!("gate: {line}"))?;
-    out!("{}", render(&outcome.report, args.format));
+    out!("{}", formatted(&outcome.report, args.format));
     if let Some(history) = &args.record {
         record(history, &outcome, args.current.as_deref())?;
     }

@@ -87,11 +87,7 @@ fn amdahl_recovers_a_serial_fraction_of_0_1() {
     let table = bin(&["fit", "--model", "amdahl", "--csv", csv.to_str().unwrap()]);
     let stdout = String::from_utf8_lossy(&table.stdout);
     assert!(table.status.success());
-    for want in [
-        "serial fraction f",
-        "max speedup 1/f",
-        "Karp-Flatt trend",
-    ] {
+    for want in ["serial fraction f", "max speedup 1/f", "Karp-Flatt trend"] {
         assert!(stdout.contains(want), "table lacks {want:?}:\n{stdout}");
     }
     // A row per thread count, the largest too.

@@ -4,7 +4,7 @@
 //! Everything is recomputed from the raw samples, with seeded bootstraps, so the same results
 //! file always gives the same analysis.
 
-pub mod comm;
+pub mod comm_model;
 pub mod groups;
 pub mod peers;
 pub mod tree_comm;

@@ -11,7 +11,7 @@
 //! (status, top-node sizes and nodes; migration, requests, answers); tree ⌈log2 p⌉ + 2(p − 1)
 //! (status; migration, essential trees).
 
-use super::comm::{PREDICTED_RANKS, fit_ping_pong, in_sweep_dir, predict};
+use super::comm_model::{PREDICTED_RANKS, fit_ping_pong, in_sweep_dir, predict};
 use super::groups::Point;
 use super::{Analysis, Fitted};
 use crate::fit::AlphaBetaFit;

@@ -11,11 +11,11 @@
 //! - [`strong`]: speedup, efficiency, Amdahl's serial fraction, Karp-Flatt and overhead terms;
 //! - [`weak`]: weak-scaling efficiency and Gustafson's serial fraction;
 //! - [`timed`]: the serial fraction from timed serial phases, compared with the fitted one;
-//! - [`comm`]: the α-β (latency-bandwidth) model of message time;
+//! - [`alpha_beta`]: the α-β (latency-bandwidth) model of message time;
 //! - [`csv`]: reading `(p or n, time)` tables written by other codes.
 
+pub mod alpha_beta;
 mod bootstrap;
-pub mod comm;
 pub mod csv;
 mod karp_flatt;
 mod linear;
@@ -27,8 +27,8 @@ mod synthetic;
 pub mod timed;
 pub mod weak;
 
+pub(crate) use alpha_beta::{AlphaBetaFit, fit_alpha_beta};
 pub use bootstrap::CiMethod;
-pub(crate) use comm::{AlphaBetaFit, fit_alpha_beta};
 use nbody_engine::stats::BOOTSTRAP_RESAMPLES as RESAMPLES;
 pub(crate) use power::crossover;
 pub use power::{ComplexityClass, PowerFit, fit_power};

@@ -150,7 +150,7 @@ fn measure_and_judge(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Re
     };
     match judged {
         Ok(report) => {
-            let json = super::render(&report, super::Format::Json);
+            let json = super::formatted(&report, super::Format::Json);
             nbody_engine::output::write_atomic(&out.join("gate.json"), json.as_bytes())?;
             Ok(Outcome {
                 report,

@@ -1,7 +1,7 @@
 //! The regression gate: two sweep results files in, a typed verdict per case out.
 //!
 //! [`compare`] is a pure function from a baseline and a current [`ResultsFile`] to a
-//! [`GateReport`]; [`render`] turns the report into text, Markdown (for a CI job summary) or
+//! [`GateReport`]; [`formatted`] turns the report into text, Markdown (for a CI job summary) or
 //! JSON. The rules:
 //!
 //! - cases are matched by their key; a baseline case the current run did not measure is
@@ -25,7 +25,7 @@ mod checks;
 mod compare;
 pub mod drive;
 pub mod family;
-mod render;
+mod format;
 pub mod route;
 pub mod save;
 pub mod study;
@@ -37,7 +37,7 @@ pub use checks::{
 };
 pub use compare::{check_threshold, compare, judge_pair};
 pub use family::Tails;
-pub use render::{Format, render};
+pub use format::{Format, formatted};
 
 use nbody_records::results::ResultsFile;
 use serde::Serialize;

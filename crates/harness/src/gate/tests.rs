@@ -294,7 +294,7 @@ fn missing_and_extra_cases_are_reported() {
     assert_eq!(report.extra, vec!["lj-box/naive/n=2000/p=1/r=1/seed=1"]);
     assert_eq!(report.cases.len(), 1);
     assert_eq!(report.exit_code(), 2);
-    let text = render(&report, Format::Text);
+    let text = formatted(&report, Format::Text);
     assert!(text.starts_with("gate INCOMPLETE: 1 cases"), "{text}");
     assert!(
         text.contains(&format!("missing: {}", removed.key)),
@@ -400,7 +400,7 @@ fn work_counters_are_compared_exactly() {
         ..GateOptions::default()
     };
     assert_eq!(compare(&base, &cur, &strict).unwrap().exit_code(), 1);
-    assert!(render(&report, Format::Markdown).contains("work changed: lj-box/cell-list"));
+    assert!(formatted(&report, Format::Markdown).contains("work changed: lj-box/cell-list"));
 }
 
 #[test]
@@ -436,7 +436,7 @@ fn renderings() {
         &GateOptions::default(),
     )
     .unwrap();
-    let text = render(&report, Format::Text);
+    let text = formatted(&report, Format::Text);
     assert!(
         text.starts_with(
             "gate FAIL: 3 cases: 1 regressed, 0 improved, 2 unchanged (threshold ±10%)"
@@ -444,14 +444,14 @@ fn renderings() {
         "{text}"
     );
     assert!(text.contains("REGRESSED"), "{text}");
-    let md = render(&report, Format::Markdown);
+    let md = formatted(&report, Format::Markdown);
     assert!(
         md.starts_with("### Performance gate: regression found"),
         "{md}"
     );
     assert!(md.contains("| case | baseline | current | ratio | 95% CI | raw ratio | verdict |"));
     assert!(md.contains("| **regressed** |"), "{md}");
-    let json: serde_json::Value = serde_json::from_str(&render(&report, Format::Json)).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&formatted(&report, Format::Json)).unwrap();
     assert_eq!(json["schema"], GATE_SCHEMA);
     assert_eq!(json["cases"][1]["verdict"], "regressed");
     assert_eq!(json["cases"][1]["normalization"], "reference");

@@ -9,7 +9,7 @@ use super::format;
 use super::legend::{Swatch, rgb};
 use super::page::{self, Area, NOTE_SIZE, Page, TICK_SIZE, anchored};
 use super::palette;
-use super::render::{DrawResult, err};
+use super::save::{DrawResult, err};
 use super::spec::{Axis, StackedBars};
 
 const BAR_HALF_HEIGHT: f64 = 0.36;

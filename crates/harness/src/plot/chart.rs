@@ -9,7 +9,7 @@ use super::axis::ResolvedAxis;
 use super::legend::{DASH, Glyph, LINE_WIDTH, Swatch, rgb};
 use super::page::{self, Area, MUTED_COLOR, NOTE_SIZE, Page, Plot, TICK_SIZE, anchored};
 use super::palette::{self, Marker, REFERENCE, REFERENCE_INDEX};
-use super::render::{DrawResult, err};
+use super::save::{DrawResult, err};
 use super::spec::{Chart, Point, Scale, SeriesStyle};
 
 const BAND_ALPHA: f64 = 0.18;

@@ -2,10 +2,10 @@
 //!
 //! [`Chart`] (x-y series, error bars, bands, reference lines, shaded regions) and
 //! [`StackedBars`] describe a figure with plain numbers and strings; [`figures`] builds the
-//! figures this project reports from per-kernel measurements. [`render`] and
-//! [`render_stacked`] draw them once, to SVG with plotters, and rasterize that SVG with resvg,
+//! figures this project reports from per-kernel measurements. [`draw`] and
+//! [`draw_stacked`] draw them once, to SVG with plotters, and rasterize that SVG with resvg,
 //! both with an embedded font, writing `stem.svg` and `stem.png` (1000×650) atomically.
-//! Without the `plot` cargo feature the types and constructors remain, and rendering returns
+//! Without the `plot` cargo feature the types and constructors remain, and drawing returns
 //! [`PlotError::Disabled`].
 
 #[cfg_attr(not(feature = "plot"), allow(dead_code))]
@@ -27,7 +27,7 @@ mod legend;
 #[cfg(feature = "plot")]
 mod page;
 #[cfg(feature = "plot")]
-mod render;
+mod save;
 #[cfg(all(test, feature = "plot"))]
 mod tests;
 mod text;
@@ -58,17 +58,17 @@ pub enum PlotError {
 
 /// Draws `chart` into `dir/stem.svg` and `dir/stem.png` (creating `dir`), replacing any earlier
 /// pair only once both are drawn.
-pub fn render(chart: &Chart, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
+pub fn draw(chart: &Chart, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
     #[cfg(feature = "plot")]
-    return render::render_figure(|root| chart::draw(root, chart), dir, stem);
+    return save::save_figure(|root| chart::draw(root, chart), dir, stem);
     #[cfg(not(feature = "plot"))]
     return disabled(&chart.title, dir, stem);
 }
 
-/// Draws `bars` into `dir/stem.svg` and `dir/stem.png`, like [`render`].
-pub fn render_stacked(bars: &StackedBars, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
+/// Draws `bars` into `dir/stem.svg` and `dir/stem.png`, like [`draw`].
+pub fn draw_stacked(bars: &StackedBars, dir: &Path, stem: &str) -> Result<Rendered, PlotError> {
     #[cfg(feature = "plot")]
-    return render::render_figure(|root| bars::draw(root, bars), dir, stem);
+    return save::save_figure(|root| bars::draw(root, bars), dir, stem);
     #[cfg(not(feature = "plot"))]
     return disabled(&bars.title, dir, stem);
 }
@@ -96,12 +96,12 @@ mod disabled_tests {
     fn rendering_without_the_feature_is_a_typed_error_and_writes_nothing() {
         let dir = tempfile::tempdir().unwrap();
         let chart = figures::time_per_step(&[], "");
-        let err = render(&chart, dir.path(), "fig").unwrap_err();
+        let err = draw(&chart, dir.path(), "fig").unwrap_err();
         assert!(matches!(err, PlotError::Disabled));
         assert!(err.to_string().contains("`plot` feature"));
         let bars = figures::phase_breakdown(&[], "");
         assert!(matches!(
-            render_stacked(&bars, dir.path(), "bars"),
+            draw_stacked(&bars, dir.path(), "bars"),
             Err(PlotError::Disabled)
         ));
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);

@@ -248,7 +248,7 @@ fn expected(chart: &Chart) -> (Vec<&str>, Vec<Drawn>) {
 }
 
 fn render_and_check(chart: &Chart, dir: &std::path::Path, stem: &str) {
-    let rendered = render(chart, dir, stem).unwrap_or_else(|e| panic!("{stem}: {e}"));
+    let rendered = draw(chart, dir, stem).unwrap_or_else(|e| panic!("{stem}: {e}"));
     let (texts, drawn) = expected(chart);
     check(&rendered, &texts, &drawn);
 }
@@ -293,7 +293,7 @@ fn a_missing_series_fails_the_check() {
     for dropped in 0..full.series.len() {
         let mut partial = full.clone();
         partial.series.remove(dropped);
-        let rendered = render(&partial, dir.path(), "partial").unwrap();
+        let rendered = draw(&partial, dir.path(), "partial").unwrap();
         let (texts, drawn) = expected(&full);
         let checked = std::panic::catch_unwind(|| check(&rendered, &texts, &drawn));
         assert!(checked.is_err(), "series {dropped} missing went unnoticed");
@@ -325,7 +325,7 @@ fn bar_figures_render_for_every_input() {
             ("phases", figures::phase_breakdown(cases, CAPTION)),
             ("shares", figures::phase_shares(cases, CAPTION)),
         ] {
-            let rendered = render_stacked(&bars, dir.path(), &format!("{name}-{i}")).unwrap();
+            let rendered = draw_stacked(&bars, dir.path(), &format!("{name}-{i}")).unwrap();
             let mut texts = vec![bars.title.as_str(), bars.caption.as_str()];
             texts.push(bars.value_label.as_str());
             let mut drawn = Vec::new();
@@ -454,7 +454,7 @@ fn a_hand_built_chart_with_every_element_renders() {
     };
     chart.regions.push(region);
     let dir = tempfile::tempdir().unwrap();
-    let rendered = render(&chart, dir.path(), "everything").unwrap();
+    let rendered = draw(&chart, dir.path(), "everything").unwrap();
     let texts = [
         "Everything & more <at once>",
         "caption line",
@@ -488,8 +488,8 @@ fn rendering_replaces_files_and_makes_the_directory() {
     let dir = tempfile::tempdir().unwrap();
     let nested = dir.path().join("figures/strong");
     let chart = figures::time_per_step(&kernel_cases().pop().unwrap().1, CAPTION);
-    let first = render(&chart, &nested, "fig").unwrap();
-    let second = render(&chart, &nested, "fig").unwrap();
+    let first = draw(&chart, &nested, "fig").unwrap();
+    let second = draw(&chart, &nested, "fig").unwrap();
     assert_eq!(first, second);
     let (texts, drawn) = expected(&chart);
     check(&second, &texts, &drawn);
@@ -501,12 +501,12 @@ fn bad_names_and_places_are_errors_that_write_nothing() {
     let dir = tempfile::tempdir().unwrap();
     let chart = figures::efficiency(&[], "threads", CAPTION);
     for stem in ["", "../escape", "a/b", ".hidden", "spaced name"] {
-        let err = render(&chart, dir.path(), stem).unwrap_err();
+        let err = draw(&chart, dir.path(), stem).unwrap_err();
         assert!(matches!(err, PlotError::BadName(_)), "{stem:?}: {err}");
     }
     let file = dir.path().join("not-a-dir");
     fs::write(&file, "x").unwrap();
-    let err = render(&chart, &file, "fig").unwrap_err();
+    let err = draw(&chart, &file, "fig").unwrap_err();
     assert!(err.to_string().contains("not-a-dir"), "{err}");
     assert_eq!(fs::read_dir(dir.path()).unwrap().count(), 1);
 }

@@ -1,9 +1,9 @@
 //! The presentation layer: an [`Analysis`] as Markdown tables ([`tables`]), how its external
-//! programs ran ([`runs`]), the per-sweep summary ([`summary`]), figures ([`figures`]) and the
+//! programs ran ([`runs`]), the per-sweep summary ([`summary`]), figures ([`analysis_figures`]) and the
 //! files of an analysis directory. Every table of `summary.md` and REPORT.md comes from [`tables`], so the two never disagree; every
 //! quantity is formatted by `crate::units`.
 
-pub mod figures;
+pub mod analysis_figures;
 pub mod runs;
 pub mod summary;
 pub mod sweep_tables;
@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 pub struct Written {
     pub fits: PathBuf,
     pub summary: PathBuf,
-    pub figures: Vec<figures::Figure>,
+    pub figures: Vec<analysis_figures::Figure>,
     /// Figures that could not be drawn (the fits and summary are written regardless).
     pub figure_errors: Vec<String>,
 }
@@ -35,7 +35,7 @@ pub fn write(analysis: &Analysis, dir: &Path) -> Result<Written, nbody_engine::o
             source: std::io::Error::other(e.to_string()),
         });
     }
-    let (figures, figure_errors) = figures::render_all(analysis, dir);
+    let (figures, figure_errors) = analysis_figures::render_all(analysis, dir);
     let text = serde_json::to_string_pretty(analysis).expect("analysis serializes");
     nbody_engine::output::write_atomic(&fits, text.as_bytes())?;
     let md = summary::markdown(analysis, &figures);

@@ -183,7 +183,7 @@ pub fn external_phases(a: &Analysis) -> String {
             c.case.scenario.name().to_string(),
             format!(
                 "{}{}",
-                crate::render::figures::case_label(c),
+                crate::render::analysis_figures::case_label(c),
                 tables::over(c.oversubscribed)
             ),
             Duration(mean).to_string(),

@@ -1,7 +1,7 @@
 //! The Markdown summary of one analysis (`summary.md`): the tables of [`super::tables`], the
 //! failed physics checks, then the figures.
 
-use super::figures::Figure;
+use super::analysis_figures::Figure;
 use super::tables;
 use crate::analysis::Analysis;
 use std::fmt::Write;
@@ -13,7 +13,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
         "# Analysis of sweep `{}` ({:?} study)\n",
         a.name, a.study
     );
-    let _ = writeln!(md, "{}\n", super::figures::caption(a));
+    let _ = writeln!(md, "{}\n", super::analysis_figures::caption(a));
     if let Some(c) = &a.calibration {
         let _ = writeln!(md, "Machine: {}\n", c.summary());
     }

@@ -3,10 +3,10 @@
 
 use super::Sweep;
 use super::keep::region;
-use crate::analysis::comm::{CommModel, Prediction};
+use crate::analysis::comm_model::{CommModel, Prediction};
 use crate::plot::figures::{self as fig, CommTimes, Curve, Measured};
 use crate::plot::{Axis, Unit};
-use crate::render::figures::Figure;
+use crate::render::analysis_figures::Figure;
 use crate::render::tables::{self, Table};
 use crate::units::{Duration, Plain, WithCi};
 use nbody_engine::decomp::Decomposition;
@@ -53,7 +53,7 @@ pub(crate) fn comm_figures(
     dir: &Path,
 ) -> (Vec<Figure>, Vec<String>) {
     let caption = weak_mpi
-        .map(|s| crate::render::figures::caption(&s.analysis))
+        .map(|s| crate::render::analysis_figures::caption(&s.analysis))
         .unwrap_or_else(|| model.source.clone());
     let mut figures = Vec::new();
     let mut errors = Vec::new();
@@ -75,7 +75,7 @@ pub(crate) fn comm_figures(
             decomp.name()
         );
         let stem = format!("comm-{}", decomp.name());
-        match crate::plot::render(&chart, dir, &stem) {
+        match crate::plot::draw(&chart, dir, &stem) {
             Ok(_) => figures.push(Figure {
                 stem,
                 title: chart.title.clone(),

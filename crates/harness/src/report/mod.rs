@@ -56,7 +56,7 @@ pub struct Sweep {
     pub analysis: Analysis,
     /// Directory of the figures relative to the report's directory, with `/` separators.
     pub(crate) figures_dir: String,
-    pub figures: Vec<crate::render::figures::Figure>,
+    pub figures: Vec<crate::render::analysis_figures::Figure>,
 }
 
 impl Sweep {
@@ -161,7 +161,7 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
     })
 }
 
-/// The communication model ([`analysis::comm::choose`]) and its figures, drawn next to the
+/// The communication model ([`analysis::comm_model::choose`]) and its figures, drawn next to the
 /// mpi-bench file it was fitted on.
 fn comm_model(
     benches: &[(PathBuf, MpiBenchFile)],
@@ -170,7 +170,7 @@ fn comm_model(
     figure_errors: &mut Vec<String>,
 ) -> Option<sections::Comm> {
     let analyses: Vec<&Analysis> = sweeps.iter().map(|s| &s.analysis).collect();
-    let chosen = analysis::comm::choose(benches, &analyses)?;
+    let chosen = analysis::comm_model::choose(benches, &analyses)?;
     let weak_mpi = chosen
         .weak_mpi
         .and_then(|a| sweeps.iter().find(|s| std::ptr::eq(&s.analysis, a)));

@@ -12,7 +12,7 @@
 //! particle stuck outside a wall), so every rank learns of an error in the same step without
 //! another collective.
 
-use super::comm::Comm;
+use super::communicator::Comm;
 use super::driver::{Driver, Tally};
 use super::error::MpiError;
 use crate::boundary::{Boundary, BoundaryError};

@@ -2,7 +2,7 @@
 //! (one-way time = half the round trip) and Allgatherv over all ranks, over message sizes
 //! 1 B, 4 B, … up to a maximum; every timed repetition is kept.
 
-use super::comm::Comm;
+use super::communicator::Comm;
 use super::error::MpiError;
 use crate::output::provenance::{git_state, utc_now};
 use crate::ranks::bench_file::{

@@ -1,7 +1,7 @@
 //! What the decompositions have in common: a rank's part of the simulation steps, and the loop
 //! that times its steps.
 
-use super::comm::{Comm, CommCounters};
+use super::communicator::{Comm, CommCounters};
 use super::error::MpiError;
 use crate::decomp::wire::pack_particle;
 use crate::kernels::WorkCounters;

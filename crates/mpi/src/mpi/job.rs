@@ -3,7 +3,7 @@
 //! `mpi-check`) integrates the same system serially to compare.
 
 use super::allgather::Allgather;
-use super::comm::{Comm, Lent};
+use super::communicator::{Comm, Lent};
 use super::domain::{Domain, DomainOptions};
 use super::driver::{Driver, Timeline, drive, pack_owned};
 use super::error::MpiError;

@@ -8,7 +8,7 @@
 
 mod allgather;
 mod bench;
-mod comm;
+mod communicator;
 mod domain;
 mod driver;
 mod error;
@@ -28,7 +28,7 @@ use crate::ranks::job::Job;
 use crate::scenario::Setup;
 use ::mpi::Threading;
 use ::mpi::environment::Universe;
-use comm::Comm;
+use communicator::Comm;
 
 /// The MPI environment of this process: initialized by [`Mpi::init`], finalized on drop.
 pub struct Mpi {

@@ -4,8 +4,8 @@
 //! all-gather of the results (one integer per rank) lets every rank stop together when any
 //! differs: rank 0 names the ranks that differ, and each of them says what it ran.
 
-use super::comm::Comm;
-use super::comm::CommCounters;
+use super::communicator::Comm;
+use super::communicator::CommCounters;
 use super::error::MpiError;
 use crate::ranks::job::{Job, JobDigest, Mismatch, build_identity};
 

@@ -6,16 +6,16 @@
 //! in the page depends on when or where it was made: the same files give the same bytes.
 
 mod chart;
-pub mod figures;
 mod html;
 pub mod markdown;
+pub mod report_figures;
 
 use super::changes::ChangeError;
 use super::series::{Series, series};
 use super::steps::{Step, steps};
 use super::store::{self, HistoryError, Record};
 use super::verdicts::{self, CaseVerdict, GateRun, Verdicts};
-use figures::Figure;
+use report_figures::Figure;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -252,7 +252,7 @@ pub fn page(loaded: &Loaded, figures: Vec<Figure>) -> Result<Page, PublishError>
 /// and what the test of the committed page compares it with.
 pub fn build(dir: &Path, report: &Path, out: &Path) -> Result<(Page, Vec<String>), PublishError> {
     let loaded = load(dir)?;
-    let page = page(&loaded, figures::figures(report, out))?;
+    let page = page(&loaded, report_figures::figures(report, out))?;
     Ok((page, loaded.warnings))
 }
 

@@ -1,6 +1,6 @@
 //! The figures this project reports, built from plain numbers. Each constructor returns a
 //! [`Chart`] or [`StackedBars`] with a default title that the caller may replace, ready for
-//! [`super::render`] or [`super::render_stacked`].
+//! [`super::draw`] or [`super::draw_stacked`].
 //!
 //! Measurements come in as [`KernelSeries`]: per kernel, (x, median, CI) triples as the
 //! analysis computes them, plus an optional fitted [`Curve`] sampled at a few x values.

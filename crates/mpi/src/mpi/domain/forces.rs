@@ -11,7 +11,7 @@
 use super::Domain;
 use crate::decomp::regions::point_box_distance2;
 use crate::decomp::wire::{bytes_of, push_source, unpack_sources};
-use crate::mpi::comm::Comm;
+use crate::mpi::communicator::Comm;
 use crate::mpi::driver::TAG_GHOSTS;
 use crate::mpi::error::MpiError;
 use crate::real::Real;

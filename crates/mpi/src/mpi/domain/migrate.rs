@@ -4,7 +4,7 @@
 use super::{BINS_PER_REGION, Domain};
 use crate::boundary::BoundaryError;
 use crate::decomp::wire::{bytes_of, pack_particle, unpack_particles};
-use crate::mpi::comm::Comm;
+use crate::mpi::communicator::Comm;
 use crate::mpi::driver::TAG_MIGRATE;
 use crate::mpi::error::MpiError;
 use crate::real::Real;

@@ -19,7 +19,7 @@
 mod forces;
 mod migrate;
 
-use super::comm::Comm;
+use super::communicator::Comm;
 use super::driver::{Driver, Tally};
 use super::error::MpiError;
 use crate::boundary::Boundary;

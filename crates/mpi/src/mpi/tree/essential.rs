@@ -25,7 +25,7 @@ use crate::decomp::essential::{open_at_walls, select};
 use crate::decomp::orb::{Orb, root_box};
 use crate::decomp::wire::{bytes_of, unpack_sources};
 use crate::kernels::{ForceKernel, KernelParams, Octree};
-use crate::mpi::comm::Comm;
+use crate::mpi::communicator::Comm;
 use crate::mpi::driver::{Driver, Tally};
 use crate::mpi::error::MpiError;
 use crate::physics::PairLaw;

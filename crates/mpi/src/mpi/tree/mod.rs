@@ -19,7 +19,7 @@ mod octants;
 pub(crate) use essential::EssentialTree;
 pub(crate) use octants::OctantTree;
 
-use super::comm::Comm;
+use super::communicator::Comm;
 use super::driver::Tally;
 use super::error::MpiError;
 use crate::boundary::{Boundary, BoundaryError};

@@ -19,7 +19,7 @@ use crate::decomp::top_nodes::{TopNodes, TopWalk, group_forces};
 use crate::decomp::wire::{bytes_of, floats_of};
 use crate::geometry::Bounds;
 use crate::kernels::{ForceKernel, ForceReport, KernelParams, WorkCounters};
-use crate::mpi::comm::Comm;
+use crate::mpi::communicator::Comm;
 use crate::mpi::driver::{Driver, Tally};
 use crate::mpi::error::MpiError;
 use crate::physics::PairLaw;

@@ -35,11 +35,11 @@ pub(crate) fn render_all(analysis: &Analysis, dir: &Path) -> (Vec<Figure>, Vec<S
         let (title, result) = match &drawing {
             Drawing::Chart(c) => (
                 c.title.clone(),
-                crate::plot::render(c, dir, &stem).map(|_| ()),
+                crate::plot::draw(c, dir, &stem).map(|_| ()),
             ),
             Drawing::Bars(b) => (
                 b.title.clone(),
-                crate::plot::render_stacked(b, dir, &stem).map(|_| ()),
+                crate::plot::draw_stacked(b, dir, &stem).map(|_| ()),
             ),
         };
         match result {

@@ -24,7 +24,7 @@ pub(crate) use super::text::DrawResult;
 pub use super::text::err;
 
 /// Draws a figure with `draw` into `dir/stem.svg` and `dir/stem.png`, creating `dir` if needed.
-pub(crate) fn render_figure(
+pub(crate) fn save_figure(
     draw: impl Fn(&Area) -> DrawResult,
     dir: &Path,
     stem: &str,

@@ -14,7 +14,7 @@ pub enum Format {
     Json,
 }
 
-pub fn render(report: &GateReport, format: Format) -> String {
+pub fn formatted(report: &GateReport, format: Format) -> String {
     match format {
         Format::Text => text(report),
         Format::Markdown => markdown(report),
