@@ -1,3 +1,6 @@
+//! `nbody-bench`: the command line of the harness (its commands in `src/cli/`): parses the
+//! arguments, runs the command, and exits with its code (2 after printing an error's causes).
+
 use clap::Parser;
 #[macro_use]
 extern crate nbody_harness;

@@ -111,6 +111,7 @@ pub fn finish(mut child: Child, what: &str) -> Output {
     }
 }
 
+/// Output bytes as text (invalid UTF-8 replaced).
 pub fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }

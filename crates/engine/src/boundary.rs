@@ -12,28 +12,46 @@ use thiserror::Error;
 #[derive(Clone, Copy, Debug)]
 pub enum Boundary<T, const D: usize> {
     /// Elastic walls at `lo` and `hi` in every dimension.
-    Reflecting { lo: [T; D], hi: [T; D] },
+    Reflecting {
+        /// Lower wall on each axis.
+        lo: [T; D],
+        /// Upper wall on each axis.
+        hi: [T; D],
+    },
     /// Unbounded space: particles go anywhere; the bounding box is tracked each step.
     Open,
 }
 
+/// A particle the boundary phase cannot place, usually because the time step is too large.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum BoundaryError {
+    /// A particle is still outside the walls after one reflection (it crossed more than the box in
+    /// a step).
     #[error(
         "step {step}: particle {id} is still outside the box after one reflection \
          (coordinate {dim} = {value}); the time step is too large for these velocities — reduce --dt"
     )]
     MultipleReflection {
+        /// The step being taken, counted from 1.
         step: u64,
+        /// The particle's id.
         id: u32,
+        /// The axis it is outside on.
         dim: usize,
+        /// Its coordinate on that axis after the reflection.
         value: f64,
     },
+    /// A particle's position is NaN or infinite.
     #[error(
         "step {step}: particle {id} has a non-finite position; the simulation blew up — \
          reduce --dt or check the initial state"
     )]
-    NonFinite { step: u64, id: u32 },
+    NonFinite {
+        /// The step being taken, counted from 1.
+        step: u64,
+        /// The particle's id.
+        id: u32,
+    },
 }
 
 impl<T: Real, const D: usize> Boundary<T, D> {

@@ -15,6 +15,7 @@ pub trait Clock: Sync {
 pub struct WallClock(Instant);
 
 impl WallClock {
+    /// A clock whose origin is now.
     pub fn new() -> Self {
         WallClock(Instant::now())
     }
@@ -39,6 +40,7 @@ pub struct MockClock {
 }
 
 impl MockClock {
+    /// A clock at 0 that advances by `tick` at every reading (the first reads `tick`).
     pub fn new(tick: Duration) -> Self {
         MockClock {
             ns: AtomicU64::new(0),

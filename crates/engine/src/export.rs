@@ -18,21 +18,28 @@ use crate::scenario::{System, SystemJob};
 use std::fmt::Write as _;
 use thiserror::Error;
 
+/// The file formats `nbody-bench export` writes (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum ExportFormat {
+    /// A LAMMPS data file in LJ reduced units (Lennard-Jones scenarios only).
     LammpsData,
+    /// The text format's columns as a little-endian float64 NumPy array.
     Npy,
+    /// A commented header and one row per particle, which `run --initial` reads back.
     Text,
 }
 
+/// Why a state cannot be exported in the format asked.
 #[derive(Debug, Error, PartialEq)]
 pub enum ExportError {
+    /// lammps-data for a scenario of another law: the scenario's name and its law's parameters.
     #[error(
         "the lammps-data format is for the Lennard-Jones scenarios (lj-box, lj-liquid); scenario \
          `{0}` has {1}: use --format text or npy"
     )]
     NotLj(&'static str, String),
+    /// lammps-data with unequal masses, which one atom type cannot hold; holds a particle's index.
     #[error("lammps-data needs equal masses (one atom type); particle {0} has another mass")]
     Masses(usize),
 }

@@ -18,7 +18,9 @@ use crate::real::Real;
 /// An axis-aligned box `[lo, hi]`, possibly empty (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds<T, const D: usize> {
+    /// Lower corner: the smallest coordinate on each axis.
     pub lo: [T; D],
+    /// Upper corner: the largest coordinate on each axis.
     pub hi: [T; D],
 }
 

@@ -28,7 +28,9 @@ pub trait Real:
     /// Machine epsilon, as `f64`, for rounding-aware tolerances.
     const EPSILON_F64: f64;
 
+    /// The nearest value of this type to `x` (rounds to nearest in f32).
     fn of(x: f64) -> Self;
+    /// The value widened to f64 (exact).
     fn as_f64(self) -> f64;
 
     /// `1/√x` for `x > 0` to within a few units in the last place, from an integer estimate

@@ -22,6 +22,7 @@ pub enum SimdLevel {
 }
 
 impl SimdLevel {
+    /// The level's name in results (`baseline`, `avx2+fma`, `avx512`).
     pub fn name(self) -> &'static str {
         match self {
             SimdLevel::Baseline => "baseline",

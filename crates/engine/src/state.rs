@@ -18,7 +18,9 @@ pub fn zero_field<T: Real, const D: usize>(n: usize) -> Field<T, D> {
 /// The dynamic state of `n` particles.
 #[derive(Clone, Debug)]
 pub struct State<T: Real, const D: usize> {
+    /// Positions, one array per coordinate, indexed by slot (`id` gives each slot's particle).
     pub pos: Field<T, D>,
+    /// Velocities, laid out as `pos`.
     pub vel: Field<T, D>,
     /// Inertial mass (divides the force in the integrator).
     pub mass: Vec<T>,
@@ -41,10 +43,12 @@ impl<T: Real, const D: usize> State<T, D> {
         }
     }
 
+    /// Number of particles.
     pub fn len(&self) -> usize {
         self.mass.len()
     }
 
+    /// Whether there are no particles.
     pub fn is_empty(&self) -> bool {
         self.mass.is_empty()
     }

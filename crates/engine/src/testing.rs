@@ -24,7 +24,9 @@ pub(crate) fn on_threads<R: Send>(p: usize, f: impl FnOnce() -> R + Send) -> R {
         .install(f)
 }
 
+/// A named seed of the tests' random states, so that two tests share a state on purpose.
 pub const SEED_1: u64 = 0x5eed_0001;
+/// A second named seed, for a state independent of [`SEED_1`]'s.
 pub const SEED_2: u64 = 0x5eed_0002;
 
 /// `n` particles uniform in the box `[0, side)^D` with small random velocities, unit mass and

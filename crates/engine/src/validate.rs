@@ -40,13 +40,17 @@ pub fn fmm_tolerance(theta: f64, order: usize) -> f64 {
 /// Agreement of one kernel with the reference.
 #[derive(Clone, Debug, Serialize)]
 pub struct KernelCheck {
+    /// Kernel name, as `--kernel` takes it.
     pub kernel: &'static str,
     /// Max and median over particles of |F − F_ref| / |F_ref| (|F_ref| floored at 1e-6 of its RMS).
     pub max_rel_error: f64,
+    /// Median over particles of the same relative error.
     pub median_rel_error: f64,
     /// Max over particles of |F − F_naive| / Σ_j |F_ij| (naive in the run's precision): the
     /// difference relative to the rounding scale.
     pub(crate) max_rounding_ratio: f64,
+    /// Whether the kernel met its bound (rounding for exact kernels, θ's tolerance for the tree
+    /// codes).
     pub passed: bool,
     /// Not run because the kernel refuses these parameters (the fmm at θ ≥ 1): neither passed
     /// nor failed, the errors NaN (null in JSON), the reason in `criterion`.
@@ -73,10 +77,15 @@ impl KernelCheck {
 /// What `validate` found for one scenario.
 #[derive(Clone, Debug, Serialize)]
 pub struct ScenarioCheck {
+    /// Scenario name.
     pub scenario: &'static str,
+    /// Particles in the system.
     pub n: usize,
+    /// Precision of the kernels checked, `f32` or `f64` (the reference is always f64).
     pub precision: &'static str,
+    /// Opening angle θ the tree kernels were checked at.
     pub theta: f64,
+    /// One check per kernel that applies to the law, in [`KernelKind::ALL`] order.
     pub kernels: Vec<KernelCheck>,
     /// The force dump text, when asked for.
     #[serde(skip)]
@@ -93,8 +102,11 @@ pub fn validate_setup(
 
 /// Runs every kernel that applies to the system's law and compares it to the reference.
 pub struct ValidateJob {
+    /// Kernel parameters every kernel is built with (θ, leaf size, skin, order).
     pub params: KernelParams,
+    /// Threads of the pool the kernels run on.
     pub threads: usize,
+    /// Whether to keep the forces as dump text in [`ScenarioCheck::dump`].
     pub want_dump: bool,
 }
 

@@ -11,6 +11,7 @@ use std::fmt;
 pub struct Duration(pub f64);
 
 impl Duration {
+    /// A span given in nanoseconds (as step timings are recorded).
     pub fn from_ns(ns: f64) -> Self {
         Duration(ns * 1e-9)
     }
@@ -131,8 +132,11 @@ impl fmt::Display for Number {
 /// precision applies to all three.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WithCi<U> {
+    /// The point estimate (a median, a fitted parameter).
     pub estimate: U,
+    /// The interval's lower bound.
     pub low: U,
+    /// The interval's upper bound.
     pub high: U,
 }
 

@@ -41,7 +41,9 @@ pub enum WeakRule {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Counts {
+    /// The counts as written, such as `n = [1000, 2000]`.
     List(Vec<usize>),
+    /// A geometric range, such as `n = { from = 1000, to = 32000, factor = 2 }`.
     Range(CountRange),
 }
 
@@ -66,10 +68,14 @@ impl<'de> Deserialize<'de> for Counts {
     }
 }
 
+/// Particle counts from `from` to `to`, each `factor` times the last (rounded); validation
+/// requires 1 <= from <= to and factor > 1.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CountRange {
+    /// First (smallest) particle count.
     pub from: usize,
+    /// Upper bound on the counts (inclusive; reached only if the factor lands on it).
     pub to: usize,
     /// Ratio between consecutive counts (> 1).
     pub factor: f64,
@@ -412,19 +418,33 @@ fn default_out() -> PathBuf {
     PathBuf::from("results")
 }
 
+/// Why a sweep config could not be loaded; every variant names the file.
 #[derive(Debug, Error)]
 pub enum ConfigError {
+    /// The file could not be read (missing, unreadable, not UTF-8).
     #[error("cannot read config {path}: {source}")]
     Read {
+        /// The config file.
         path: PathBuf,
+        /// The I/O error reading it.
         source: std::io::Error,
     },
+    /// The text is not valid TOML or does not fit the config's shape (unknown key, wrong type).
     #[error("config {path}: {message}")]
-    Parse { path: PathBuf, message: String },
+    Parse {
+        /// The config file.
+        path: PathBuf,
+        /// What is wrong, naming the key and what it accepts.
+        message: String,
+    },
+    /// The config parsed but a value breaks a rule (range, combination of keys).
     #[error("config {path}: `{key}` {problem}")]
     Invalid {
+        /// The config file.
         path: PathBuf,
+        /// The offending key, dotted for a table's (`weak.base_n`).
         key: String,
+        /// What is wrong with it and what is allowed.
         problem: String,
     },
 }

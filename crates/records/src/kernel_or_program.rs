@@ -7,6 +7,7 @@ use nbody_engine::kernels::KernelKind;
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 use std::fmt;
 
+/// What a case measures: a built-in kernel or an `[[external]]` program, known by its name.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum KernelOrProgram {
     /// A kernel of this crate, measured in this process (or under the config's MPI launcher).
@@ -25,6 +26,7 @@ impl KernelOrProgram {
         }
     }
 
+    /// The name written in results files, case keys, tables and plots (`"cell-list"`, `"lammps"`).
     pub fn name(&self) -> &str {
         match self {
             KernelOrProgram::Kernel(k) => k.name(),
@@ -40,6 +42,7 @@ impl KernelOrProgram {
         }
     }
 
+    /// Whether the case runs an `[[external]]` program rather than a built-in kernel.
     pub fn is_external(&self) -> bool {
         matches!(self, KernelOrProgram::External(_))
     }

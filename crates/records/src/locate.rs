@@ -21,38 +21,62 @@ fn config_dirs() -> Vec<PathBuf> {
     vec![PathBuf::from("configs")]
 }
 
+/// Why a config, a results file or a run directory could not be found or made.
 #[derive(Debug, Error)]
 pub enum LocateError {
+    /// A `--config` that is neither a readable file nor a name found in `configs/`.
     #[error(
         "no config `{given}`: looked for {looked}; configs available: {available}; pass a path \
          or one of these names"
     )]
     NoConfig {
+        /// The path or name as the user gave it.
         given: String,
+        /// The paths tried, comma-separated.
         looked: String,
+        /// The config names in `configs/`, comma-separated.
         available: String,
     },
+    /// Results named by a path, directory or config name where no `results.json` exists.
     #[error(
         "no results for `{given}`: looked for {looked}; pass a results.json, a run directory, or \
          the name of a config that has been swept"
     )]
-    NoResults { given: String, looked: String },
+    NoResults {
+        /// The path or name as the user gave it.
+        given: String,
+        /// The paths tried, comma-separated.
+        looked: String,
+    },
+    /// `sweep --resume` without a directory, when every run of the config is complete.
     #[error(
         "no unfinished run of `{name}` under {dir}; start a new one with `nbody-bench sweep \
          --config {name}`, or pass the run to resume: --resume DIR"
     )]
-    NothingToResume { name: String, dir: PathBuf },
+    NothingToResume {
+        /// The config's name.
+        name: String,
+        /// The directory of its runs, `<out>/runs/<name>/`.
+        dir: PathBuf,
+    },
+    /// A run newer than any unfinished one has a results file that cannot be loaded (it may be
+    /// the run the user means, so it is not skipped).
     #[error(
         "the run {dir} cannot be read ({source}); pass the run to resume (--resume DIR), or \
          move the broken one aside"
     )]
     Unreadable {
+        /// The run directory.
         dir: PathBuf,
+        /// Why its `results.json` could not be loaded.
         source: Box<super::results::ResultsError>,
     },
+    /// A new run directory (or its parent) could not be created.
     #[error("cannot create the run directory {path}: {source}")]
     CreateRun {
+        /// The directory that could not be created.
         path: PathBuf,
+        /// The I/O error creating it.
         source: std::io::Error,
     },
 }

@@ -10,10 +10,13 @@ use serde::{Deserialize, Serialize};
 /// One measured configuration: everything that changes the work or the machine use.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Case {
+    /// The initial state and force law simulated.
     pub scenario: ScenarioKind,
     /// A built-in kernel or an external program, by name.
     pub kernel: KernelOrProgram,
+    /// Particle count of the whole system (in a weak study, derived from `weak.base_n`).
     pub n: usize,
+    /// Worker threads of each rank (of the process without MPI).
     pub threads: usize,
     /// MPI ranks (1 without MPI).
     pub ranks: usize,
@@ -29,7 +32,9 @@ pub struct Case {
     /// kernel's default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub skin: Option<f64>,
+    /// Seed of the initial state.
     pub seed: u64,
+    /// Floating-point precision the config imposes; `None`: each scenario's own.
     pub precision: Option<Precision>,
     /// Simulated-time factor of a weak-by-time study (the run stands for this many times the
     /// steps of the one-thread case); 1 otherwise.
@@ -95,8 +100,6 @@ pub fn is_monopole(m: &Multipole) -> bool {
     *m == Multipole::Monopole
 }
 
-/// The cases of a config, in a fixed order: the externals' first, then per scenario, kernel,
-/// n, threads, seed, θ, multipole or fmm order.
 /// The cases of `config`, refused when two share a key (an `[[external]]` named like a
 /// built-in kernel, say): one would be measured and reported for both.
 pub fn unique_cases(config: &SweepConfig) -> Result<Vec<Case>, String> {
@@ -113,6 +116,8 @@ pub fn unique_cases(config: &SweepConfig) -> Result<Vec<Case>, String> {
     Ok(planned)
 }
 
+/// The cases of a config, in a fixed order: the externals' first, then per scenario, kernel,
+/// n, threads, seed, θ, multipole or fmm order.
 pub fn cases(config: &SweepConfig) -> Vec<Case> {
     let mut out = Vec::new();
     external_cases(config, &mut out);

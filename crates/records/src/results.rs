@@ -16,22 +16,33 @@ use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// The `schema` value of results files this version writes and reads; any other is refused.
 pub const RESULTS_SCHEMA: &str = "nbody-bench/results/v1";
 
+/// A sweep's `results.json`: everything needed to analyse it again without re-running.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct ResultsFile {
+    /// Always [`RESULTS_SCHEMA`] in a file this version loads.
     pub schema: String,
+    /// The build and machine that produced the results.
     pub metadata: Metadata,
     /// The config as parsed, and verbatim as written.
     pub config: SweepConfig,
+    /// The config file's text as read, comments included.
     pub config_text: String,
+    /// The machine's calibration before and after the cases.
     pub calibration: Calibrations,
+    /// Every planned case, measured or not yet, each key once.
     pub cases: Vec<CaseRecord>,
 }
 
+/// The machine calibrations of a sweep; see [`Calibrations::for_analysis`] for the one read.
 #[derive(Clone, Debug, Default, Serialize, Deserialize)]
 pub struct Calibrations {
+    /// Taken before the first case; `None` when calibration was off or its batch job ended
+    /// without a result.
     pub start: Option<Calibration>,
+    /// Taken after the last case; `None` likewise, or while the sweep is unfinished.
     pub end: Option<Calibration>,
 }
 
@@ -53,16 +64,25 @@ impl Calibrations {
 /// only with results of the same machine and build.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metadata {
+    /// The nbody-bench version (`CARGO_PKG_VERSION`) that wrote the file.
     pub tool_version: String,
+    /// `git rev-parse HEAD` where the sweep ran; "unknown" outside a git checkout.
     pub git_commit: String,
+    /// Tracked files differed from that commit (results and REPORT.md aside).
     pub git_dirty: bool,
+    /// The compiler that built the binary (`rustc --version`).
     pub rustc_version: String,
     /// Instruction set the pair loops ran with, and the target features compiled in.
     pub simd: String,
+    /// SIMD target features enabled at compile time, then `runtime-dispatch:<level>`.
     pub target_features: Vec<String>,
+    /// The build's cargo features that change what it measures (`mpi`, `test-slowdown`).
     pub cargo_features: Vec<String>,
+    /// "release" or "debug" (a debug build's timings are not comparable).
     pub profile: String,
+    /// Host name from `/etc/hostname`, "unknown" when unreadable.
     pub host: String,
+    /// Operating system and architecture, e.g. "linux x86_64".
     pub os: String,
     /// UTC, ISO 8601, when the sweep started (the first run, not a resume).
     pub started: String,
@@ -77,7 +97,9 @@ pub struct Metadata {
 /// One case: what it is, every raw value, and summaries recomputed from them.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct CaseRecord {
+    /// The case's key ([`Case::key`]), unique in the file: what tables, plots and resumes match on.
     pub key: String,
+    /// The configuration measured.
     pub case: Case,
     /// Particles simulated.
     pub n: usize,
@@ -85,7 +107,9 @@ pub struct CaseRecord {
     pub oversubscribed: bool,
     /// Rounds measured so far; the case is complete at `rounds_planned`.
     pub rounds_done: usize,
+    /// Rounds the config asks for (`measure.rounds`).
     pub rounds_planned: usize,
+    /// Timed steps per sample, as the last round used (later rounds keep the first's); 0 before any.
     pub steps_per_sample: u64,
     /// Each round as measured (samples in seconds per step, phases, counters, sanity).
     pub rounds: Vec<RoundOutcome>,
@@ -105,15 +129,20 @@ pub struct CaseRecord {
 pub struct Summary {
     /// Median over samples of the time per step, seconds, with a bootstrap 95% CI.
     pub median_s: f64,
+    /// Bootstrap 95% confidence interval of that median, seconds per step ([low, high]).
     pub ci95_s: [f64; 2],
+    /// Median absolute deviation of the samples, seconds per step.
     pub mad_s: f64,
     pub(crate) min_s: f64,
     pub(crate) mean_s: f64,
+    /// Samples over all rounds, the rejected ones left out.
     pub samples: usize,
     /// Per-step percentiles from the histogram, nanoseconds; `None` when no step was timed
     /// alone (an external program is timed per run).
     pub step_ns: Option<StepPercentiles>,
+    /// Median step time per particle, nanoseconds.
     pub ns_per_particle_step: f64,
+    /// Throughput at the median: particles advanced one step per second.
     pub particle_steps_per_s: f64,
     /// `None` when the code counted no pair (an external program).
     pub pair_evals_per_s: Option<f64>,
@@ -134,35 +163,66 @@ pub struct Summary {
     /// Largest |energy drift| of any round, and whether it stayed within the config's limit;
     /// `None` when no round measured a drift (an external program).
     pub max_energy_drift: Option<f64>,
+    /// That drift is within `measure.max_energy_drift`; `None` when there is no drift.
     pub sanity_ok: Option<bool>,
+    /// Median and largest relative force error of the last round that measured it.
     pub force_error: Option<[f64; 2]>,
     /// Largest timing overhead (clock readings) relative to the median step.
     pub(crate) clock_overhead: f64,
 }
 
+/// Why a results file could not be loaded or saved; every variant but `Write` names the file.
 #[derive(Debug, Error)]
 pub enum ResultsError {
+    /// The file could not be read (missing, unreadable, not UTF-8).
     #[error("cannot read {path}: {source}")]
     Read {
+        /// The results file.
         path: PathBuf,
+        /// The I/O error reading it.
         source: std::io::Error,
     },
+    /// The text is not JSON, or not the shape of a results file.
     #[error(
         "{path} is not a valid results file ({detail}); it may be truncated or from another tool"
     )]
-    Corrupt { path: PathBuf, detail: String },
+    Corrupt {
+        /// The results file.
+        path: PathBuf,
+        /// The JSON parser's message, with its line and column.
+        detail: String,
+    },
+    /// The file's `schema` is not [`RESULTS_SCHEMA`] ("(none)" when it has none).
     #[error("{path} has schema `{found}`, this version reads `{RESULTS_SCHEMA}`")]
-    Schema { path: PathBuf, found: String },
+    Schema {
+        /// The results file.
+        path: PathBuf,
+        /// The schema it declares.
+        found: String,
+    },
+    /// Two cases of the file have the same key.
     #[error(
         "{path} lists case `{key}` twice; a case key is unique in a results file: remove one \
          of the copies (or measure the case again in a new run)"
     )]
-    Duplicate { path: PathBuf, key: String },
+    Duplicate {
+        /// The results file.
+        path: PathBuf,
+        /// The repeated case key.
+        key: String,
+    },
+    /// Saving was refused because the serialized text would not load back; nothing was written.
     #[error(
         "not saving {path}: the results would not read back ({detail}); the file on disk is \
          unchanged"
     )]
-    Unreadable { path: PathBuf, detail: String },
+    Unreadable {
+        /// The results file that was to be written.
+        path: PathBuf,
+        /// Why the text does not read back.
+        detail: String,
+    },
+    /// Writing the file atomically failed.
     #[error(transparent)]
     Write(#[from] nbody_engine::output::WriteError),
 }
@@ -181,6 +241,7 @@ pub fn read_json(path: &Path) -> Result<serde_json::Value, ResultsError> {
 }
 
 impl ResultsFile {
+    /// Reads a results file and checks it ([`ResultsFile::from_value`]), summaries recomputed.
     pub fn load(path: &Path) -> Result<ResultsFile, ResultsError> {
         ResultsFile::from_value(path, read_json(path)?)
     }
@@ -233,12 +294,14 @@ impl ResultsFile {
         Ok(())
     }
 
+    /// The record of the case with this key, `None` if the file has no such case.
     pub fn record_mut(&mut self, key: &str) -> Option<&mut CaseRecord> {
         self.cases.iter_mut().find(|c| c.key == key)
     }
 }
 
 impl CaseRecord {
+    /// A record of `case` with no round measured yet; `logical_cpus` decides `oversubscribed`.
     pub fn new(case: Case, rounds_planned: usize, logical_cpus: usize) -> Self {
         CaseRecord {
             key: case.key(),
@@ -255,6 +318,7 @@ impl CaseRecord {
         }
     }
 
+    /// All `rounds_planned` rounds are recorded (a round without a successful sample counts).
     pub fn is_complete(&self) -> bool {
         self.rounds_done >= self.rounds_planned
     }
@@ -433,8 +497,11 @@ impl Metadata {
 /// content (a file changed between two sweeps shows here).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct InitialRecord {
+    /// The file's absolute path (the config's `initial`, resolved against the config's directory).
     pub path: String,
+    /// The format it was read as: "export" or "barnes-hut".
     pub format: String,
+    /// Bodies it holds.
     pub bodies: usize,
     /// FNV-1a of the file's bytes, 16 hex digits.
     pub fnv1a: String,

@@ -8,13 +8,16 @@ use serde::{Deserialize, Serialize};
 /// What one round measured. Times are per step.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RoundOutcome {
+    /// Steps each sample's time is the mean of (an external program: the steps of one run).
     pub steps_per_sample: u64,
     /// Mean step time of each sample, seconds.
     pub samples_s: Vec<f64>,
     /// Every timed step, nanoseconds.
     #[serde(skip)]
     pub step_ns: Vec<u64>,
+    /// Steps timed in the round (at least samples × steps per sample; an MPI run may time more).
     pub steps: u64,
+    /// Untimed warm-up steps before the samples.
     pub warmup_steps: u64,
     /// Seconds per step in each phase (means over the timed steps).
     pub phases: PhaseTimes,

@@ -55,9 +55,11 @@ crate::config_keys::documented_keys! {
     }
 }
 
+/// The batch systems a sweep can submit to (`kind`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum SchedulerKind {
+    /// Slurm: jobs are submitted with `sbatch` and followed with `squeue` and `scontrol`.
     Slurm,
 }
 
@@ -183,7 +185,9 @@ pub struct JobRecord {
 /// A job that ended without a result, with the last lines of its output.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct JobError {
+    /// What happened: the job id, its final state and why its `result.json` is missing or refused.
     pub what: String,
+    /// The last lines of the job's output file (`job.out`); empty if it cannot be read.
     pub output_tail: Vec<String>,
 }
 

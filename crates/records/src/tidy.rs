@@ -13,7 +13,9 @@ use std::borrow::Cow;
 /// Named columns and rows of JSON values, every row as long as `columns`.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TidyTable {
+    /// Column names, in the order written (the CSV header, the JSON keys' order).
     pub columns: Vec<String>,
+    /// The observations, each one value per column; `null` where nothing was measured.
     pub rows: Vec<Vec<Value>>,
 }
 
@@ -39,6 +41,7 @@ impl TidyFormat {
 }
 
 impl TidyTable {
+    /// An empty table with these column names.
     pub fn new<S: Into<String>>(columns: impl IntoIterator<Item = S>) -> TidyTable {
         TidyTable {
             columns: columns.into_iter().map(Into::into).collect(),

@@ -27,6 +27,7 @@ pub struct Rejected {
     pub what: String,
     /// The value as measured (text: it may be NaN or infinite).
     pub value: String,
+    /// Why no measurement can give it, e.g. "not a finite number".
     pub reason: String,
 }
 

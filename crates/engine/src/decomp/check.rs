@@ -10,19 +10,24 @@ use serde::Serialize;
 /// How the distributed final state compares with the serial one.
 #[derive(Clone, Debug, Serialize)]
 pub struct CheckReport {
+    /// Particles in the serial run's final state.
     pub n_serial: usize,
+    /// Particles in the distributed run's final state, gathered from the ranks.
     pub n_distributed: usize,
     /// Every id `0..n` appears exactly once in the distributed state.
     pub ids_complete: bool,
     /// Σ id over the distributed state, and what it should be (n(n−1)/2).
     pub id_sum: u64,
+    /// n(n−1)/2: the sum of the ids when each of `0..n` appears once.
     pub id_sum_expected: u64,
     /// Largest position difference over the box size (the serial state's largest extent), and
     /// largest velocity difference over the largest serial speed component.
     pub position_error: f64,
+    /// Largest velocity difference over the largest serial speed component.
     pub velocity_error: f64,
     /// Particles that changed rank, in all and beyond the neighbouring regions.
     pub migrated: u64,
+    /// Of those, particles that moved beyond the neighbouring regions in one step.
     pub far_migrated: u64,
     /// Forces and energy, for the decompositions that distribute the tree.
     pub tree: Option<TreeCheck>,
@@ -38,11 +43,15 @@ pub struct TreeCheck {
     /// positions: of its own forces, of the serial octree's there, and `validate`'s bound at
     /// this θ.
     pub force_error: f64,
+    /// Median relative force error of the serial octree at the same positions and θ.
     pub serial_force_error: f64,
+    /// The bound `validate` holds the serial octree to at this θ.
     pub force_tolerance: f64,
     /// |E_end − E_0| over the start's |kinetic| + |potential| + |external|, of the distributed
     /// and of the serial run ([`relative_drift`]).
     pub energy_drift: f64,
+    /// The serial run's energy drift, which the distributed drift is held to (see
+    /// [`DRIFT_FACTOR`]).
     pub serial_energy_drift: f64,
 }
 
@@ -55,6 +64,8 @@ pub const DRIFT_FACTOR: f64 = 4.0;
 pub const DRIFT_FLOOR: f64 = 1e-5;
 
 impl TreeCheck {
+    /// Whether the forces are within the tolerance and the drift within [`DRIFT_FACTOR`] times the
+    /// serial drift plus [`DRIFT_FLOOR`].
     pub fn passes(&self) -> bool {
         self.force_error <= self.force_tolerance
             && self.energy_drift <= DRIFT_FACTOR * self.serial_energy_drift + DRIFT_FLOOR

@@ -51,21 +51,29 @@ pub enum Decomposition {
     Tree,
 }
 
+/// Why a decomposition cannot run a kernel.
 #[derive(Debug, Error, PartialEq)]
 pub enum DecompError {
+    /// `--decomp domain` with a kernel other than the cell list or the Verlet list; holds the
+    /// kernel's name.
     #[error(
         "--decomp domain needs --kernel cell-list or verlet (a short-range law with a cutoff); \
          use --decomp allgather with {0}"
     )]
     DomainKernel(&'static str),
+    /// A tree decomposition (`octants`, `tree`) with a kernel other than the octree.
     #[error(
         "--decomp {decomp} distributes the Barnes-Hut tree and needs --kernel octree; use \
          --decomp allgather with {kernel}"
     )]
     TreeKernel {
+        /// The decomposition's name.
         decomp: &'static str,
+        /// The kernel's name.
         kernel: &'static str,
     },
+    /// A tree decomposition with the fmm kernel, which has no distributed walk; holds the
+    /// decomposition's name.
     #[error(
         "--decomp {0} distributes the octree's Barnes-Hut tree; the fmm kernel has no distributed \
          walk (its cell pairs would cross ranks both ways): run it with --decomp allgather, where \
@@ -75,6 +83,7 @@ pub enum DecompError {
 }
 
 impl Decomposition {
+    /// Every decomposition, in the order the command line lists them.
     pub const ALL: [Decomposition; 4] = [
         Decomposition::Allgather,
         Decomposition::Domain,
@@ -82,6 +91,7 @@ impl Decomposition {
         Decomposition::Tree,
     ];
 
+    /// The decomposition's name on the command line and in results.
     pub fn name(self) -> &'static str {
         match self {
             Decomposition::Allgather => "allgather",
@@ -129,6 +139,7 @@ pub type Aabb<const D: usize> = ([f64; D], [f64; D]);
 /// The spatial domains of the ranks of a tree decomposition: who owns a point, and the boxes
 /// that make up each rank's domain (what the locally essential tree is selected against).
 pub trait Domains<const D: usize> {
+    /// Number of ranks the space is split among.
     fn ranks(&self) -> usize;
 
     /// The rank that owns `x`; points outside the root box go to a rank whose domain touches
@@ -160,14 +171,33 @@ pub trait Domains<const D: usize> {
 /// Why a tree decomposition could not be built.
 #[derive(Debug, Error, PartialEq)]
 pub enum DomainError {
+    /// No rank to split the space among.
     #[error("a decomposition needs at least one rank")]
     NoRanks,
+    /// The root box has a non-finite corner or `hi < lo` on some axis.
     #[error("the root box must be finite with hi >= lo (got [{lo:?}, {hi:?}])")]
-    BadBox { lo: Vec<f64>, hi: Vec<f64> },
+    BadBox {
+        /// Lower corner given.
+        lo: Vec<f64>,
+        /// Upper corner given.
+        hi: Vec<f64>,
+    },
+    /// The number of weights differs from the number of bodies.
     #[error("{weights} weights for {bodies} bodies; give one weight per body")]
-    WeightCount { weights: usize, bodies: usize },
+    WeightCount {
+        /// Weights given.
+        weights: usize,
+        /// Bodies to split.
+        bodies: usize,
+    },
+    /// A body's weight is negative or not finite.
     #[error("weight {value} of body {body} is not a finite number >= 0")]
-    BadWeight { body: usize, value: f64 },
+    BadWeight {
+        /// Index of the body.
+        body: usize,
+        /// Its weight.
+        value: f64,
+    },
 }
 
 #[cfg(test)]

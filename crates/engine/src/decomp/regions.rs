@@ -16,20 +16,32 @@
 
 use thiserror::Error;
 
+/// Why the regions of a domain decomposition cannot be built.
 #[derive(Debug, Error, PartialEq)]
 pub enum RegionsError {
+    /// The `--rank-grid` factors do not multiply to the number of ranks.
     #[error(
         "rank grid {grid} has {got} regions for {ranks} ranks; give --rank-grid factors whose product is the rank count"
     )]
     GridMismatch {
+        /// The grid as given.
         grid: String,
+        /// Regions the grid makes.
         got: usize,
+        /// Ranks of the run.
         ranks: usize,
     },
+    /// A `--rank-grid` that is not `AxB` or `AxBxC` with factors of at least 1; holds the text.
     #[error("rank grid `{0}` is not of the form AxB (2-D) or AxBxC (3-D) with factors >= 1")]
     BadGrid(String),
+    /// The box has a non-finite wall or `hi < lo` on some axis.
     #[error("the domain decomposition needs a box with finite walls (got [{lo:?}, {hi:?}])")]
-    BadBox { lo: Vec<f64>, hi: Vec<f64> },
+    BadBox {
+        /// Lower corner given.
+        lo: Vec<f64>,
+        /// Upper corner given.
+        hi: Vec<f64>,
+    },
 }
 
 /// The regions of `p = Π dims` ranks over the box `[lo, hi]`.
@@ -69,10 +81,12 @@ impl<const D: usize> Regions<D> {
         Ok(Regions { lo, hi, dims, cuts })
     }
 
+    /// Number of regions, one per rank: the product of the grid's factors.
     pub fn ranks(&self) -> usize {
         self.dims.iter().product()
     }
 
+    /// Regions per axis (the rank grid).
     pub fn dims(&self) -> [usize; D] {
         self.dims
     }

@@ -15,9 +15,11 @@ use serde::{Deserialize, Serialize};
 /// What one rank measured over the timed steps.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RankStats {
+    /// The rank's number in the communicator, from 0.
     pub rank: usize,
     /// Particles owned at the end, and the mean over the timed steps.
     pub particles: u64,
+    /// Particles owned, averaged over the timed steps.
     pub particles_mean: f64,
     /// Seconds outside MPI calls (forces, integration, walls, packing), summed over steps.
     pub compute_s: f64,
@@ -31,6 +33,7 @@ pub struct RankStats {
     pub transfer_s: f64,
     /// Payload bytes and messages this rank sent (collectives: see `docs/explanation/mpi.md`).
     pub bytes_sent: u64,
+    /// Messages this rank sent (how collectives count: `docs/explanation/mpi.md`).
     pub messages_sent: u64,
     /// Collective calls made.
     pub collectives: u64,
@@ -45,12 +48,16 @@ pub struct RankStats {
 /// Minimum, mean and maximum of a quantity over the ranks.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MinMeanMax {
+    /// Smallest value over the ranks.
     pub min: f64,
+    /// Mean over the ranks.
     pub mean: f64,
+    /// Largest value over the ranks.
     pub max: f64,
 }
 
 impl MinMeanMax {
+    /// The minimum, mean and maximum of `values`; all 0 when there are none.
     pub fn of(values: impl IntoIterator<Item = f64>) -> MinMeanMax {
         let (mut min, mut max, mut sum, mut k) = (f64::INFINITY, f64::NEG_INFINITY, 0.0, 0);
         for v in values {
@@ -82,19 +89,29 @@ impl MinMeanMax {
 /// The per-rank statistics reduced over the ranks.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct ReducedStats {
+    /// Particles owned at the end of the run.
     pub particles: MinMeanMax,
+    /// Seconds outside MPI calls, summed over the steps.
     pub compute_s: MinMeanMax,
+    /// Seconds of force computation, summed over the steps.
     pub force_s: MinMeanMax,
+    /// Seconds inside MPI calls, summed over the steps.
     pub comm_s: MinMeanMax,
+    /// Estimated seconds waiting for slower ranks.
     pub wait_s: MinMeanMax,
+    /// Seconds inside MPI calls not spent waiting: moving data and MPI overhead.
     pub transfer_s: MinMeanMax,
+    /// Payload bytes sent.
     pub bytes_sent: MinMeanMax,
+    /// Messages sent.
     pub messages_sent: MinMeanMax,
     /// Collective calls this rank took part in (absent from files written before they were
     /// reported).
     #[serde(default)]
     pub collectives: MinMeanMax,
+    /// Ghost particles received, summed over the steps.
     pub ghosts_received: MinMeanMax,
+    /// Particles that left the rank's region, summed over the steps.
     pub migrated_out: MinMeanMax,
     /// Slowest rank's compute time over the mean (1 = perfectly balanced).
     pub compute_imbalance: f64,
@@ -164,8 +181,11 @@ pub struct MasterSummary {
 /// The `mpi` block of a distributed run's result.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MpiReport {
+    /// Number of MPI processes.
     pub ranks: usize,
+    /// How the work was split among the ranks.
     pub decomposition: Decomposition,
+    /// Threads of each rank's pool.
     pub threads_per_rank: usize,
     /// Regions per axis (domain decomposition).
     pub rank_grid: Option<Vec<usize>>,
@@ -177,7 +197,9 @@ pub struct MpiReport {
     pub warmup_steps: u64,
     /// Times the domain boundaries moved to rebalance particle counts.
     pub rebalances: u64,
+    /// Each rank's statistics, in rank order.
     pub per_rank: Vec<RankStats>,
+    /// The per-rank statistics reduced to min/mean/max over the ranks.
     pub reduced: ReducedStats,
     /// Older files call it `source_004`; both names are read.
     #[serde(alias = "source_004")]

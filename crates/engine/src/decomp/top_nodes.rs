@@ -85,10 +85,12 @@ impl<T: Real, const D: usize> TopNodes<T, D> {
         out
     }
 
+    /// Number of top nodes shared.
     pub fn len(&self) -> usize {
         self.nodes.len()
     }
 
+    /// Whether there are no nodes: the rank's tree is empty.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
     }

@@ -33,6 +33,7 @@ pub struct PhaseTimes {
 }
 
 impl PhaseTimes {
+    /// Seconds over all phases.
     pub fn total(&self) -> f64 {
         self.force_build + self.force_interact + self.integrate + self.boundary + self.output
     }
@@ -68,13 +69,16 @@ impl std::ops::Sub for PhaseTimes {
 /// Energies of the current state.
 #[derive(Clone, Copy, Debug, Serialize)]
 pub struct Energy {
+    /// Kinetic energy Σ ½ m v².
     pub kinetic: f64,
+    /// Pair potential energy, each pair once (Lennard-Jones: shifted to 0 at the cutoff).
     pub potential: f64,
     /// Potential energy in the external field.
     pub external: f64,
 }
 
 impl Energy {
+    /// Kinetic plus pair potential plus field energy.
     pub fn total(&self) -> f64 {
         self.kinetic + self.potential + self.external
     }
@@ -99,13 +103,17 @@ impl Energy {
     "energy is not finite after step {step} (E = {energy}); the simulation blew up — reduce --dt"
 )]
 pub struct EnergyBlowUp {
+    /// The step the energy was probed after.
     pub step: u64,
+    /// The non-finite total (NaN or ±infinity).
     pub energy: f64,
 }
 
 /// A system being integrated with one kernel.
 pub struct Simulation<T: Real, const D: usize> {
+    /// The particles, in the slot order the kernel last asked for (`State::id` maps back).
     pub state: State<T, D>,
+    /// Force on each particle (in slot order) from the last force computation.
     pub forces: Field<T, D>,
     kernel: Box<dyn ForceKernel<T, D>>,
     boundary: Boundary<T, D>,
@@ -113,6 +121,7 @@ pub struct Simulation<T: Real, const D: usize> {
     dt: T,
     /// Steps taken so far.
     pub step: u64,
+    /// Seconds per phase, summed over the steps taken.
     pub phases: PhaseTimes,
     /// Work summed over the steps taken (probe computations excluded).
     pub work: WorkCounters,

@@ -82,9 +82,13 @@ fn parse_available(meminfo: &str) -> Option<u64> {
      {available:.1} GiB available{share}: lower -n{threads_hint}"
 )]
 pub struct TooLarge {
+    /// Particles asked.
     pub n: usize,
+    /// The kernel's name.
     pub kernel: &'static str,
+    /// Estimated memory of the run, times the processes on this machine, in GiB.
     pub need: f64,
+    /// Memory available on this machine (`MemAvailable`), in GiB.
     pub available: f64,
     share: String,
     threads_hint: &'static str,

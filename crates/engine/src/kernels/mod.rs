@@ -74,6 +74,7 @@ pub enum KernelKind {
 }
 
 impl KernelKind {
+    /// Every kernel, in the order `list`, `validate` and the sweeps go through them.
     pub const ALL: [KernelKind; 8] = [
         KernelKind::Naive,
         KernelKind::Symmetric,
@@ -85,6 +86,7 @@ impl KernelKind {
         KernelKind::Fmm,
     ];
 
+    /// The kernel's name on the command line and in results.
     pub fn name(self) -> &'static str {
         match self {
             KernelKind::Naive => "naive",
@@ -276,6 +278,8 @@ impl Default for KernelParams {
 }
 
 impl KernelParams {
+    /// Checks every parameter is in its range (θ ≥ 0, leaf sizes 1 to 4096, order 1 to
+    /// `fmm::MAX_ORDER`, skin > 0).
     pub fn validate(&self) -> Result<(), KernelError> {
         if !(self.theta.is_finite() && self.theta >= 0.0) {
             return Err(KernelError::BadParam(format!(
@@ -346,21 +350,35 @@ impl KernelParams {
     }
 }
 
+/// Why a kernel cannot be built for a system.
 #[derive(Debug, Error)]
 pub enum KernelError {
+    /// The kernel cannot compute forces of the system's law (no cutoff for a cell list, not
+    /// inverse-square for a tree).
     #[error("kernel `{kernel}` does not apply to the {law} law; kernels for {law}: {supported}")]
     Incompatible {
+        /// The kernel's name.
         kernel: &'static str,
+        /// The law's name.
         law: &'static str,
+        /// The kernels that do apply to the law, comma-separated.
         supported: String,
     },
+    /// A kernel parameter is out of range; holds the message, which names the range and the
+    /// default.
     #[error("{0}")]
     BadParam(String),
+    /// The fmm kernel was asked for a system that is not 3-D.
     #[error(
         "kernel `{kernel}` runs in three dimensions only and this system has {dim}; the long-range \
          scenarios (coulomb, galaxy) are 3-D, and the octree handles 2-D systems"
     )]
-    Dimension { kernel: &'static str, dim: usize },
+    Dimension {
+        /// The kernel's name.
+        kernel: &'static str,
+        /// The system's dimension.
+        dim: usize,
+    },
 }
 
 /// Steps between the spatial re-orderings a kernel may ask for (cell or Morton order), unless
@@ -440,11 +458,13 @@ pub struct ForceReport {
     pub energy: Option<f64>,
     /// Seconds spent building cells, trees or sort orders, part of the force phase.
     pub build_s: f64,
+    /// Work counted during the computation.
     pub work: WorkCounters,
 }
 
 /// Computes the forces of one configuration.
 pub trait ForceKernel<T: Real, const D: usize>: Send {
+    /// Which of the eight kernels this is.
     fn kind(&self) -> KernelKind;
 
     /// Overwrites `forces` with the force on every particle. With `probe`, also returns the

@@ -11,11 +11,13 @@ use crate::simd;
 use crate::state::{Field, State};
 use std::ops::Range;
 
+/// The `naive` kernel: every particle against every other, parallel over targets.
 pub struct Naive<L> {
     law: L,
 }
 
 impl<L> Naive<L> {
+    /// The kernel for `law`.
     pub fn new(law: L) -> Self {
         Naive { law }
     }

@@ -14,6 +14,7 @@ use crate::state::{Field, State, zero_field};
 use rayon::prelude::*;
 use std::ops::Range;
 
+/// The `per-thread` kernel: symmetric pairs over the pool's threads, one force buffer each.
 pub struct PerThread<L, T: Real, const D: usize> {
     law: L,
     buffers: Vec<Field<T, D>>,
@@ -23,6 +24,7 @@ pub struct PerThread<L, T: Real, const D: usize> {
 }
 
 impl<L, T: Real, const D: usize> PerThread<L, T, D> {
+    /// The kernel for `law`; its buffers are allocated on the first step.
     pub fn new(law: L) -> Self {
         PerThread {
             law,

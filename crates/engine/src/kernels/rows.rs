@@ -18,6 +18,7 @@ pub use crate::simd::LANES;
 /// Sum over a run of sources of their effect on one target.
 #[derive(Clone, Copy, Debug)]
 pub struct RowSum<T, const D: usize> {
+    /// Force on the target from these sources.
     pub force: [T; D],
     /// Potential energy of the target with these sources (only when probing).
     pub energy: T,
@@ -28,14 +29,18 @@ pub struct RowSum<T, const D: usize> {
 /// A target particle: position and source strength.
 #[derive(Clone, Copy, Debug)]
 pub struct Target<T, const D: usize> {
+    /// The target's position.
     pub x: [T; D],
+    /// The target's source strength (charge, gravitational mass; 1 for Lennard-Jones).
     pub s: T,
 }
 
 /// A contiguous run of sources: positions per component and strengths, all of equal length.
 #[derive(Clone, Copy, Debug)]
 pub struct Sources<'a, T, const D: usize> {
+    /// Positions, one slice per coordinate.
     pub pos: [&'a [T]; D],
+    /// Source strengths.
     pub s: &'a [T],
 }
 
@@ -49,11 +54,13 @@ impl<'a, T: Real, const D: usize> Sources<'a, T, D> {
         }
     }
 
+    /// Number of sources in the run.
     #[inline(always)]
     pub fn len(&self) -> usize {
         self.s.len()
     }
 
+    /// Whether the run has no sources.
     #[inline(always)]
     pub fn is_empty(&self) -> bool {
         self.s.is_empty()
@@ -70,6 +77,7 @@ pub struct Exclude {
 }
 
 impl Exclude {
+    /// Nothing excluded: every source acts.
     pub const NONE: Exclude = Exclude {
         below: 0,
         index: usize::MAX,
@@ -403,6 +411,7 @@ pub fn scatter<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
 }
 
 impl<T: Real, const D: usize> RowSum<T, D> {
+    /// No force, no energy, no pairs: the sum over no sources.
     pub fn zero() -> Self {
         RowSum {
             force: [T::zero(); D],
@@ -411,6 +420,7 @@ impl<T: Real, const D: usize> RowSum<T, D> {
         }
     }
 
+    /// Adds the sum over another run of sources for the same target.
     #[inline(always)]
     pub fn add(&mut self, other: &RowSum<T, D>) {
         for d in 0..D {

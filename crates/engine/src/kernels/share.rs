@@ -6,7 +6,9 @@ use std::ops::Range;
 /// Share `index` of `count` equal shares of a computation.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Share {
+    /// Which share, from 0; always below `count`.
     pub index: usize,
+    /// Shares the computation is split into (the MPI ranks).
     pub count: usize,
 }
 

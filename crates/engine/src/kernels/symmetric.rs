@@ -16,11 +16,13 @@ use std::ops::Range;
 /// Particles per tile: positions, source strength and forces of a tile stay inside L1.
 pub(crate) const BLOCK: usize = 512;
 
+/// The `symmetric` kernel: each pair once with Newton's third law, on one thread.
 pub struct Symmetric<L> {
     law: L,
 }
 
 impl<L> Symmetric<L> {
+    /// The kernel for `law`.
     pub fn new(law: L) -> Self {
         Symmetric { law }
     }

@@ -42,10 +42,13 @@ impl Colors {
         Colors { parts, disjoint }
     }
 
+    /// Number of parts, both colours together.
     pub fn parts(&self) -> usize {
         self.parts
     }
 
+    /// Whether the parts of each colour touch disjoint places, so that a colour's parts can run at
+    /// once.
     pub fn disjoint(&self) -> bool {
         self.disjoint
     }
@@ -70,7 +73,9 @@ impl Colors {
 /// Read-only inputs of the pair work, valid between the barriers of a phase.
 #[derive(Clone, Copy)]
 pub struct StateView<'s, T, const D: usize> {
+    /// Positions, one slice per coordinate, in slot order.
     pub pos: [&'s [T]; D],
+    /// Source strengths, in slot order.
     pub source: &'s [T],
 }
 

@@ -13,10 +13,13 @@ use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// A file that could not be written, with the I/O error.
 #[derive(Debug, Error)]
 #[error("cannot write {path}: {source}")]
 pub struct WriteError {
+    /// The file.
     pub path: PathBuf,
+    /// The I/O error.
     #[source]
     pub source: io::Error,
 }
@@ -24,36 +27,66 @@ pub struct WriteError {
 /// Why an output path cannot be written; found before any work starts.
 #[derive(Debug, Error)]
 pub enum OutputError {
+    /// The path names a directory.
     #[error("{flag} {path}: is a directory; name a file")]
-    Directory { flag: String, path: PathBuf },
+    Directory {
+        /// The option that named the path, as typed.
+        flag: String,
+        /// The path as given.
+        path: PathBuf,
+    },
+    /// The path names a device, pipe or socket, which the atomic rename would replace.
     #[error(
         "{flag} {path}: is not a regular file (a device, pipe or socket); results are written \
          under a temporary name and renamed into place, which would replace it: name a file"
     )]
-    Special { flag: String, path: PathBuf },
+    Special {
+        /// The option that named the path, as typed.
+        flag: String,
+        /// The path as given.
+        path: PathBuf,
+    },
+    /// The path's directory does not exist.
     #[error("{flag} {path}: its directory {dir} does not exist; create it first")]
     NoDirectory {
+        /// The option that named the path, as typed.
         flag: String,
+        /// The path as given.
         path: PathBuf,
+        /// The missing directory.
         dir: PathBuf,
     },
+    /// The path is one of the command's inputs (or the same file by another path).
     #[error("{flag} {path}: is also an input of this command ({input}); it would be overwritten")]
     IsInput {
+        /// The option that named the path, as typed.
         flag: String,
+        /// The path as given.
         path: PathBuf,
+        /// The option that named the input it would overwrite.
         input: String,
     },
+    /// The path is a symbolic link whose target is missing or that loops.
     #[error(
         "{flag} {path}: is a symbolic link that leads nowhere (its target is missing, or the \
          links loop); writing it would replace the link: fix or remove the link, or name a file"
     )]
-    BrokenLink { flag: String, path: PathBuf },
+    BrokenLink {
+        /// The option that named the path, as typed.
+        flag: String,
+        /// The path as given.
+        path: PathBuf,
+    },
+    /// Two outputs of the command name the same file.
     #[error(
         "{flag} and {other} both name {path}; one output would be lost: give each its own file"
     )]
     Twice {
+        /// The option that named the path, as typed.
         flag: String,
+        /// The earlier output's option that names the same file.
         other: String,
+        /// The path as given.
         path: PathBuf,
     },
 }

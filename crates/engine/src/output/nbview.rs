@@ -11,6 +11,7 @@
 
 use std::io::{self, Read, Write};
 
+/// Which NBView encoding a trajectory is written in (`run --format`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 pub enum NbviewFormat {
@@ -66,8 +67,11 @@ pub(crate) fn write_frame(
 /// A binary trajectory read back: header and frames.
 #[derive(Debug, PartialEq)]
 pub struct Trajectory {
+    /// Particles per frame.
     pub n: u32,
+    /// Side of the view box [0, scale]²: the box side, or the initial extent of an open system.
     pub scale: f32,
+    /// Each frame's (x, y) positions, in particle-id order.
     pub frames: Vec<Vec<[f32; 2]>>,
 }
 

@@ -13,6 +13,7 @@ pub struct TemporaryDir {
 }
 
 impl TemporaryDir {
+    /// Creates a fresh private directory whose name starts with `prefix`.
     pub fn new(prefix: &str) -> io::Result<Self> {
         let mut builder = tempfile::Builder::new();
         builder.prefix(prefix);
@@ -26,6 +27,7 @@ impl TemporaryDir {
         Ok(TemporaryDir { dir })
     }
 
+    /// Where the directory is.
     pub fn path(&self) -> &Path {
         self.dir.path()
     }

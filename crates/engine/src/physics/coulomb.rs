@@ -3,6 +3,8 @@
 use super::{LawKind, PairLaw};
 use crate::real::{Real, select};
 
+/// The Coulomb pair law between charges (the per-particle source strengths), quenched at short
+/// range.
 #[derive(Clone, Copy, Debug)]
 pub struct Coulomb<T> {
     quench2: T,

@@ -3,6 +3,7 @@
 use super::{LawKind, PairLaw};
 use crate::real::Real;
 
+/// Newtonian gravity between masses (the per-particle source strengths), Plummer-softened.
 #[derive(Clone, Copy, Debug)]
 pub struct Gravity<T> {
     g: T,
@@ -12,6 +13,7 @@ pub struct Gravity<T> {
 }
 
 impl<T: Real> Gravity<T> {
+    /// The law with gravitational constant `g` and Plummer softening length `softening`.
     pub fn new(g: f64, softening: f64) -> Self {
         Gravity {
             g: T::of(g),

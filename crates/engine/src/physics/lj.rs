@@ -23,6 +23,8 @@ pub struct LennardJones<T> {
 }
 
 impl<T: Real> LennardJones<T> {
+    /// The law with well depth `epsilon`, particle size `sigma` and cutoff radius `rc` (length
+    /// units).
     pub fn new(epsilon: f64, sigma: f64, rc: f64) -> Self {
         let uc = (sigma * sigma / (rc * rc)).powi(3);
         LennardJones {

@@ -22,12 +22,17 @@ use serde::Serialize;
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum LawKind {
+    /// Lennard-Jones 12-6, truncated at a cutoff: short-ranged (cell list, Verlet list, cluster
+    /// pairs).
     LennardJones,
+    /// Quenched Coulomb between charges: inverse-square, long-ranged (trees, fmm).
     Coulomb,
+    /// Plummer-softened Newtonian gravity between masses: inverse-square, long-ranged.
     Gravity,
 }
 
 impl LawKind {
+    /// The law's name in results and dump headers.
     pub fn name(self) -> &'static str {
         match self {
             LawKind::LennardJones => "lennard-jones",
@@ -63,11 +68,26 @@ impl LawKind {
 #[serde(tag = "law", rename_all = "kebab-case")]
 pub enum LawParameters {
     /// Force truncated at `rc`, not shifted.
-    LennardJones { epsilon: f64, sigma: f64, rc: f64 },
+    LennardJones {
+        /// Well depth ε (energy unit).
+        epsilon: f64,
+        /// Particle size σ, where the potential crosses zero (length unit).
+        sigma: f64,
+        /// Cutoff radius beyond which the force is zero.
+        rc: f64,
+    },
     /// Force zeroed below `quench`.
-    Coulomb { quench: f64 },
+    Coulomb {
+        /// Distance below which the force is zero.
+        quench: f64,
+    },
     /// Plummer softening.
-    Gravity { g: f64, softening: f64 },
+    Gravity {
+        /// Gravitational constant G.
+        g: f64,
+        /// Plummer softening length ε.
+        softening: f64,
+    },
 }
 
 impl std::fmt::Display for LawParameters {
@@ -100,6 +120,7 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     /// The same law in f64, for reference computations.
     type Wide: PairLaw<f64>;
 
+    /// Which family the law belongs to.
     fn kind(&self) -> LawKind;
 
     /// The parameters the law was made with.
@@ -146,7 +167,9 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
 /// below `quench2` (gravity: k = G; Coulomb: k = −1, ε = 0, quenched).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct InverseSquare<T> {
+    /// Coupling constant: G for gravity, −1 for Coulomb (like charges repel).
     pub k: T,
+    /// Squared softening length ε² (0 for Coulomb).
     pub eps2: T,
     /// Zero for a law that is never quenched.
     pub quench2: T,

@@ -39,10 +39,13 @@ pub enum Work {
     Step,
 }
 
+/// Why a benchmark case cannot be prepared.
 #[derive(Debug, thiserror::Error)]
 pub enum BenchCaseError {
+    /// The scenario's set-up is invalid.
     #[error(transparent)]
     Setup(#[from] crate::scenario::SetupError),
+    /// The kernel does not apply to the system, or has no build phase to time; holds the message.
     #[error("{0}")]
     Kernel(String),
 }

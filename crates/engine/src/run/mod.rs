@@ -20,35 +20,52 @@ pub use outcome::{Counters, EnergyCheck, Measured, MomentumCheck, RunOutcome, Th
 /// What to run, besides the system.
 #[derive(Clone, Debug)]
 pub struct RunSpec {
+    /// The kernel that computes the forces.
     pub kernel: KernelKind,
+    /// Its parameters (θ, leaf size, skin, order, ...).
     pub params: KernelParams,
+    /// Steps to take, all timed.
     pub steps: u64,
+    /// Threads of the run's pool.
     pub threads: usize,
+    /// Where to write an NBView trajectory; `None`: no trajectory.
     pub trajectory: Option<TrajectorySpec>,
+    /// Where to write the final state (`--dump-state`); `None`: no dump.
     pub dump_state: Option<PathBuf>,
 }
 
+/// An NBView trajectory to write during a run (`--trajectory`).
 #[derive(Clone, Debug)]
 pub struct TrajectorySpec {
+    /// The file, written atomically when the run ends.
     pub path: PathBuf,
+    /// Text or binary NBView.
     pub format: NbviewFormat,
     /// A frame every this many steps (and the initial state).
     pub every: u64,
 }
 
+/// Why a run stopped before giving a result.
 #[derive(Debug, thiserror::Error)]
 pub enum RunError {
+    /// The kernel does not fit the law, the dimension or its parameters.
     #[error(transparent)]
     Kernel(#[from] crate::kernels::KernelError),
+    /// A particle left the box (too large a time step) or its position stopped being finite.
     #[error(transparent)]
     Boundary(#[from] crate::boundary::BoundaryError),
+    /// A trajectory or state dump could not be written.
     #[error(transparent)]
     Write(#[from] WriteError),
+    /// The thread pool could not be started.
     #[error("cannot start a pool of {threads} threads: {source}")]
     Pool {
+        /// Threads asked.
         threads: usize,
+        /// Rayon's error.
         source: rayon::ThreadPoolBuildError,
     },
+    /// The total energy stopped being finite.
     #[error(transparent)]
     EnergyBlowUp(#[from] crate::engine::EnergyBlowUp),
 }

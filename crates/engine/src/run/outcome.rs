@@ -15,39 +15,61 @@ pub(crate) const RUN_SCHEMA: &str = "nbody-bench/run/v1";
 /// The result of a run, as written by `run --json`.
 #[derive(Clone, Debug, Serialize)]
 pub struct RunOutcome {
+    /// Schema tag of the document, `nbody-bench/run/v1`: it changes when the layout does.
     pub schema: &'static str,
+    /// Version of the engine crate that ran (`CARGO_PKG_VERSION`).
     pub tool_version: &'static str,
+    /// Scenario name (`lj-box`, `galaxy`, ...).
     pub scenario: &'static str,
+    /// Kernel name, as `--kernel` takes it.
     pub kernel: &'static str,
+    /// Pair law name (`lennard-jones`, `coulomb`, `gravity`).
     pub law: &'static str,
+    /// Particles simulated (all ranks together in an MPI run).
     pub n: usize,
+    /// Particles asked; more than `n` when `--allow-fewer` let the placement put fewer.
     pub n_requested: usize,
+    /// Steps taken and timed.
     pub steps: u64,
+    /// Threads per process (the size of the run's thread pool).
     pub threads: usize,
     /// Threads exceed the machine's logical CPUs.
     pub oversubscribed: bool,
+    /// Spatial dimension, 2 or 3.
     pub dim: usize,
+    /// Floating-point precision, `f32` or `f64`.
     pub precision: &'static str,
+    /// Seed of the initial state.
     pub seed: u64,
+    /// Time step, in simulated time units.
     pub dt: f64,
+    /// Particles per unit area of the Lennard-Jones box; `None` for scenarios without one.
     pub density: Option<f64>,
+    /// Side of the reflecting box, √(n/ρ); `None` in open space.
     pub box_side: Option<f64>,
     /// The initial-state file the bodies came from (`run --initial`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub initial: Option<String>,
+    /// The kernel parameters the run used (θ, leaf size, skin, order, ...).
     pub kernel_params: KernelParams,
     /// Instruction set the pair loops ran with.
     pub simd: &'static str,
+    /// Wall time, per-step percentiles and time per phase.
     pub timing: Timing,
+    /// Particle-steps and pair evaluations per second of step time.
     pub throughput: Throughput,
+    /// The kernels' work counters.
     pub counters: Counters,
+    /// Energies before and after the run, and their relative drift.
     pub energy: EnergyCheck,
+    /// Total momentum before and after the run.
     pub momentum: MomentumCheck,
     /// Ranks, decomposition and per-rank statistics of an MPI run (`--decomp`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mpi: Option<MpiReport>,
 }
 
+/// Where a run's time went: the whole loop, each step, each phase.
 #[derive(Clone, Debug, Serialize)]
 pub struct Timing {
     /// Wall time of the stepping loop, including trajectory output.
@@ -64,6 +86,7 @@ pub struct Timing {
     pub ns_per_particle_step: f64,
 }
 
+/// Rates over the summed step time (output excluded).
 #[derive(Clone, Debug, Serialize)]
 pub struct Throughput {
     /// n × steps / (sum of step times).
@@ -72,6 +95,7 @@ pub struct Throughput {
     pub pair_evals_per_s: f64,
 }
 
+/// The work a run's force computations did, counted by the kernels.
 #[derive(Clone, Debug, Serialize)]
 pub struct Counters {
     /// Work summed over the timed steps.
@@ -82,9 +106,12 @@ pub struct Counters {
     pub pairs_interacting_final: u64,
 }
 
+/// Energy conservation of a run: the energies before and after, and the drift.
 #[derive(Clone, Debug, Serialize)]
 pub struct EnergyCheck {
+    /// Energies before the first step.
     pub initial: Energy,
+    /// Energies after the last step (`final` in the JSON).
     #[serde(rename = "final")]
     pub last: Energy,
     /// (E_final − E_initial) / |E_initial|.
@@ -93,19 +120,27 @@ pub struct EnergyCheck {
     pub(crate) lj_potential: &'static str,
 }
 
+/// Total momentum Σ m·v (in f64, one component per dimension) before and after a run.
 #[derive(Clone, Debug, Serialize)]
 pub struct MomentumCheck {
+    /// Before the first step.
     pub initial: Vec<f64>,
+    /// After the last step (`final` in the JSON).
     #[serde(rename = "final")]
     pub last: Vec<f64>,
 }
 
 /// What a run measured, serially or over MPI ranks; [`RunOutcome::new`] derives the rest.
 pub struct Measured<'a> {
+    /// Facts about the system (scenario, n asked, seed, time step, box).
     pub info: &'a SystemInfo,
+    /// Pair law name (`lennard-jones`, `coulomb`, `gravity`).
     pub law: &'static str,
+    /// The kernel that computed the forces.
     pub kernel: KernelKind,
+    /// The kernel parameters used.
     pub params: KernelParams,
+    /// Particles simulated (all ranks together in an MPI run).
     pub n: usize,
     /// Timed steps (warm-up excluded).
     pub steps: u64,
@@ -121,11 +156,13 @@ pub struct Measured<'a> {
     pub phases: PhaseTimes,
     /// Work summed over the timed steps.
     pub work: WorkCounters,
+    /// Pairs within interaction range in the final state (from the energy probe).
     pub pairs_interacting_final: u64,
     /// Energies before the first and after the last step.
     pub energy: [Energy; 2],
     /// Total momentum before and after.
     pub momentum: [Vec<f64>; 2],
+    /// The ranks' report of an MPI run; `None` for a serial run.
     pub mpi: Option<MpiReport>,
 }
 

@@ -12,6 +12,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use std::f64::consts::PI;
 
+/// Gravitational constant of the galaxy scenario, in its units (AU, 10⁻³ M☉): 1.
 pub const G: f64 = 1.0;
 /// Plummer softening: small against the cloud's scale radius, large enough that close
 /// encounters of light bodies are resolved at dt = 1e-3.

@@ -27,6 +27,7 @@ pub const EXPORT_HEADER: &str = "# nbody-bench initial state v1";
 const EXPORT_PREFIX: &str = "# nbody-bench initial state";
 const BARNES_HUT_COLUMNS: [&str; 7] = ["m", "x", "y", "z", "vx", "vy", "vz"];
 
+/// Which of the two initial-state formats a file is in, told apart by its first line.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum InitialFormat {
@@ -37,6 +38,7 @@ pub enum InitialFormat {
 }
 
 impl InitialFormat {
+    /// The format's name in messages: `export` or `barnes-hut`.
     pub fn name(self) -> &'static str {
         match self {
             InitialFormat::Export => "export",
@@ -48,8 +50,11 @@ impl InitialFormat {
 /// One body as read, in f64 and up to 3-D (unused components are 0).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Body {
+    /// Position; components past the file's dimension are 0.
     pub pos: [f64; 3],
+    /// Velocity; components past the file's dimension are 0.
     pub vel: [f64; 3],
+    /// Inertial mass, always positive.
     pub mass: f64,
     /// The law's source strength: charge (coulomb), gravitational mass (gravity).
     pub strength: f64,
@@ -60,8 +65,11 @@ pub struct Body {
 /// The bodies of an initial-state file.
 #[derive(Clone, PartialEq)]
 pub struct InitialBodies {
+    /// The file the bodies were read from, named in errors and in the run's results.
     pub path: PathBuf,
+    /// The format the file was read as.
     pub format: InitialFormat,
+    /// Spatial dimension of the bodies, 2 or 3 (a Barnes-Hut file is always 3).
     pub dim: usize,
     /// The line that fixes the dimension (the columns line, or the first body).
     dim_line: usize,
@@ -83,23 +91,37 @@ impl std::fmt::Debug for InitialBodies {
     }
 }
 
+/// Why an initial-state file cannot start a run.
 #[derive(Debug, Error)]
 pub enum InitialError {
+    /// The file could not be read (missing, unreadable, a device, or too large).
     #[error("cannot read initial state {}: {source}", path.display())]
     Read {
+        /// The initial-state file.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
+    /// The file holds comments and blank lines only.
     #[error(
         "initial state {}: no bodies ({lines} lines of comments and blank lines): a body file \
          has one body per line",
         path.display()
     )]
-    Empty { path: PathBuf, lines: usize },
+    Empty {
+        /// The initial-state file.
+        path: PathBuf,
+        /// Lines in the file, all comments or blank.
+        lines: usize,
+    },
+    /// One line of the file is wrong; the problem says how.
     #[error("initial state {} line {line}: {problem}", path.display())]
     Line {
+        /// The initial-state file.
         path: PathBuf,
+        /// The line, counted from 1.
         line: usize,
+        /// What is wrong on it.
         problem: LineProblem,
     },
 }
@@ -107,69 +129,113 @@ pub enum InitialError {
 /// What is wrong on one line of an initial-state file.
 #[derive(Debug, Error, PartialEq)]
 pub enum LineProblem {
+    /// The header names a version of the export format this tool does not read; holds the header.
     #[error(
         "`{0}` is not a version this tool reads (it reads `{EXPORT_HEADER}`, as \
          `nbody-bench export --format text` writes)"
     )]
     Version(String),
+    /// The `# columns:` line is neither the 2-D nor the 3-D export columns; holds the columns
+    /// given.
     #[error(
         "columns `{0}` are not those of an exported state (`id x y vx vy mass strength` in 2-D, \
          `id x y z vx vy vz mass strength` in 3-D)"
     )]
     Columns(String),
+    /// An exported state has a body before its `# columns:` line.
     #[error("a body before the `# columns:` line: an exported state names its columns first")]
     NoColumns,
+    /// An exported state has a second `# columns:` line.
     #[error(
         "a second `# columns:` line (the first is line {first}): one file holds bodies of one \
          dimension; remove one of them"
     )]
-    ColumnsTwice { first: usize },
+    ColumnsTwice {
+        /// The line of the first `# columns:` line.
+        first: usize,
+    },
+    /// A body line has the wrong number of values.
     #[error("{found} values where {} were expected ({})", .want.len(), .want.join(" "))]
     Count {
+        /// Values on the line.
         found: usize,
+        /// The column names expected, in order.
         want: Vec<&'static str>,
     },
+    /// A value does not parse as a number.
     #[error("`{text}` (column {column}, {name}) is not a number")]
     NotANumber {
+        /// The text found.
         text: String,
+        /// Its column, counted from 1.
         column: usize,
+        /// The column's name (`x`, `mass`, ...).
         name: &'static str,
     },
+    /// A value is NaN or infinite.
     #[error("{name} (column {column}) is {value}: every value must be finite")]
     NotFinite {
+        /// The value read.
         value: f64,
+        /// Its column, counted from 1.
         column: usize,
+        /// The column's name (`x`, `mass`, ...).
         name: &'static str,
     },
+    /// A body's mass is 0 or negative; holds the mass.
     #[error("mass {0} is not positive: every body needs a mass greater than 0")]
     Mass(f64),
+    /// An exported body's id is not a number below the body count.
     #[error("id `{text}` is not one of 0..{n} (ids count the bodies from 0)")]
-    Id { text: String, n: usize },
+    Id {
+        /// The id as written.
+        text: String,
+        /// Bodies in the file: ids run over 0..n.
+        n: usize,
+    },
+    /// Two exported bodies have the same id.
     #[error("id {id} is given twice (again on line {again})")]
-    DuplicateId { id: usize, again: usize },
+    DuplicateId {
+        /// The repeated id.
+        id: usize,
+        /// The line where it appears again (the error is reported at the first).
+        again: usize,
+    },
+    /// The bodies' dimension is not the scenario's.
     #[error("the bodies are {file}-D ({format} format) but scenario `{scenario}` is {want}-D")]
     Dimension {
+        /// Dimension of the bodies in the file.
         file: usize,
+        /// Name of the file's format.
         format: &'static str,
+        /// The scenario asked for, by its command-line name.
         scenario: &'static str,
+        /// The scenario's dimension.
         want: usize,
     },
+    /// A Barnes-Hut file (masses only) was given to coulomb, which needs charges.
     #[error(
         "a Barnes-Hut body file gives masses, not charges, so it cannot start coulomb: write \
          the bodies as an exported state (`nbody-bench export --format text` shows the columns), \
          whose strength column is the charge"
     )]
     NoCharges,
+    /// A body's gravitational mass is negative in a gravity scenario; holds the strength.
     #[error("gravitational mass (strength) {0} is negative; gravity needs strengths of 0 or more")]
     NegativeStrength(f64),
+    /// A body lies outside the scenario's reflecting box.
     #[error(
         "the body at {pos:?} is outside the reflecting box [0, {side}]^{dim} (scenario \
          `{scenario}`, side sqrt(n / density)): move it inside, or change --density"
     )]
     OutsideBox {
+        /// Its position, in the file's dimension.
         pos: Vec<f64>,
+        /// Side of the box, √(n/ρ).
         side: f64,
+        /// Dimension of the box.
         dim: usize,
+        /// The scenario asked for, by its command-line name.
         scenario: &'static str,
     },
 }
@@ -384,10 +450,12 @@ fn export_columns(dim: usize) -> Vec<&'static str> {
 }
 
 impl InitialBodies {
+    /// Number of bodies.
     pub fn len(&self) -> usize {
         self.bodies.len()
     }
 
+    /// Whether the file held no bodies (never true for a file that parsed).
     pub fn is_empty(&self) -> bool {
         self.bodies.is_empty()
     }

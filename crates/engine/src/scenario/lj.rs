@@ -35,7 +35,10 @@ pub const LJ_GRAVITY: f64 = 1.0;
 /// The Lennard-Jones parameters a run changes; `None` keeps the scenario's.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct LjOverrides {
+    /// Well depth ε (`--epsilon`); `None`: [`LJ_EPSILON`].
     pub epsilon: Option<f64>,
+    /// Particle size σ (`--sigma`), also the minimum spacing of the placement; `None`:
+    /// [`LJ_SIGMA`].
     pub sigma: Option<f64>,
     /// Downward acceleration of the external field.
     pub g: Option<f64>,
@@ -44,18 +47,22 @@ pub struct LjOverrides {
 }
 
 impl LjOverrides {
+    /// Well depth ε: the override, else [`LJ_EPSILON`].
     pub fn epsilon(&self) -> f64 {
         self.epsilon.unwrap_or(LJ_EPSILON)
     }
 
+    /// Particle size σ: the override, else [`LJ_SIGMA`].
     pub fn sigma(&self) -> f64 {
         self.sigma.unwrap_or(LJ_SIGMA)
     }
 
+    /// Cutoff radius: [`LJ_CUTOFF_SIGMAS`] times σ.
     pub fn cutoff(&self) -> f64 {
         LJ_CUTOFF_SIGMAS * self.sigma()
     }
 
+    /// Initial temperature: the override, else [`LJ_T0`].
     pub fn t0(&self) -> f64 {
         self.t0.unwrap_or(LJ_T0)
     }

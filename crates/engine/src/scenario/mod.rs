@@ -42,6 +42,7 @@ pub enum ScenarioKind {
 }
 
 impl ScenarioKind {
+    /// Every scenario, in the order `list` and `validate` go through them.
     pub const ALL: [ScenarioKind; 4] = [
         ScenarioKind::LjBox,
         ScenarioKind::LjLiquid,
@@ -49,6 +50,7 @@ impl ScenarioKind {
         ScenarioKind::Galaxy,
     ];
 
+    /// The scenario's name on the command line and in results (kebab-case, as serde writes it).
     pub fn name(self) -> &'static str {
         match self {
             ScenarioKind::LjBox => "lj-box",
@@ -58,6 +60,7 @@ impl ScenarioKind {
         }
     }
 
+    /// The pair law its particles interact by.
     pub fn law(self) -> LawKind {
         match self {
             ScenarioKind::LjBox | ScenarioKind::LjLiquid => LawKind::LennardJones,
@@ -66,6 +69,7 @@ impl ScenarioKind {
         }
     }
 
+    /// Spatial dimension: 2 for the Lennard-Jones boxes, 3 for coulomb and galaxy.
     pub fn dim(self) -> usize {
         match self {
             ScenarioKind::LjBox | ScenarioKind::LjLiquid => 2,
@@ -73,6 +77,7 @@ impl ScenarioKind {
         }
     }
 
+    /// Particle count, time step, precision and density used where the user gives none.
     pub fn defaults(self) -> Defaults {
         match self {
             ScenarioKind::LjBox => Defaults {
@@ -129,18 +134,24 @@ pub(crate) const COULOMB_QUENCH: f64 = 1e-3;
 /// A scenario's defaults.
 #[derive(Clone, Copy, Debug)]
 pub struct Defaults {
+    /// Particle count when `-n` is not given.
     pub n: usize,
+    /// Time step, in the scenario's simulated time units.
     pub dt: f64,
+    /// Precision when `--precision` is not given.
     pub precision: Precision,
     /// Particles per unit area, for the scenarios that have a density parameter.
     pub density: Option<f64>,
 }
 
+/// Floating-point precision of positions, velocities and forces.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize)]
 #[cfg_attr(feature = "clap", derive(clap::ValueEnum))]
 #[serde(rename_all = "kebab-case")]
 pub enum Precision {
+    /// 32-bit floats: the Lennard-Jones scenarios' default.
     F32,
+    /// 64-bit floats: the default of coulomb and galaxy.
     F64,
 }
 
@@ -153,6 +164,7 @@ impl Precision {
         }
     }
 
+    /// `f32` or `f64`, as the command line and the results write it.
     pub fn name(self) -> &'static str {
         match self {
             Precision::F32 => "f32",
@@ -164,11 +176,18 @@ impl Precision {
 /// A scenario with the user's overrides; `None` means the scenario's default.
 #[derive(Clone, Debug)]
 pub struct Setup {
+    /// The physical set-up to build.
     pub scenario: ScenarioKind,
+    /// Particle count asked (`-n`); `None`: the scenario's default (an initial-state file sets it
+    /// instead).
     pub n: Option<usize>,
+    /// Seed of the random placement and velocities: the same seed builds the same state.
     pub seed: u64,
+    /// Time step in simulated time units; `None`: the scenario's default.
     pub dt: Option<f64>,
+    /// Particles per unit area (Lennard-Jones scenarios only; the box side becomes √(n/ρ)).
     pub density: Option<f64>,
+    /// Precision to run in; `None`: the scenario's default (f32 for LJ, f64 otherwise).
     pub precision: Option<Precision>,
     /// Accept fewer particles than asked when the box cannot hold `n` at minimum spacing.
     pub allow_fewer: bool,
@@ -179,62 +198,90 @@ pub struct Setup {
     pub lj: LjOverrides,
 }
 
+/// Why a [`Setup`] cannot be built.
 #[derive(Debug, Error)]
 pub enum SetupError {
+    /// The particle count is 0.
     #[error("n must be at least 1 (got 0)")]
     ZeroParticles,
+    /// The particle count is above 2^29, the most particle ids (`u32`) and memory allow.
     #[error("n = {0} is more than this tool handles (at most {MAX_PARTICLES} particles)")]
     TooManyParticles(usize),
+    /// The time step is zero, negative or not finite.
     #[error("--dt must be a positive finite number (got {0})")]
     BadDt(f64),
+    /// The density given is zero, negative or not finite.
     #[error("--density must be a positive finite number (got {0})")]
     BadDensity(f64),
+    /// A density was given to a scenario that has none (coulomb, galaxy); holds its name.
     #[error("scenario `{0}` has no density parameter; drop --density")]
     NoDensity(&'static str),
+    /// The box side √(n/ρ) is so large that positions in this precision cannot resolve σ near the
+    /// far wall.
     #[error(
         "a box of side {side:.3e} ({n} particles at density {density:e}) is too large for {precision} \
          positions to resolve the particle size σ = {sigma}: raise --density, lower -n, or use \
          --precision f64"
     )]
     BoxTooLarge {
+        /// Side of the box, √(n/ρ).
         side: f64,
+        /// Particle count.
         n: usize,
+        /// Particles per unit area.
         density: f64,
+        /// Precision name, `f32` or `f64`.
         precision: &'static str,
+        /// Particle size σ that positions must resolve.
         sigma: f64,
     },
+    /// The seeded placement could not fit the particles at minimum spacing σ.
     #[error(transparent)]
     Placement(#[from] PlacementError),
+    /// A Lennard-Jones option was given to a scenario of another law: the flag and the scenario's
+    /// name.
     #[error(
         "{flag} applies to the Lennard-Jones scenarios (lj-box, lj-liquid) only; scenario `{1}` \
          has no such parameter: drop it", flag = .0
     )]
     NotLj(&'static str, &'static str),
+    /// A Lennard-Jones option has a value the physics cannot use (ε or σ not positive, g or T0 not
+    /// finite, T0 < 0).
     #[error("{flag} must be {want} (got {got})")]
     BadLj {
+        /// The option, as the command line names it (`--sigma`, ...).
         flag: &'static str,
+        /// What it accepts, in words.
         want: &'static str,
+        /// The value given.
         got: f64,
     },
+    /// `-n` differs from the number of bodies in the initial-state file.
     #[error(
         "n = {n} was asked but the initial state {} holds {bodies} bodies: drop -n (the file \
          sets n) or give -n {bodies}", path.display()
     )]
     InitialCount {
+        /// The initial-state file.
         path: std::path::PathBuf,
+        /// The count asked with `-n`.
         n: usize,
+        /// Bodies in the file.
         bodies: usize,
     },
+    /// `--t0` was given with an initial-state file, whose bodies carry their own velocities.
     #[error(
         "--t0 sets the velocities of generated particles; the bodies of the initial state {} \
          carry their own: drop --t0", .0.display()
     )]
     T0WithInitial(std::path::PathBuf),
+    /// The initial-state file could not be read, or its bodies do not fit the scenario.
     #[error(transparent)]
     Initial(#[from] InitialError),
 }
 
 impl Setup {
+    /// The scenario with no overrides: its defaults, seed 1.
     pub fn new(scenario: ScenarioKind) -> Self {
         Setup {
             scenario,
@@ -257,10 +304,12 @@ impl Setup {
         }
     }
 
+    /// The time step in simulated time units: the override, else the scenario's default.
     pub fn dt(&self) -> f64 {
         self.dt.unwrap_or(self.scenario.defaults().dt)
     }
 
+    /// The precision: the override, else the scenario's default.
     pub fn precision(&self) -> Precision {
         self.precision.unwrap_or(self.scenario.defaults().precision)
     }
@@ -413,14 +462,21 @@ impl Setup {
 /// Facts about a built system, for summaries and results.
 #[derive(Clone, Debug, Serialize)]
 pub struct SystemInfo {
+    /// The scenario built.
     pub scenario: ScenarioKind,
     /// Particles actually placed.
     pub n: usize,
+    /// Particles asked; more than `n` when `--allow-fewer` let the placement put fewer.
     pub n_requested: usize,
+    /// Seed of the placement and velocities.
     pub seed: u64,
+    /// Time step, in simulated time units.
     pub dt: f64,
+    /// Precision the system runs in.
     pub precision: Precision,
+    /// Particles per unit area of the Lennard-Jones box; `None` for scenarios without one.
     pub density: Option<f64>,
+    /// Side of the reflecting box, √(n/ρ); `None` in open space.
     pub box_side: Option<f64>,
     /// The file the bodies came from (`run --initial`), else none: the seed placed them.
     pub initial: Option<String>,
@@ -429,18 +485,25 @@ pub struct SystemInfo {
 /// A ready-to-run system in concrete types.
 #[derive(Clone, Debug)]
 pub struct System<T: Real, L, const D: usize> {
+    /// Positions, velocities, masses and source strengths of the particles.
     pub state: State<T, D>,
+    /// The pair law, with the scenario's parameters.
     pub law: L,
+    /// Reflecting walls or open space.
     pub boundary: Boundary<T, D>,
     /// Constant external acceleration on every particle (the lj-box field).
     pub external: [T; D],
+    /// Time step in simulated time units, in the system's precision.
     pub dt: T,
+    /// What was built, for summaries and results.
     pub info: SystemInfo,
 }
 
 /// Work that runs on a system whatever its types (the visitor of [`Setup::dispatch`]).
 pub trait SystemJob {
+    /// What the job gives back, the same type whatever the system's.
     type Output;
+    /// Runs the job on `system`, compiled for its precision, pair law and dimension.
     fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
         self,
         system: System<T, L, D>,

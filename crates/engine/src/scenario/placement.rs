@@ -3,15 +3,19 @@
 use rand::Rng;
 use thiserror::Error;
 
+/// The box cannot hold the particles asked at minimum spacing σ (random placement gave up).
 #[derive(Debug, Error)]
 #[error(
     "could place only {placed} of {requested} particles at minimum spacing {min_dist} in a box of side {side:.4}; \
      lower -n or --density, or pass --allow-fewer to run with {placed}"
 )]
 pub struct PlacementError {
+    /// Particles placed before giving up.
     pub placed: usize,
+    /// Particles asked.
     pub requested: usize,
     pub(crate) min_dist: f64,
+    /// Side of the box.
     pub side: f64,
 }
 

@@ -6,11 +6,17 @@ use serde::Serialize;
 /// Order statistics of per-step times in nanoseconds.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, serde::Deserialize)]
 pub struct StepPercentiles {
+    /// Fastest step.
     pub min: u64,
+    /// Median step.
     pub p50: u64,
+    /// 90th percentile.
     pub p90: u64,
+    /// 99th percentile.
     pub p99: u64,
+    /// Slowest step.
     pub max: u64,
+    /// Mean step time, from the histogram's values (to its three digits).
     pub mean: f64,
 }
 
@@ -30,6 +36,7 @@ impl Default for StepHistogram {
 }
 
 impl StepHistogram {
+    /// An empty histogram.
     pub fn new() -> Self {
         StepHistogram {
             hist: hdrhistogram::Histogram::new_with_bounds(1, 3_600_000_000_000, 3)
@@ -48,6 +55,7 @@ impl StepHistogram {
         h
     }
 
+    /// Records one step of `ns` nanoseconds (0 counts as 1 ns).
     pub fn record(&mut self, ns: u64) {
         self.record_n(ns, 1);
     }

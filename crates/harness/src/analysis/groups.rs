@@ -21,12 +21,17 @@ pub struct Point {
     /// from the key.
     #[serde(skip)]
     pub case: nbody_records::plan::Case,
+    /// The case's key in the results file, unique there; what tables and figures name it by.
     pub key: String,
+    /// Particles simulated.
     pub n: usize,
+    /// Threads per rank.
     pub threads: usize,
+    /// MPI ranks (1 without MPI).
     pub ranks: usize,
     /// Simulated-time factor of a weak-by-time case (1 otherwise).
     pub time_factor: u64,
+    /// The opening angle θ (octree and fmm cases only).
     pub theta: Option<f64>,
     /// MPI decomposition of a case run under a launcher.
     pub decomp: Option<Decomposition>,
@@ -44,21 +49,28 @@ pub struct Point {
     /// Seconds per step: every raw sample, the median and its bootstrap 95% CI.
     #[serde(skip)]
     pub samples: Vec<f64>,
+    /// The median of `samples`, seconds per step.
     pub median_s: f64,
+    /// The bootstrap 95% CI of that median, `[low, high]` seconds per step.
     pub ci95_s: [f64; 2],
+    /// Threads × ranks exceeded the machine's logical CPUs (time-sharing, left out of fits).
     pub oversubscribed: bool,
+    /// The median step time per particle, nanoseconds.
     pub ns_per_particle_step: f64,
     /// `None` when the code counted no pair (an external program).
     pub pair_evals_per_s: Option<f64>,
+    /// Seconds per step in each of the engine's phases, averaged over rounds.
     pub phases: PhaseTimes,
     /// The phases an external program timed itself (`phases`), by name.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub named_phases: Vec<NamedPhase>,
     /// `None` when no step was timed alone (an external program is timed per run).
     pub step_ns: Option<StepPercentiles>,
+    /// Median and largest relative force error, `[median, max]`; `None` when not measured.
     pub force_error: Option<[f64; 2]>,
     /// `None` when nothing measured the energy (an external program).
     pub max_energy_drift: Option<f64>,
+    /// Whether that drift stayed within the config's `max_energy_drift`; `None` without a drift.
     pub sanity_ok: Option<bool>,
 }
 
@@ -99,8 +111,11 @@ impl Point {
 /// A phase an external program timed: seconds per step, the mean over its successful runs.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct NamedPhase {
+    /// The phase's name as the program's `[[external]]` entry gives it.
     pub name: String,
+    /// Whether the phase is parallel, serial or communication.
     pub kind: PhaseKind,
+    /// Seconds per step in the phase, the mean over successful runs.
     pub s_per_step: f64,
 }
 
@@ -135,9 +150,13 @@ fn named_phases(r: &CaseRecord, ext: Option<&External>) -> Vec<NamedPhase> {
 /// What a series holds fixed. `None` fields vary along the series or do not apply.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SeriesKey {
+    /// The scenario every case of the series simulates.
     pub scenario: ScenarioKind,
+    /// The kernel or external program; an external family's name for a θ series of its members.
     pub kernel: KernelOrProgram,
+    /// The floating-point precision (the scenario's default when the case set none).
     pub precision: Precision,
+    /// The opening angle; `None` along a θ series or for codes without one.
     pub theta: Option<f64>,
     /// The octree's expansion order (absent from the JSON when monopole, as in case keys).
     #[serde(skip_serializing_if = "nbody_records::plan::is_monopole")]
@@ -148,9 +167,13 @@ pub struct SeriesKey {
     /// The neighbour-list skin, when the config set one.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub skin: Option<f64>,
+    /// The particle count; `None` along a complexity series and a weak-scaling one.
     pub n: Option<usize>,
+    /// Threads per rank; `None` along a strong- or weak-scaling series.
     pub threads: Option<usize>,
+    /// MPI ranks; `None` along a strong- or weak-scaling series.
     pub ranks: Option<usize>,
+    /// The MPI decomposition; `None` for cases run without a launcher.
     pub decomp: Option<Decomposition>,
 }
 
@@ -211,7 +234,9 @@ pub(crate) fn workers_noun(cases: impl IntoIterator<Item = (usize, usize)>) -> &
 /// Cases that differ only in the quantity the series varies, sorted by it.
 #[derive(Clone, Debug, Serialize)]
 pub struct Series {
+    /// What the cases have in common.
     pub key: SeriesKey,
+    /// The cases, sorted by the quantity the series varies (n, p, θ or force error).
     pub points: Vec<Point>,
 }
 

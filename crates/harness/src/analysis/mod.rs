@@ -30,7 +30,9 @@ pub(crate) const FITS_SCHEMA: &str = "nbody-bench/fits/v1";
 /// A fit, or why there is none (too few points, …): a series is never dropped silently.
 #[derive(Clone, Debug, Serialize)]
 pub struct Fitted<T> {
+    /// The fit; `None` when it was refused.
     pub fit: Option<T>,
+    /// Why the fit was refused (a [`fit::FitError`]'s message); `None` when there is a fit.
     pub error: Option<String>,
 }
 
@@ -49,11 +51,15 @@ impl<T> Fitted<T> {
     }
 }
 
+/// A series over n at fixed workers and the power law and complexity class fitted to it.
 #[derive(Clone, Debug, Serialize)]
 pub struct ComplexityAnalysis {
+    /// What the series' cases have in common.
     pub series: SeriesKey,
     pub(crate) label: String,
+    /// The cases, in increasing n.
     pub points: Vec<Point>,
+    /// The power law and complexity class fitted to their step times.
     pub fit: Fitted<PowerFit>,
 }
 
@@ -71,10 +77,13 @@ pub(crate) struct Crossover {
     pub n: Option<f64>,
 }
 
+/// A series over p at fixed n (from p = 1) and the strong-scaling models fitted to it.
 #[derive(Clone, Debug, Serialize)]
 pub struct StrongAnalysis {
+    /// What the series' cases have in common.
     pub series: SeriesKey,
     pub(crate) label: String,
+    /// The cases, in increasing p (threads × ranks), oversubscribed ones included.
     pub points: Vec<Point>,
     /// Speedup and efficiency at every measured p, oversubscribed ones included.
     pub measured: Vec<fit::StrongPoint>,
@@ -87,11 +96,15 @@ pub struct StrongAnalysis {
     pub(crate) serial_comparison: Option<SerialFractionComparison>,
 }
 
+/// A weak-scaling series over p (from p = 1) and Gustafson's model fitted to it.
 #[derive(Clone, Debug, Serialize)]
 pub struct WeakAnalysis {
+    /// What the series' cases have in common.
     pub series: SeriesKey,
     pub(crate) label: String,
+    /// How the sweep's config grows the problem with p; `None` when it has no `[weak]` table.
     pub rule: Option<WeakRule>,
+    /// The cases, in increasing p, oversubscribed ones included.
     pub points: Vec<Point>,
     /// Efficiency at every measured p, oversubscribed ones included.
     pub measured: Vec<fit::EfficiencyPoint>,
@@ -99,26 +112,40 @@ pub struct WeakAnalysis {
     pub fit: Fitted<WeakFit>,
 }
 
+/// A tree code over θ (or an external family over its accuracy settings) at fixed n and p.
 #[derive(Clone, Debug, Serialize)]
 pub struct ThetaAnalysis {
+    /// What the series' cases have in common.
     pub series: SeriesKey,
     pub(crate) label: String,
+    /// The cases, in increasing θ (a family's members in increasing force error).
     pub points: Vec<Point>,
 }
 
 /// Everything `analyze` derives from one results file (`fits.json`).
 #[derive(Clone, Debug, Serialize)]
 pub struct Analysis {
+    /// The format of `fits.json`: `nbody-bench/fits/v1`.
     pub schema: String,
+    /// The path of the results file analysed, as given.
     pub source: String,
+    /// The sweep's name from its config.
     pub name: String,
+    /// What the sweep studies (strong, weak, complexity or every combination).
     pub study: Study,
+    /// The machine, build and commit the results were measured with.
     pub metadata: Metadata,
+    /// The machine's calibrated peaks and parallel ceilings (start and end readings merged);
+    /// `None` when the sweep ran without a calibration.
     pub calibration: Option<Calibration>,
+    /// Every series over n, with its fit.
     pub complexity: Vec<ComplexityAnalysis>,
     pub(crate) crossovers: Vec<Crossover>,
+    /// Every strong-scaling series, with its fits.
     pub strong: Vec<StrongAnalysis>,
+    /// Every weak-scaling series, with its fit.
     pub weak: Vec<WeakAnalysis>,
+    /// Every accuracy series (over θ or an external family's settings).
     pub theta: Vec<ThetaAnalysis>,
     /// Our kernels next to the external programs of the same sweep.
     #[serde(skip_serializing_if = "Vec::is_empty")]
@@ -163,10 +190,15 @@ impl Analysis {
     }
 }
 
+/// Why a results file could not be analysed.
 #[derive(Debug, Error)]
 pub enum AnalysisError {
+    /// The results file has no complete case yet (a sweep interrupted before any finished).
     #[error("{path} has no complete case to analyse; finish it with `nbody-bench sweep --resume`")]
-    Empty { path: PathBuf },
+    Empty {
+        /// The results file.
+        path: PathBuf,
+    },
 }
 
 /// Fits every series of `results` (read from `source`, for the record).

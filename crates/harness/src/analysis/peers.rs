@@ -25,20 +25,26 @@ const SEED: u64 = 0x9EE2;
 /// One of our cases next to the fastest external case of the same system and workers.
 #[derive(Clone, Debug, Serialize)]
 pub struct PeerRatio {
+    /// The scenario both cases simulate, by name.
     pub scenario: String,
+    /// Particles, the same for both.
     pub n: usize,
     /// Threads × ranks, the same for both.
     pub workers: usize,
+    /// Our case's label: kernel, θ, expansion, workers.
     pub ours: String,
+    /// The fastest external case's label.
     pub theirs: String,
     /// Nanoseconds per particle-step: median and bootstrap 95% CI.
     pub(crate) ours_ns: f64,
     pub(crate) ours_ci_ns: [f64; 2],
+    /// Their median, nanoseconds per particle-step.
     pub theirs_ns: f64,
     pub(crate) theirs_ci_ns: [f64; 2],
     /// Their time over ours (> 1: ours is faster), from the medians, with the bootstrap 95%
     /// CI of that ratio over both sets of samples.
     pub speedup: f64,
+    /// The bootstrap 95% CI of `speedup`; `None` when either case has no samples.
     pub speedup_ci: Option<[f64; 2]>,
     /// Median relative force errors, where measured.
     pub(crate) ours_error: Option<f64>,
@@ -55,11 +61,14 @@ pub struct PeerRatio {
 /// of ours.
 #[derive(Clone, Debug, Serialize)]
 pub struct PeerVariant {
+    /// The external case's label.
     pub theirs: String,
+    /// Its median, nanoseconds per particle-step.
     pub theirs_ns: f64,
     pub(crate) theirs_ci_ns: [f64; 2],
     /// Its time over ours (from the medians).
     pub speedup: f64,
+    /// It or our case ran more workers than logical CPUs.
     pub oversubscribed: bool,
 }
 

@@ -39,12 +39,16 @@ pub(crate) const TREE_DECOMPS: [Decomposition; 3] = [
 /// Counted bytes per step of one decomposition at one rank count.
 #[derive(Clone, Debug, Serialize)]
 pub struct Counted {
+    /// The rank count p.
     pub ranks: usize,
+    /// The galaxy's bodies, `n_per_rank · p`.
     pub n: usize,
+    /// The decomposition counted (allgather, octants or tree).
     pub decomp: Decomposition,
     /// Mean and largest over the ranks of the bytes sent per step.
     pub(crate) bytes_mean: f64,
     pub(crate) bytes_max: f64,
+    /// Messages (latencies) per step per rank, from [`messages`].
     pub messages: f64,
     /// Max over mean of the bodies per rank (the load imbalance of the concentrated cloud).
     pub(crate) bodies_imbalance: f64,
@@ -61,10 +65,14 @@ pub(crate) struct Transport {
     pub rows: Vec<Row>,
 }
 
+/// One decomposition at one rank count under one transport: predicted next to measured.
 #[derive(Clone, Debug, Serialize)]
 pub struct Row {
+    /// The rank count p.
     pub ranks: usize,
+    /// The galaxy's bodies at p ranks.
     pub n: usize,
+    /// The decomposition (allgather, octants or tree).
     pub decomp: Decomposition,
     pub(crate) predicted_bytes: f64,
     pub(crate) predicted_s: f64,
@@ -75,7 +83,10 @@ pub struct Row {
     pub(crate) measured_bytes: Option<f64>,
     pub(crate) measured_s: Option<f64>,
     pub(crate) measured_transfer_s: Option<f64>,
+    /// The measured case's mean over rounds of max/mean over ranks of the compute time;
+    /// `None` when the sweep has no such case.
     pub compute_imbalance: Option<f64>,
+    /// The measured case ran more workers than logical CPUs (false without a measured case).
     pub oversubscribed: bool,
 }
 

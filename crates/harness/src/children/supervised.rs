@@ -20,26 +20,36 @@ const DRAIN_WAIT: Duration = Duration::from_secs(2);
 /// At most this much of each output stream is kept (the end of it: error messages come last).
 const KEPT_OUTPUT_BYTES: usize = 1 << 20;
 
+/// Why a supervised child gave no exit status; each variant names the child as the caller does.
 #[derive(Debug, Error)]
 pub enum ChildError {
+    /// The program could not be spawned (not found, not executable).
     #[error("{what} cannot be started: {source}")]
     Start {
+        /// The child as messages name it, e.g. "rustc -vV".
         what: String,
+        /// The error of the spawn.
         source: std::io::Error,
     },
+    /// The child ran past its limit; its process group was terminated.
     #[error(
         "{what} did not finish within {limit} and was stopped{hint}",
         hint = if hint.is_empty() { String::new() } else { format!("; {hint}") }
     )]
     TimedOut {
+        /// The child as messages name it.
         what: String,
         /// The limit, e.g. "120 s" or "0.3 s".
         limit: String,
+        /// What the user can do about it, appended after "; "; empty for none.
         hint: String,
     },
+    /// Waiting for the child's exit failed (an operating-system error).
     #[error("waiting for {what} failed: {source}")]
     Wait {
+        /// The child as messages name it.
         what: String,
+        /// The error of the wait.
         source: std::io::Error,
     },
 }

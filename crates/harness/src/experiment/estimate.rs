@@ -50,6 +50,7 @@ const REFERENCE_MIN_S: f64 = 5e-4;
 /// One kernel set-up measured on one thread at `n` particles (times in seconds).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Probe {
+    /// The particle count the times are for (the probe's, or the case's after [`Probe::at`]).
     pub n: usize,
     /// Building the system and the simulation (placement, spatial order), without the energy
     /// probe the simulation starts with.
@@ -115,9 +116,11 @@ pub struct Done {
 /// The estimate of one case's remaining rounds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CaseEstimate {
+    /// The case estimated.
     pub case: Case,
     /// Rounds and samples still to measure.
     pub rounds: usize,
+    /// Samples still to measure over those rounds, each a timing of whole steps.
     pub samples: usize,
     /// Expected time of one step at the case's n, threads and ranks.
     pub step_s: f64,
@@ -128,9 +131,11 @@ pub struct CaseEstimate {
 /// The estimate of a whole sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Estimate {
+    /// Each built-in kernel's case (external programs are not estimated), in plan order.
     pub cases: Vec<CaseEstimate>,
     /// The calibrations still to run (start and end).
     pub calibration_s: f64,
+    /// Expected wall time of the whole sweep, seconds: the calibrations plus every case.
     pub total_s: f64,
 }
 
@@ -267,20 +272,30 @@ pub struct Probed {
     pub seconds: f64,
 }
 
+/// Why probing a sweep's kernel set-ups failed.
 #[derive(Debug, Error)]
 pub enum ProbeError {
+    /// rayon could not build the one-thread pool the probes run on.
     #[error("cannot start the estimate's one-thread pool: {0}")]
     Pool(rayon::ThreadPoolBuildError),
+    /// A set-up's system or simulation could not be built at the probe's n.
     #[error("estimating the sweep: {what} at n = {n}: {source}")]
     Setup {
+        /// The set-up, `scenario/kernel`.
         what: String,
+        /// The particle count probed.
         n: usize,
+        /// Why it could not be built.
         source: SetupError,
     },
+    /// A set-up's probe steps (or its force-error check) failed.
     #[error("estimating the sweep: {what} at n = {n}: {source}")]
     Run {
+        /// The set-up, `scenario/kernel`.
         what: String,
+        /// The particle count probed.
         n: usize,
+        /// Why the run failed.
         source: RunError,
     },
 }

@@ -12,16 +12,26 @@ use std::os::unix::io::AsRawFd;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// Why a sweep could not take the writer lock of its results file.
 #[derive(Debug, Error)]
 pub enum LockError {
+    /// Another live process (a second sweep or resume) holds the lock.
     #[error(
         "{results} is being written by another sweep ({holder}); wait for it to end or stop it, \
          or write elsewhere with --out"
     )]
-    Held { results: PathBuf, holder: String },
+    Held {
+        /// The results file both want to write.
+        results: PathBuf,
+        /// Who holds it, as the holder wrote into the lock file: `pid P on HOST, since TIME`.
+        holder: String,
+    },
+    /// Opening, locking or writing the lock file failed.
     #[error("cannot lock {path}: {source}")]
     Io {
+        /// The lock file, `.<name>.lock` beside the results file.
         path: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
 }

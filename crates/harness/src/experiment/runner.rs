@@ -40,9 +40,15 @@ pub struct SweepOptions {
 
 /// Follows a sweep's progress (terminal bar, log lines, or nothing).
 pub trait Observer {
+    /// Called once before measuring: rounds of every case in all, and how many of them a
+    /// resumed file already holds.
     fn start(&mut self, _total_rounds: usize, _done_rounds: usize) {}
+    /// Called after each round is measured and saved: the case's record with it, and the
+    /// round's 0-based index.
     fn round_done(&mut self, _record: &CaseRecord, _round: usize) {}
+    /// A line for the user: a warning, a calibration summary, why the sweep stopped.
     fn message(&mut self, _text: &str) {}
+    /// Called once when the sweep returns without an error, after the end calibration.
     fn finish(&mut self) {}
     /// Asked before each round: `false` stops the sweep there, as an interrupt would (what
     /// was measured is saved; `--resume` continues). The tests of resuming stop this way.
@@ -55,63 +61,97 @@ pub trait Observer {
 pub struct Silent;
 impl Observer for Silent {}
 
+/// Why a sweep did not start or stopped with an error (what was measured before is saved).
 #[derive(Debug, Error)]
 pub enum SweepError {
+    /// The results file (given) exists and neither `--resume` nor `--fresh` was passed.
     #[error(
         "{0} already exists; pass --resume to continue that sweep, or --fresh to start over \
          (the existing file is kept as a .bak copy)"
     )]
     Exists(PathBuf),
+    /// Resuming without `--force` a file made with another config, commit or file of bodies.
     #[error(
         "{path} was produced by a different {what} ({detail}); refusing to mix results — \
          pass --force to resume anyway or --fresh to start over"
     )]
     Mismatch {
+        /// The results file.
         path: PathBuf,
+        /// What differs: "config", "commit" or "file of bodies".
         what: &'static str,
+        /// How it differs, e.g. the file's commit and the current one.
         detail: String,
     },
+    /// Loading or saving the results file failed.
     #[error(transparent)]
     Results(#[from] ResultsError),
+    /// A case failed its checks before the sweep (invalid set-up, too little memory) or failed
+    /// while being measured.
     #[error("case {key}")]
     Case {
+        /// The case's key.
         key: String,
+        /// What went wrong.
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// `NBODY_BENCH_TEST_SLOWDOWN` (test builds only) is set but is not `KERNEL:K`; the
+    /// message says what is wrong.
     #[error("{0}")]
     Slowdown(String),
+    /// The config runs kernels under an MPI launcher but this build lacks the `mpi` feature.
     #[error(
         "config `{config}` runs cases under MPI: {}",
         nbody_engine::decomp::WITHOUT_MPI
     )]
-    WithoutMpi { config: String },
+    WithoutMpi {
+        /// The config's name.
+        config: String,
+    },
+    /// An external program could not be found or checked before the sweep.
     #[error(transparent)]
     External(#[from] super::external::ExternalError),
+    /// The path of this executable, for external commands' `{nbody_bench}`, is unknown.
     #[error("cannot find this program for {{nbody_bench}}: {0}")]
     Exe(std::io::Error),
+    /// The config's cases could not be planned (e.g. two cases with the same key); the message
+    /// says why.
     #[error("{0}")]
     Plan(String),
+    /// The config's file of bodies (`initial`) could not be read or parsed.
     #[error("config key `initial`: {source}")]
     Initial {
+        /// Why.
         source: nbody_engine::scenario::initial::InitialError,
     },
+    /// The sweep's own copy of the file of bodies, beside the results, could not be written.
     #[error("cannot keep the sweep's copy of the file of bodies: {source}")]
     InitialCopy {
+        /// Why.
         source: nbody_engine::output::WriteError,
     },
+    /// Another process is writing the same results file, or its lock could not be taken.
     #[error(transparent)]
     Lock(#[from] super::lock::LockError),
+    /// The `[scheduler]` (Slurm) is unavailable or one of its jobs failed.
     #[error(transparent)]
     Slurm(#[from] super::slurm::SlurmError),
+    /// `--fresh` could not rename the existing results file (or its `jobs` directory) to a
+    /// `.bak` name.
     #[error("cannot keep {path} as a backup: {source}")]
     Backup {
+        /// The file or directory being kept.
         path: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
+    /// The results directory (or its `initial/` subdirectory) could not be created.
     #[error("cannot create {path}: {source}")]
     Dir {
+        /// The directory.
         path: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
 }
@@ -119,8 +159,11 @@ pub enum SweepError {
 /// What a sweep did.
 #[derive(Debug)]
 pub struct SweepReport {
+    /// The results file written.
     pub path: PathBuf,
+    /// Rounds measured by this invocation (not those a resumed file already held).
     pub rounds_measured: usize,
+    /// Cases in the results file.
     pub cases: usize,
     /// Cases not complete (budget reached or stopped).
     pub incomplete: usize,
@@ -151,6 +194,9 @@ pub fn run_sweep_wall(
     )
 }
 
+/// Runs the sweep of `config` (whose TOML text `config_text` is kept in the results) with
+/// `clock` timing every sample: plans, calibrates, measures the rounds still to do, saving after
+/// each, and reports to `observer`.
 pub fn run_sweep<C: Clock>(
     config: &SweepConfig,
     config_text: &str,

@@ -20,6 +20,7 @@ const WARMUP_STEPS: u64 = 10;
 /// One candidate skin, timed.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct SkinTrial {
+    /// The candidate skin: `params.skin` times one of [`SKIN_FACTORS`], in length units.
     pub skin: f64,
     /// Wall time per particle-step over the trial, nanoseconds.
     pub ns_per_particle_step: f64,

@@ -79,6 +79,7 @@ impl TestSlowdown {
 
     /// How many times as long `kernel`'s timed force computations are to take (1 for a
     /// kernel the knob does not name); the engine's `kernels::repeated` does it.
+    #[cfg_attr(not(feature = "test-slowdown"), allow(dead_code))]
     pub(crate) fn factor_for(&self, kernel: KernelKind) -> f64 {
         if self.kernel == kernel {
             self.factor

@@ -21,6 +21,7 @@ pub enum CiMethod {
 }
 
 impl CiMethod {
+    /// A phrase for reports saying how the intervals were obtained.
     pub fn describe(self) -> &'static str {
         match self {
             CiMethod::ResampleWithinX => "resampling the raw samples within each x",

@@ -6,62 +6,112 @@
 use super::{Samples, WeakSamples};
 use thiserror::Error;
 
+/// Why a table of measurements was refused; each names the 1-based line it is about.
 #[derive(Clone, Debug, PartialEq, Error)]
 #[non_exhaustive]
 pub enum CsvError {
+    /// The text has no header: it is empty or holds only blank and `#` lines.
     #[error(
         "line {line}: the table ends with no header (it is empty); expected a header line `{expected}` followed by data rows"
     )]
-    Empty { line: usize, expected: String },
+    Empty {
+        /// The line just past the end of the text.
+        line: usize,
+        /// The header the table should have started with, e.g. `p,time`.
+        expected: String,
+    },
+    /// The first non-blank line holds only numbers, so it is data, not a header.
     #[error(
         "line {line}: missing header: the first line must name the columns (`{expected}`), not hold numbers"
     )]
-    MissingHeader { line: usize, expected: String },
+    MissingHeader {
+        /// The line taken for the header.
+        line: usize,
+        /// The header expected, e.g. `p,time`.
+        expected: String,
+    },
+    /// The header names columns this kind of table does not have.
     #[error("line {line}: unknown column(s) {names}; expected `{expected}`")]
     UnknownColumns {
+        /// The header's line.
         line: usize,
+        /// The unknown names, back-quoted and comma-separated.
         names: String,
+        /// The header expected, e.g. `p,n,time`.
         expected: String,
     },
+    /// The header lacks a required column.
     #[error("line {line}: missing column `{name}`; expected `{expected}`")]
     MissingColumn {
+        /// The header's (or the row's) line.
         line: usize,
+        /// The missing column: `p`, `n` or `time`.
         name: &'static str,
+        /// The header expected, e.g. `p,time`.
         expected: String,
     },
+    /// The header names one column twice.
     #[error("line {line}: column `{name}` appears twice")]
-    DuplicateColumn { line: usize, name: String },
+    DuplicateColumn {
+        /// The header's line.
+        line: usize,
+        /// The repeated name, lower-cased.
+        name: String,
+    },
+    /// A data row has more or fewer comma-separated fields than the header.
     #[error("line {line}: {got} fields, but the header has {expected}")]
     WrongFieldCount {
+        /// The row's line.
         line: usize,
+        /// The row's number of fields.
         got: usize,
+        /// The header's number of columns.
         expected: usize,
     },
+    /// A field does not parse as a number, or is NaN or infinite.
     #[error("line {line}: `{value}` in column `{column}` is not a finite number")]
     NotANumber {
+        /// The row's line.
         line: usize,
+        /// The field's column: `p`, `n` or `time`.
         column: &'static str,
+        /// The field as written, trimmed and unquoted.
         value: String,
     },
+    /// A number outside its column's range: p below 1, or n or time not positive.
     #[error("line {line}: {column} = {value}, but {requirement}")]
     OutOfRange {
+        /// The row's line.
         line: usize,
+        /// The field's column: `p`, `n` or `time`.
         column: &'static str,
+        /// The value read.
         value: f64,
+        /// The column's rule, as a phrase for the message.
         requirement: &'static str,
     },
+    /// A `p,n,time` table gives one worker count two different problem sizes.
     #[error(
         "line {line}: p = {p} has n = {n}, but line {first_line} gave it n = {first_n}; each p needs one problem size"
     )]
     InconsistentN {
+        /// The line with the second problem size.
         line: usize,
+        /// The worker count.
         p: f64,
+        /// The problem size (particles) on `line`.
         n: f64,
+        /// The line where `p` first appeared.
         first_line: usize,
+        /// The problem size `p` had there.
         first_n: f64,
     },
+    /// The header is followed by no data rows.
     #[error("no data rows after the header on line {header_line}")]
-    NoRows { header_line: usize },
+    NoRows {
+        /// The header's line.
+        header_line: usize,
+    },
 }
 
 /// A column the parser knows: its name and the values it accepts.
@@ -267,10 +317,14 @@ pub fn parse_sizes(text: &str) -> Result<Vec<Samples>, CsvError> {
 /// A weak-scaling table: `p,time`, or `p,n,time` when the problem sizes are known.
 #[derive(Clone, Debug, PartialEq)]
 pub enum WeakTable {
+    /// A `p,time` table: samples at x = p, problem sizes unknown (for [`super::fit_weak`]).
     Times(Vec<Samples>),
+    /// A `p,n,time` table: samples at each p with its problem size (for
+    /// [`super::fit_weak_with_n`]), in order of first appearance.
     WithN(Vec<WeakSamples>),
 }
 
+/// A weak-scaling table, with or without its `n` column; a p given two different n is refused.
 pub fn parse_weak(text: &str) -> Result<WeakTable, CsvError> {
     let table = parse_table(text, &[P, TIME], &[N])?;
     let pairs = table.rows.iter().map(|r| (r.required[0], r.required[1]));

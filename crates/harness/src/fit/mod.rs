@@ -48,11 +48,14 @@ pub const DEFAULT_SEED: u64 = 0x5eed_0f17;
 /// Raw measurements at one x (threads, particles or bytes); `values` are seconds.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct Samples {
+    /// Where the samples were taken: thread count p, particle count n or message bytes.
     pub x: f64,
+    /// The times measured at `x`, seconds, in any order (entries with the same x are merged).
     pub values: Vec<f64>,
 }
 
 impl Samples {
+    /// The samples `values` (seconds) measured at `x`.
     pub fn new(x: f64, values: Vec<f64>) -> Self {
         Samples { x, values }
     }
@@ -63,7 +66,9 @@ impl Samples {
 /// serial fraction may be 0) is infinite and serializes as `null`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Estimate {
+    /// The point estimate: the fit to the per-x medians.
     pub estimate: f64,
+    /// The bootstrap's 95% percentile interval `[lo, hi]`, lo ≤ hi; an end may be infinite.
     pub ci95: [f64; 2],
 }
 
@@ -86,8 +91,11 @@ impl Estimate {
 /// What a fit was given at one x: the median of the samples and how many there were.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct Input {
+    /// The x (threads, particles or bytes) after merging entries with the same x.
     pub x: f64,
+    /// The median of the samples at `x`, seconds; what the point fit is fitted to.
     pub median: f64,
+    /// How many samples were measured at `x` (at least 1).
     pub samples: usize,
 }
 
@@ -95,76 +103,136 @@ pub struct Input {
 #[derive(Clone, Debug, PartialEq, Error)]
 #[non_exhaustive]
 pub enum FitError {
+    /// Fewer distinct x values than the model has to have (but more than one).
     #[error("{model}: needs at least {need} distinct x values, got {got}; measure more points")]
     TooFewPoints {
+        /// The model refusing, as named in messages (e.g. "strong scaling").
         model: &'static str,
+        /// The least number of distinct x values it fits.
         need: usize,
+        /// The number of distinct x values given.
         got: usize,
     },
+    /// Every sample has the same x, so nothing varies to fit a model to.
     #[error("{model}: every sample is at x = {x}; a fit needs at least {need} distinct x values")]
     OneX {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The one x every sample was measured at.
         x: f64,
+        /// The least number of distinct x values the model fits.
         need: usize,
     },
+    /// An entry of the input has an x but an empty list of times.
     #[error("{model}: no samples at x = {x}; every x needs at least one measured time")]
-    NoSamples { model: &'static str, x: f64 },
+    NoSamples {
+        /// The model refusing, as named in messages.
+        model: &'static str,
+        /// The x without samples.
+        x: f64,
+    },
+    /// A measured time is zero or negative (a failed run or a unit mix-up).
     #[error(
         "{model}: time {value} at x = {x} is not positive; times must be seconds > 0 (check units and failed runs)"
     )]
     NonPositive {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The x the time was measured at.
         x: f64,
+        /// The offending time, seconds.
         value: f64,
     },
+    /// An x or a time is NaN or infinite.
     #[error("{model}: a NaN or infinite value at x = {x}; remove it or measure again")]
-    NotFinite { model: &'static str, x: f64 },
+    NotFinite {
+        /// The model refusing, as named in messages.
+        model: &'static str,
+        /// The x at which it was found (itself, when the x is the non-finite value).
+        x: f64,
+    },
+    /// An x outside what the model accepts (worker counts below 1, sizes not positive).
     #[error("{model}: x = {x} is out of range: {expected}")]
     BadX {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The x out of range (for weak scaling with n, possibly the problem size n).
         x: f64,
+        /// What the model accepts, as a phrase for the message.
         expected: &'static str,
     },
+    /// A strong- or weak-scaling fit has no one-worker run to take T1 from.
     #[error(
         "{model}: needs a measurement at p = 1 (the baseline T1); measured p = {measured}; add runs with one worker"
     )]
     NoBaseline {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The worker counts that were measured, comma-separated in increasing order.
         measured: String,
     },
+    /// A hardware-ceiling entry given to the strong-scaling fit is not a finite p ≥ 1 with a
+    /// finite positive ratio.
     #[error("{model}: hardware ceiling {ratio} at p = {p} must be a finite ratio > 0 at p >= 1")]
     BadCeiling {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The worker count of the entry.
         p: f64,
+        /// The ceiling's speedup ratio at `p`.
         ratio: f64,
     },
+    /// Residual resampling was needed (some x has a single sample) but there are no more x
+    /// values than parameters, so no residual spread is left.
     #[error(
         "{model}: one sample per x and only {points} x values for {params} parameters leaves no \
          spread to put a confidence interval on; repeat the measurements or add x values"
     )]
     NoSpread {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The number of distinct x values.
         points: usize,
+        /// The model's number of free parameters.
         params: usize,
     },
+    /// The point fit or most bootstrap replicates give no usable parameters.
     #[error("{model}: the fit is degenerate ({why})")]
     Degenerate {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// What went wrong, as a phrase for the message.
         why: &'static str,
     },
+    /// Weak scaling with n: one worker count was measured at two different problem sizes.
     #[error(
         "{model}: p = {p} appears with n = {n_first} and n = {n_other}; each p needs one problem size"
     )]
     InconsistentN {
+        /// The model refusing, as named in messages.
         model: &'static str,
+        /// The worker count measured twice.
         p: f64,
+        /// The problem size (particles) first seen at `p`.
         n_first: f64,
+        /// The different problem size seen later at `p`.
         n_other: f64,
     },
+    /// The power-law fit found no complexity class that describes the data (times not growing
+    /// with n, or the best class missing held-out points by too much).
     #[error("{model}: the data do not support it: {why}")]
-    Unsupported { model: &'static str, why: String },
+    Unsupported {
+        /// The model refusing, as named in messages.
+        model: &'static str,
+        /// Why, with the numbers and what to do, as a sentence for the message.
+        why: String,
+    },
+    /// Phase times given for the timed serial fraction are negative, not finite or add up to 0.
     #[error("timed serial fraction: {what}")]
-    BadPhases { what: String },
+    BadPhases {
+        /// What was wrong with the phase times, as a sentence for the message.
+        what: String,
+    },
 }
 
 /// Which x values a model accepts.

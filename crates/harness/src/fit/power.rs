@@ -13,15 +13,22 @@ const MODEL: &str = "power law";
 /// (any base is absorbed by `c`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ComplexityClass {
+    /// Linear, `g(n) = n`.
     N,
+    /// `g(n) = n·log2 n` (tree codes such as Barnes-Hut).
     NLogN,
+    /// `g(n) = n^1.5`.
     NSqrtN,
+    /// Quadratic, `g(n) = n²` (direct all-pairs summation).
     N2,
+    /// `g(n) = n²·log2 n`.
     N2LogN,
+    /// Cubic, `g(n) = n³`.
     N3,
 }
 
 impl ComplexityClass {
+    /// Every class, in increasing order of growth: the hypotheses the selection tries.
     pub const ALL: [ComplexityClass; 6] = [
         ComplexityClass::N,
         ComplexityClass::NLogN,
@@ -31,6 +38,7 @@ impl ComplexityClass {
         ComplexityClass::N3,
     ];
 
+    /// How the class is written in tables, messages and JSON, e.g. `n log n` or `n^2`.
     pub fn name(self) -> &'static str {
         match self {
             ComplexityClass::N => "n",
@@ -64,6 +72,7 @@ impl Serialize for ComplexityClass {
 /// One hypothesis of the class selection, fitted to all the medians.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ClassCandidate {
+    /// The growth class `g(n)` of this hypothesis.
     pub class: ComplexityClass,
     /// `a + c·g(n)` when true, `c·g(n)` otherwise.
     pub with_constant: bool,
@@ -82,10 +91,15 @@ pub struct ClassCandidate {
 /// The selected hypothesis with bootstrap intervals on its parameters.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SelectedClass {
+    /// The growth class `g(n)` selected.
     pub class: ComplexityClass,
+    /// Whether the selected model is `a + c·g(n)` rather than `c·g(n)`.
     pub with_constant: bool,
+    /// `a`, seconds (exactly 0 when `with_constant` is false).
     pub constant: Estimate,
+    /// `c`, seconds per unit of `g(n)`.
     pub coefficient: Estimate,
+    /// The selected hypothesis' leave-one-out SMAPE, percent (at most 50, else the fit is refused).
     pub loo_smape_percent: f64,
     /// In-sample fit of the selected model to the medians (r² on relative residuals).
     pub goodness: Goodness,
@@ -107,11 +121,16 @@ pub struct PowerFit {
     pub power_law_goodness: Goodness,
     /// The selected complexity class (also in `selected`).
     pub class: ComplexityClass,
+    /// The selected hypothesis with its parameters' intervals and how firmly it was selected.
     pub selected: SelectedClass,
     /// Every hypothesis with its leave-one-out SMAPE.
     pub candidates: Vec<ClassCandidate>,
+    /// How the bootstrap drew its replicates (decides what the intervals include).
     pub ci_method: CiMethod,
+    /// The number of bootstrap replicates drawn (before degenerate ones were dropped).
     pub resamples: usize,
+    /// Warnings for a reader, one sentence each: weak class support, wide exponent interval,
+    /// a runner-up class too close over the measured range of n.
     pub notes: Vec<String>,
 }
 

@@ -19,8 +19,11 @@ const MODEL: &str = "strong scaling";
 /// Per thread count: the measured time and what follows from it.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct StrongPoint {
+    /// The thread (worker) count.
     pub p: f64,
+    /// The median time at `p`, seconds.
     pub median_s: f64,
+    /// How many times were measured at `p`.
     pub samples: usize,
     /// `S = T1 / T(p)` from the medians.
     pub speedup: Estimate,
@@ -37,6 +40,7 @@ pub struct StrongPoint {
 pub struct StrongFit {
     /// x = p, the median time and sample count at each p.
     pub inputs: Vec<Input>,
+    /// Speedup and efficiency at each measured p, in increasing p (the first is p = 1).
     pub points: Vec<StrongPoint>,
     /// Amdahl's T(1), seconds.
     pub t1: Estimate,
@@ -52,10 +56,17 @@ pub struct StrongFit {
     pub goodness: Goodness,
     /// e(p) at every p > 1.
     pub karp_flatt: Vec<KarpFlattPoint>,
+    /// How e(p) changes as p doubles, and what that says about the overhead.
     pub karp_flatt_trend: KarpFlattTrend,
+    /// Amdahl with an added overhead term, each tried by leave-one-out cross-validation
+    /// (none with fewer than 4 thread counts).
     pub overhead: OverheadSelection,
+    /// How the bootstrap drew its replicates (decides what the intervals include).
     pub ci_method: CiMethod,
+    /// The number of bootstrap replicates drawn (before degenerate ones were dropped).
     pub resamples: usize,
+    /// Warnings for a reader, one sentence each: clamping, too few thread counts, a kept
+    /// overhead term, ceilings at unmeasured p.
     pub notes: Vec<String>,
     /// `(T1, clamped f)` of every bootstrap replicate, for curve bands.
     #[serde(skip)]

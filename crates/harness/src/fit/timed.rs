@@ -12,7 +12,9 @@ use serde::Serialize;
 pub struct TimedSerialFraction {
     pub(crate) serial_s: f64,
     pub(crate) parallel_s: f64,
+    /// The one-worker run's time, serial plus parallelisable phases, seconds.
     pub total_s: f64,
+    /// The timed serial fraction, serial time over total, in [0, 1].
     pub fraction: f64,
 }
 

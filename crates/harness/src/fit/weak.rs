@@ -18,20 +18,27 @@ const MODEL: &str = "weak scaling";
 /// Samples of one weak-scaling run where the problem size is known.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct WeakSamples {
+    /// The worker count.
     pub p: f64,
+    /// The problem size of the run at `p`, particles.
     pub n: f64,
+    /// The measured times, seconds.
     pub values: Vec<f64>,
 }
 
+/// Weak-scaling efficiency at one worker count.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct EfficiencyPoint {
+    /// The worker count.
     pub p: f64,
     /// `T1 / T(p)`; 1 is perfect weak scaling.
     pub e: Estimate,
 }
 
+/// Gustafson's scaled speedup at one worker count.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct ScaledSpeedupPoint {
+    /// The worker count.
     pub p: f64,
     /// `p · T1 / T(p)`.
     pub s: Estimate,
@@ -40,32 +47,42 @@ pub struct ScaledSpeedupPoint {
 /// How far a run's work per worker is from the one-worker run's, under the cost model.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct WorkPerWorker {
+    /// The worker count.
     pub p: f64,
+    /// The run's problem size, particles.
     pub n: f64,
     /// `(g(n)/p) / g(n1)`; the run's times were divided by it.
     pub ratio: f64,
 }
 
+/// A weak-scaling analysis: efficiency, scaled speedup and Gustafson's serial fraction.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct WeakFit {
     /// x = p, the median time (as measured) and sample count at each p.
     pub inputs: Vec<Input>,
     /// The one-worker time, seconds (median with interval).
     pub t1: Estimate,
+    /// `T1 / T(p)` at each measured p, in increasing p (the first is p = 1).
     pub efficiency: Vec<EfficiencyPoint>,
+    /// `p·T1 / T(p)` at each measured p, in increasing p.
     pub scaled_speedup: Vec<ScaledSpeedupPoint>,
     /// Gustafson's α, clamped to [0, 1] (see `clamped`).
     pub serial_fraction: Estimate,
     pub(crate) serial_fraction_unclamped: Estimate,
+    /// Whether α or an end of its interval was clamped to [0, 1].
     pub clamped: bool,
     /// Fit of `p − α(p − 1)` to the measured scaled speedups (r² weighted by 1/p²).
     pub goodness: Goodness,
     /// With problem sizes given: the cost model `g(n)` used to check and normalise the work
     /// per worker.
     pub cost_model: Option<ComplexityClass>,
+    /// With problem sizes given: each p's work per worker relative to p = 1's; `None` without.
     pub work_per_worker: Option<Vec<WorkPerWorker>>,
+    /// How the bootstrap drew its replicates (decides what the intervals include).
     pub ci_method: CiMethod,
+    /// The number of bootstrap replicates drawn (before degenerate ones were dropped).
     pub resamples: usize,
+    /// Warnings for a reader, one sentence each: clamping, work per worker off by more than 2%.
     pub notes: Vec<String>,
     /// Clamped α of every bootstrap replicate, for curve bands.
     #[serde(skip)]

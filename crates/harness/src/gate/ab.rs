@@ -32,10 +32,19 @@ pub fn check_rounds(rounds: usize) -> Result<(), AbError> {
     Ok(())
 }
 
+/// Why an A/B run cannot be prepared or measured.
 #[derive(Debug, Error)]
 pub enum AbError {
+    /// The config has a form the A/B gate cannot run: MPI, weak-by-time cases, a text that is
+    /// not a TOML table, or a one-case config that does not parse back to its case.
     #[error("the A/B gate cannot run config `{name}`: {why}")]
-    Unsupported { name: String, why: String },
+    Unsupported {
+        /// The config's `name`.
+        name: String,
+        /// What in it the A/B form cannot run, with what to do instead.
+        why: String,
+    },
+    /// `--rounds` is odd, below 2 or above [`MAX_ROUNDS`].
     #[error(
         "--rounds must be an even number from 2 to {max} (got {0}): each build must go first \
          as often as the other, and {max} rounds of every case are already far more than the \
@@ -46,22 +55,37 @@ pub enum AbError {
     /// A build's sweep past its time limit.
     #[error(transparent)]
     Stuck(ChildError),
+    /// A build did not answer `sweep --help` in time, asked whether its sweep takes `--yes`.
     #[error("the base build at {path} cannot be asked for its options: {source}")]
-    Probe { path: PathBuf, source: ChildError },
+    Probe {
+        /// The binary asked.
+        path: PathBuf,
+        /// How it failed: past its time limit, or waiting for it failed.
+        source: ChildError,
+    },
+    /// A build's one-case sweep could not start, failed, or wrote no results for the case.
     #[error(
         "the {side} build failed to measure {key} (round {round}); its output ends with:\n{tail}"
     )]
     Side {
+        /// Which build: "base" or "current".
         side: &'static str,
+        /// The case's key.
         key: String,
+        /// The A/B round it failed in, counted from 0.
         round: usize,
+        /// The last lines of its standard error and output, or why it could not start.
         tail: String,
     },
+    /// A one-case sweep's directory or config could not be written.
     #[error("cannot write {path}: {source}")]
     Io {
+        /// The directory or file.
         path: PathBuf,
+        /// The underlying error.
         source: std::io::Error,
     },
+    /// A one-case sweep's results file could not be loaded.
     #[error(transparent)]
     Results(#[from] nbody_records::results::ResultsError),
 }
@@ -69,11 +93,14 @@ pub enum AbError {
 /// The two builds, A (the base) and B (this one).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Side {
+    /// The base revision's build (A).
     Base,
+    /// This build (B).
     Current,
 }
 
 impl Side {
+    /// "base" or "current", as named in progress lines, errors and scratch directories.
     pub fn name(self) -> &'static str {
         match self {
             Side::Base => "base",
@@ -84,10 +111,13 @@ impl Side {
 
 /// What an A/B run needs.
 pub struct AbPlan<'a> {
+    /// The sweep config both builds measure.
     pub config: &'a SweepConfig,
+    /// Its text, copied into the merged results files.
     pub config_text: &'a str,
     /// Every case with its one-case config, from [`prepare`].
     pub cases: &'a [OneCase],
+    /// The base revision's binary.
     pub base: &'a BaseBinary,
     /// This build's binary.
     pub current: &'a Path,
@@ -103,7 +133,9 @@ pub struct AbPlan<'a> {
 /// One case of an A/B run and the config text both builds sweep it with.
 #[derive(Clone, Debug)]
 pub struct OneCase {
+    /// The case, as this build plans it.
     pub case: Case,
+    /// TOML config that plans exactly this case, for one round.
     pub text: String,
 }
 
@@ -203,7 +235,10 @@ pub fn child_limit(
 
 /// Both builds' merged results.
 pub struct AbResults {
+    /// The base build's rounds of every case merged into one results file, its metadata naming
+    /// the base commit (no calibration: the caller adds the one both sides share).
     pub base: ResultsFile,
+    /// This build's rounds of every case, merged likewise.
     pub current: ResultsFile,
     /// Wall time of the interleaved measurement, seconds.
     pub measure_s: f64,

@@ -21,32 +21,53 @@ pub const BUILD_LIMIT: Duration = Duration::from_secs(3600);
 /// Longest `rustc -vV` may take.
 const RUSTC_LIMIT: Duration = Duration::from_secs(60);
 
+/// Why the base revision's binary cannot be had.
 #[derive(Debug, Error)]
 pub enum BaseBuildError {
+    /// The directory is not inside a git checkout, or git cannot be run.
     #[error(
         "the A/B gate builds the base revision with git, and {0}; run it inside a git \
          checkout of the project"
     )]
     NoRepository(String),
+    /// The base revision does not resolve to a commit in this clone (often a shallow one).
     #[error(
         "base revision `{rev}` is not in this clone ({detail}); a shallow clone lacks older \
          commits: fetch them (git fetch --unshallow, or git fetch origin {rev}) or pass \
          --against a revision that is present"
     )]
-    MissingRevision { rev: String, detail: String },
+    MissingRevision {
+        /// The revision as given, e.g. `origin/main`.
+        rev: String,
+        /// Why git does not know it: the clone is shallow, or no such revision.
+        detail: String,
+    },
+    /// Git could not add the worktree the base revision is built in.
     #[error("cannot prepare the base revision {commit}: {detail}")]
-    Worktree { commit: String, detail: String },
+    Worktree {
+        /// Full hash of the base commit.
+        commit: String,
+        /// Git's error text.
+        detail: String,
+    },
+    /// `cargo build --release` of the base revision failed or timed out.
     #[error(
         "the base revision {commit} does not build (cargo build --release; the log is {log}):\n{tail}"
     )]
     Build {
+        /// Full hash of the base commit.
         commit: String,
+        /// The build's log, `build.log` in the commit's cache directory.
         log: PathBuf,
+        /// The last lines of the log, or why the build did not run.
         tail: String,
     },
+    /// A directory or file of the build cache could not be created, copied or renamed.
     #[error("cannot write the base build's files under {path}: {source}")]
     Io {
+        /// The directory or file.
         path: PathBuf,
+        /// The underlying error.
         source: std::io::Error,
     },
 }
@@ -56,6 +77,7 @@ pub enum BaseBuildError {
 pub struct BaseBinary {
     /// The full commit hash.
     pub commit: String,
+    /// The cached binary, `<target>/gate-base/<commit>-<toolchain>/nbody-bench`.
     pub path: PathBuf,
     /// It was built by this call (not taken from the cache).
     pub built: bool,

@@ -20,15 +20,19 @@ use thiserror::Error;
 /// The baseline the gate judges against.
 #[derive(Debug)]
 pub struct Chosen {
+    /// The baseline results file, in the baseline folder.
     pub path: PathBuf,
     /// Where it comes from (read even from a file this build can no longer load).
     pub info: RunInfo,
+    /// Whether this build can sweep its config again; if not, the gate runs A/B against its
+    /// commit.
     pub fitness: Fitness,
 }
 
 /// Whether this build can sweep a baseline's config again and get the baseline's cases.
 #[derive(Debug)]
 pub enum Fitness {
+    /// This build parses the stored config and plans exactly the baseline's cases.
     Reproducible(Box<Reproducible>),
     /// Why not, in one line.
     Stale(String),
@@ -37,6 +41,7 @@ pub enum Fitness {
 /// A baseline this build reproduces.
 #[derive(Debug)]
 pub struct Reproducible {
+    /// The baseline results as this build loaded them.
     pub file: ResultsFile,
     /// Its stored config, as this build parsed it.
     pub config: SweepConfig,
@@ -158,18 +163,24 @@ pub(crate) fn json_files(dir: &Path) -> Result<Vec<PathBuf>, BaselinesError> {
     Ok(paths)
 }
 
+/// Why the baseline folder gives no baseline.
 #[derive(Debug, Error)]
 pub enum BaselinesError {
+    /// The folder cannot be listed.
     #[error("cannot read the baseline folder {path}: {source}")]
     Read {
+        /// The folder.
         path: PathBuf,
+        /// The underlying error.
         source: std::io::Error,
     },
+    /// The folder holds no `.json` file.
     #[error(
         "the baseline folder {0} holds no .json results file; measure one with \
          scripts/refresh-baseline.sh, or pass --against REV"
     )]
     Empty(PathBuf),
+    /// A `.json` file in the folder is unreadable, not JSON, or records no commit or machine.
     #[error(transparent)]
     Results(#[from] ResultsError),
 }

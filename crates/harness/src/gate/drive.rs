@@ -28,24 +28,40 @@ const REFERENCE_TOLERANCE: f64 = 0.05;
 /// What a gate run is asked to do (the command's options).
 #[derive(Clone, Debug)]
 pub struct Request {
+    /// The reference run: a results file, or a folder of baselines, one per machine class.
     pub baseline: PathBuf,
+    /// Results to judge as they are (`--current`); `None` makes the gate measure this build.
     pub current: Option<PathBuf>,
+    /// Revision to measure side by side with this build (A/B); `None`: the baseline decides.
     pub against: Option<String>,
+    /// Config to measure (a file or a config name); `None` sweeps the baseline's own config.
     pub config: Option<PathBuf>,
+    /// Rounds of every case per build in an A/B run: even, from 2 to [`ab::MAX_ROUNDS`].
     pub rounds: usize,
+    /// Longest one build's sweep of one case may take in an A/B run, seconds; `None`: from the
+    /// case's estimate ([`ab::child_limit`]).
     pub timeout: Option<f64>,
+    /// Where a measuring gate keeps what it measured; `None`: a new run directory under
+    /// `results/runs/gate/`.
     pub out: Option<PathBuf>,
+    /// Relative change a case must exceed (0.10 = 10%); `None` takes the mode's default.
     pub threshold: Option<f64>,
+    /// What the times are divided by before comparing.
     pub normalize: NormalizationChoice,
     /// The ratio cases are judged on [default: each mode's, `AB_JUDGE` or `FILE_JUDGE`].
     pub judge: Option<Judged>,
+    /// Compare results from another machine, build or config anyway (with warnings).
     pub force: bool,
+    /// A change of the deterministic work counters fails the gate too (exit 1).
     pub fail_on_work_change: bool,
 }
 
 /// A gate run's report and where its measurements were kept.
 pub struct Outcome {
+    /// The comparison of every case, also written to `gate.json`.
     pub report: GateReport,
+    /// Directory holding `gate.json` and the measured results; `None` when two files were
+    /// compared.
     pub kept_in: Option<PathBuf>,
 }
 

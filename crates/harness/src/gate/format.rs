@@ -7,13 +7,18 @@ use crate::render::tables::{Align, Table};
 use crate::units::Duration;
 use std::fmt::Write;
 
+/// How a gate report is printed (`--format`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Format {
+    /// Plain text for a terminal: the verdict, both runs' origins and a table of the cases.
     Text,
+    /// Markdown made for a CI job summary (`>> $GITHUB_STEP_SUMMARY`).
     Markdown,
+    /// Pretty-printed JSON of the whole report (schema `nbody-bench/gate/v1`), newline-terminated.
     Json,
 }
 
+/// The report rendered in `format`.
 pub fn formatted(report: &GateReport, format: Format) -> String {
     match format {
         Format::Text => text(report),

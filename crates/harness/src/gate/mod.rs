@@ -49,12 +49,14 @@ use thiserror::Error;
 /// process. Interleaving keeps raw times fair, and the reference workload only adds its own
 /// noise there (the normalised ratio missed slowdowns the raw one caught).
 pub const AB_THRESHOLD: f64 = 0.03;
+/// The ratio an A/B run judges by default: the raw one, fair since both builds run interleaved.
 pub const AB_JUDGE: Judged = Judged::Raw;
 /// Default threshold against a baseline file measured at another time, and the ratio it
 /// judges: the raw ratio alone gave false alarms beside a spinning process, the normalised
 /// and the raw one both none; 0.10 leaves room for the drift between days the study could not
 /// see.
 pub const FILE_THRESHOLD: f64 = 0.10;
+/// The ratio judged against a baseline file by default: a change counts only if both show it.
 pub const FILE_JUDGE: Judged = Judged::Both;
 /// Default rounds of every case per build in an A/B run (even: each build goes first as often).
 pub const AB_ROUNDS: usize = 4;
@@ -81,6 +83,7 @@ pub struct GateOptions {
     pub threshold: f64,
     /// Compare results from another machine, build or config anyway (with warnings).
     pub force: bool,
+    /// Which machine measurement the case times are divided by before comparing.
     pub normalization: NormalizationChoice,
     /// A change of the work counters makes the gate fail too (exit 1).
     pub fail_on_work_change: bool,
@@ -88,6 +91,7 @@ pub struct GateOptions {
     pub judge: Judged,
     /// Bootstrap resamples per case, and the seed they start from (with the case key mixed in).
     pub resamples: usize,
+    /// Seed of the bootstrap resampling; each case mixes its key's hash into it.
     pub seed: u64,
 }
 
@@ -111,8 +115,11 @@ impl Default for GateOptions {
 pub enum NormalizationChoice {
     /// The reference workload if both runs timed it for the case, else the calibration, else none.
     Auto,
+    /// Divide each sample by the reference workload timed before it; an error if a run lacks it.
     Reference,
+    /// Divide by the time of the sweep's calibrated FMA rate; an error if a run has none.
     Calibration,
+    /// Raw seconds per step, not normalised.
     None,
 }
 
@@ -125,8 +132,11 @@ pub enum NormalizationChoice {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, serde::Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "kebab-case")]
 pub enum Judged {
+    /// The ratio of the normalised medians alone.
     Normalized,
+    /// The ratio of the raw medians (seconds per step) alone.
     Raw,
+    /// Both ratios: a change is claimed only when each of them shows it.
     Both,
 }
 
@@ -145,6 +155,7 @@ pub enum Normalization {
 }
 
 impl Normalization {
+    /// What the times were divided by, as a phrase for the report ("the sweep's calibrated ...").
     pub fn describe(self) -> &'static str {
         match self {
             Normalization::Reference => "the reference workload timed before each sample",
@@ -163,10 +174,12 @@ pub enum Verdict {
     Regressed,
     /// Faster by more than the threshold, by the same rule below 1 − threshold.
     Improved,
+    /// Within the threshold either way, or not shown at the family-wise confidence.
     Unchanged,
 }
 
 impl Verdict {
+    /// The verdict as written in reports and JSON: "regressed", "improved" or "unchanged".
     pub fn name(self) -> &'static str {
         match self {
             Verdict::Regressed => "regressed",
@@ -179,8 +192,11 @@ impl Verdict {
 /// One case measured in both runs.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CaseComparison {
+    /// The case's key in the results files, shared by both runs.
     pub key: String,
+    /// Set across all cases by Holm's step-down once every case has its p-values.
     pub verdict: Verdict,
+    /// What the case's times were divided by, chosen per case from what both runs measured.
     pub normalization: Normalization,
     /// Raw median seconds per step in each run.
     pub(crate) baseline_median_s: f64,
@@ -197,6 +213,7 @@ pub struct CaseComparison {
     pub p: family::Tails,
     /// Those of the normalised ratio and of the raw ratio alone.
     pub p_normalized: family::Tails,
+    /// Those of the raw ratio alone.
     pub p_raw: family::Tails,
     /// Samples in each run.
     pub samples: [usize; 2],
@@ -211,8 +228,11 @@ pub struct CaseComparison {
 /// A work counter of the initial state that differs.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct WorkChange {
+    /// Name of the counter, e.g. `particles`, `pair_checks` or `nodes_opened`.
     pub counter: String,
+    /// Its value in the baseline run.
     pub baseline: u64,
+    /// Its value in the current run.
     pub current: u64,
 }
 
@@ -220,19 +240,28 @@ pub struct WorkChange {
 /// (too few samples for a CI, work counters asked for but absent): the gate exits 2.
 #[derive(Clone, Debug, PartialEq, Eq, Serialize)]
 pub struct MissingCase {
+    /// The baseline case's key.
     pub key: String,
+    /// Why it was not compared, as a sentence for the report.
     pub reason: String,
 }
 
 /// Where a results file comes from.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunInfo {
+    /// Commit the run's binary was built from, as recorded in the file's metadata.
     pub git_commit: String,
+    /// Whether that build had uncommitted changes.
     pub git_dirty: bool,
+    /// UTC, ISO 8601, when the sweep started (empty when not recorded).
     pub started: String,
+    /// Host name the run was measured on (empty when not recorded).
     pub host: String,
+    /// CPU model of the calibration; `None` when the run was swept without calibration.
     pub cpu_model: Option<String>,
+    /// Vendor, family, model and stepping (e.g. `AuthenticAMD 26/2/1`); `None` when not recorded.
     pub cpu_signature: Option<String>,
+    /// Logical CPUs the calibration saw; `None` when the run was swept without calibration.
     pub logical_cpus: Option<usize>,
 }
 
@@ -289,6 +318,8 @@ impl RunInfo {
         })
     }
 
+    /// Where a loaded results file comes from; the machine is that of its start calibration,
+    /// else of its end one.
     pub fn of(file: &ResultsFile) -> RunInfo {
         let cal = file
             .calibration
@@ -310,16 +341,23 @@ impl RunInfo {
 /// The result of a gate run.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct GateReport {
+    /// Schema of the report's JSON rendering (`nbody-bench/gate/v1`).
     pub schema: String,
+    /// Relative change a case had to exceed to count (0.10 = 10%).
     pub threshold: f64,
+    /// Whether a change of the work counters fails the gate too (exit 1).
     pub fail_on_work_change: bool,
+    /// Where the baseline results come from.
     pub baseline: RunInfo,
+    /// Where the current results come from.
     pub current: RunInfo,
     /// Cases measured in both runs, in the baseline's order.
     pub cases: Vec<CaseComparison>,
+    /// Baseline cases that could not be compared: any makes the gate exit 2 (1 on a regression).
     pub missing: Vec<MissingCase>,
     /// Cases only the current run measured.
     pub extra: Vec<String>,
+    /// Mismatches of machine, build or config that were forced through, and other caveats.
     pub warnings: Vec<String>,
     /// Which ratio the cases were judged on.
     pub judged_on: Judged,
@@ -328,6 +366,7 @@ pub struct GateReport {
 }
 
 impl GateReport {
+    /// How many of the compared cases got `verdict`.
     pub fn count(&self, verdict: Verdict) -> usize {
         self.cases.iter().filter(|c| c.verdict == verdict).count()
     }
@@ -359,19 +398,26 @@ impl GateReport {
     }
 }
 
+/// Why two results files cannot be compared, or the options are invalid.
 #[derive(Debug, Error)]
 pub enum GateError {
+    /// `--threshold` is not a number from 0 to [`MAX_THRESHOLD`].
     #[error(
         "--threshold must be a number from 0 to {max} (got {0:?}); 0.10 means 10%, {max} a \
          doubling",
         max = MAX_THRESHOLD
     )]
     BadThreshold(f64),
+    /// A file has no machine calibration (swept with `--no-calibration`), and no `--force`.
     #[error(
         "the {which} results have no machine calibration (swept with --no-calibration), so \
          the machine cannot be checked; sweep again with calibration, or pass --force"
     )]
-    UnknownMachine { which: &'static str },
+    UnknownMachine {
+        /// Which file: "baseline" or "current".
+        which: &'static str,
+    },
+    /// The files come from different machine classes (CPU model, signature or logical CPU count).
     #[error(
         "the baseline comes from another machine: {what} `{baseline}` there, `{current}` here; \
          timings are only comparable on the same machine class. Run the gate without --current \
@@ -380,32 +426,47 @@ pub enum GateError {
          anyway"
     )]
     OtherMachine {
+        /// What differs: "CPU model", "CPU signature" or "logical CPU count".
         what: &'static str,
+        /// Its value in the baseline.
         baseline: String,
+        /// Its value in the current run.
         current: String,
     },
+    /// The files come from builds with a different SIMD level or profile.
     #[error(
         "the baseline was built differently: {what} `{baseline}` in the baseline, `{current}` \
          now; rebuild the same way, refresh the baseline, or pass --force"
     )]
     OtherBuild {
+        /// What differs: "SIMD level" or "profile".
         what: &'static str,
+        /// Its value in the baseline.
         baseline: String,
+        /// Its value in the current run.
         current: String,
     },
+    /// The two runs swept different configs.
     #[error(
         "the two runs used different configs (they differ in {differences}); sweep the \
          baseline's config (its text is in the file's config_text), refresh the baseline, or \
          pass --force to compare the cases they share"
     )]
-    OtherConfig { differences: String },
+    OtherConfig {
+        /// The config keys whose values differ, e.g. "n, measure.samples".
+        differences: String,
+    },
+    /// The normalisation asked for with `--normalize` is missing from a run for a case.
     #[error(
         "case {key}: normalisation `{wanted}` is not available in both files ({why}); use \
          --normalize auto"
     )]
     NormalizationUnavailable {
+        /// Key of the first case it is missing for.
         key: String,
+        /// The normalisation asked for: "reference" or "calibration".
         wanted: &'static str,
+        /// What a run lacks, with how to get it.
         why: &'static str,
     },
 }

@@ -23,11 +23,16 @@ pub enum Route {
     /// Sweep `config` with this build and compare with the baseline file (same machine class,
     /// reproducible, machine speed as when it was measured).
     Fast {
+        /// The baseline results file.
         path: PathBuf,
+        /// Its results, as this build loaded them.
         baseline: Box<ResultsFile>,
     },
     /// Measure revision `rev` and this build side by side.
-    AB { rev: String },
+    AB {
+        /// The base revision: `--against`'s, or the commit the baseline was measured at.
+        rev: String,
+    },
 }
 
 /// The machine this process runs on, as a gate sees a results file's.

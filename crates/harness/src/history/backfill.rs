@@ -23,6 +23,8 @@ pub struct Backfill {
     pub rounds: usize,
     /// The history folder, and where the runs are kept.
     pub dir: PathBuf,
+    /// Where the runs are kept: a folder per backfill (named by its UTC start), in it one per
+    /// commit.
     pub runs: PathBuf,
     /// Build (or find cached) every commit's binary and stop: the builds need no quiet
     /// machine, the measurements do.
@@ -32,11 +34,24 @@ pub struct Backfill {
 /// How one commit went.
 pub enum Done {
     /// Measured: the records appended.
-    Recorded { commit: String, records: usize },
+    Recorded {
+        /// Full hash of the commit.
+        commit: String,
+        /// History records appended, of both sides.
+        records: usize,
+    },
     /// Not measured (it does not build, or does not read the config): why.
-    Skipped { commit: String, why: String },
+    Skipped {
+        /// Full hash of the commit.
+        commit: String,
+        /// The build's or the gate run's error.
+        why: String,
+    },
     /// Built (or found in the cache), not measured: `build_only`.
-    Built { commit: String },
+    Built {
+        /// Full hash of the commit.
+        commit: String,
+    },
 }
 
 /// The commits of `range` to measure, oldest first: every `every`-th counted back from the

@@ -63,15 +63,24 @@ const MEDIAN_SE: f64 = 1.253_314_137_315_500_1;
 /// The two-sided 95% quantile of the standard normal.
 const Z95: f64 = 1.959_963_984_540_054;
 
+/// Why a series or a detector is refused.
 #[derive(Clone, Debug, Error, PartialEq)]
 pub enum ChangeError {
+    /// A value of the series is zero, negative, NaN or infinite: change points need times.
     #[error(
         "point {index} of the series is {value}: change points compare times by their ratio, \
          so every value must be positive and finite"
     )]
-    NotATime { index: usize, value: f64 },
+    NotATime {
+        /// Position of the point in the series, from 0.
+        index: usize,
+        /// The value.
+        value: f64,
+    },
+    /// A minimum segment below 3 points was asked for.
     #[error("a minimum segment of {0} points lets a spike become a change point: give at least 3")]
     ShortSegment(usize),
+    /// A penalty that is not positive and finite was asked for.
     #[error("the penalty per change point must be positive and finite, not {0}")]
     Penalty(f64),
 }
@@ -108,10 +117,12 @@ impl Detector {
         })
     }
 
+    /// The shortest segment, in points (at least 3).
     pub fn min_segment(&self) -> usize {
         self.min_segment
     }
 
+    /// The cost of one change point, in units of the series' noise σ (log space).
     pub fn penalty(&self) -> f64 {
         self.penalty
     }
@@ -171,6 +182,7 @@ pub struct Incremental {
 }
 
 impl Incremental {
+    /// An empty series judged by `detector`.
     pub fn new(detector: Detector) -> Self {
         Incremental {
             detector,
@@ -198,10 +210,12 @@ impl Incremental {
         describe(&self.logs, &self.fit.starts(), scale_of(&self.logs))
     }
 
+    /// Points pushed so far.
     pub fn len(&self) -> usize {
         self.logs.len()
     }
 
+    /// Whether no point has been pushed.
     pub fn is_empty(&self) -> bool {
         self.logs.is_empty()
     }

@@ -19,21 +19,31 @@ pub enum Metric {
 /// One commit's measurement of a case.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Point {
+    /// The commit measured, as its records name it.
     pub commit: String,
+    /// Its committer date, ISO 8601; `None` when git did not know the commit.
     pub commit_date: Option<String>,
     /// The median of its records' medians (one record: its median), and the widest interval
     /// of them.
     pub value: f64,
+    /// The lowest low and the highest high of its records' 95% intervals, in the series' metric.
     pub ci95: [f64; 2],
+    /// Records of the commit the point is made from (builds with uncommitted changes left out).
     pub records: usize,
 }
 
+/// A case's series on one machine class and config: one point per commit, in commit order.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Series {
+    /// The machine class, as its history file names it.
     pub class: String,
+    /// The sweep config's name the records came from.
     pub config: String,
+    /// The case key.
     pub case: String,
+    /// What the values are, one metric for the whole series.
     pub metric: Metric,
+    /// One point per commit, ordered by commit date, then by order of measurement.
     pub points: Vec<Point>,
     /// Records measured on a build with uncommitted changes: not any commit's code, so not
     /// in the series.

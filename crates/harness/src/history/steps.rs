@@ -17,9 +17,11 @@ pub struct Step {
     pub between: [String; 2],
     /// The levels of the whole segments before and after, in the series' metric.
     pub before: f64,
+    /// The level after, likewise.
     pub after: f64,
     /// `after / before` and its 95% interval.
     pub ratio: f64,
+    /// The 95% interval of the ratio, from the series' noise and the two segments' lengths.
     pub ratio_ci95: [f64; 2],
 }
 

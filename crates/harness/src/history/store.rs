@@ -24,11 +24,14 @@ const SEED: u64 = 0x5eed;
 /// One case of one measurement (a sweep, a gate run, a backfilled commit).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Record {
+    /// Schema tag, [`HISTORY_SCHEMA`]; a line with another is not read as a record.
     pub schema: String,
     /// The commit measured (empty when the results name none), its first parent and its
     /// committer date (ISO 8601), when git knows them.
     pub commit: String,
+    /// Full hash of the commit's first parent; `None` when git does not know the commit.
     pub parent: Option<String>,
+    /// Committer date of the commit, ISO 8601; `None` when git does not know the commit.
     pub commit_date: Option<String>,
     /// Uncommitted changes were in the build.
     pub dirty: bool,
@@ -36,19 +39,24 @@ pub struct Record {
     pub measured: String,
     /// The machine class (CPU signature and logical CPUs), as the gate's baselines name it.
     pub class: String,
+    /// How the measured binary was built.
     pub build: Build,
     /// The sweep config's name and what made the record (`sweep`, `gate`, `backfill`).
     pub config: String,
+    /// What made the record: `sweep`, `gate` or `backfill`.
     pub source: String,
     /// The case key, and its particle count.
     pub case: String,
+    /// Particles of the case.
     pub n: usize,
     /// Median time per step with its bootstrap 95% interval, seconds.
     pub median_s: f64,
+    /// Bootstrap 95% interval of that median, seconds per step ([low, high]).
     pub ci95_s: [f64; 2],
     /// The same over the reference workload timed before each sample (dimensionless), when
     /// every sample has one: comparable across machines of a class whose speed drifts.
     pub normalized: Option<Normalized>,
+    /// Samples the median is over, all rounds, the rejected ones left out.
     pub samples: usize,
     /// The work of one force computation on the initial state (the same for the same code).
     pub work: Option<WorkCounters>,
@@ -57,52 +65,70 @@ pub struct Record {
 /// How the measured binary was built.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Build {
+    /// Version of nbody-bench that measured (`CARGO_PKG_VERSION`).
     pub tool_version: String,
+    /// Cargo profile of the build: "release" or "debug".
     pub profile: String,
+    /// The SIMD level the kernels ran with.
     pub simd: String,
+    /// Cargo features compiled in.
     pub features: Vec<String>,
 }
 
+/// A case's median over the reference workload timed before each sample (dimensionless).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Normalized {
+    /// Median of each sample over its reference time.
     pub median: f64,
+    /// Bootstrap 95% interval of that median ([low, high]).
     pub ci95: [f64; 2],
 }
 
 /// A line of a history file that is not a record.
 #[derive(Clone, Debug, PartialEq)]
 pub struct BadLine {
+    /// Line number in the file, from 1.
     pub line: usize,
+    /// What is wrong with it: not JSON of a record, or another schema.
     pub problem: String,
 }
 
 /// A history file's records, and the lines that were not records.
 #[derive(Clone, Debug, Default)]
 pub struct History {
+    /// The readable records, in file order.
     pub records: Vec<Record>,
+    /// The lines that were not records, left out.
     pub bad: Vec<BadLine>,
 }
 
+/// Why a history file cannot be read or appended to.
 #[derive(Debug, Error)]
 pub enum HistoryError {
+    /// The history file exists but cannot be read.
     #[error("cannot read {path}: {source}")]
     Read {
+        /// The file.
         path: PathBuf,
+        /// The underlying error.
         source: std::io::Error,
     },
+    /// The history folder or a file in it cannot be created, locked or written.
     #[error("cannot append to {path}: {source}")]
     Append {
+        /// The file.
         path: PathBuf,
+        /// The underlying error.
         source: std::io::Error,
     },
-    #[error("{path}: case {case} has no successful sample; nothing to record (measure it first)")]
-    Unmeasured { path: PathBuf, case: String },
 }
 
 /// The commit facts git gives for a record: first parent and committer date.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct CommitFacts {
+    /// Full hash of the commit's first parent; `None` when git does not know the commit.
     pub parent: Option<String>,
+    /// Committer date, ISO 8601 (`git show --format=%cI`); `None` when git does not know it.
     pub date: Option<String>,
 }
 

@@ -20,18 +20,25 @@ pub const GATE_REPORT_SCHEMA: &str = crate::gate::GATE_SCHEMA;
 /// One gate run.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GateRun {
+    /// Schema tag, [`VERDICTS_SCHEMA`]; a line with another is not read as a run.
     pub schema: String,
     /// UTC, when the run's later side started measuring.
     pub measured: String,
+    /// The machine class, as the gate's baselines name it.
     pub class: String,
     /// The baseline's commit and this build's, each with whether it had uncommitted changes.
     pub base: String,
+    /// Whether the baseline's build had uncommitted changes.
     pub base_dirty: bool,
+    /// This build's commit.
     pub current: String,
+    /// Whether this build had uncommitted changes.
     pub current_dirty: bool,
+    /// Relative change a case had to exceed to count (0.10 = 10%).
     pub threshold: f64,
     /// Which ratio the verdicts come from; each case's `ratio` is that one.
     pub judged_on: Judged,
+    /// Every compared case's verdict, in the baseline's order.
     pub cases: Vec<CaseVerdict>,
     /// Baseline cases that could not be compared.
     #[serde(default)]
@@ -41,10 +48,13 @@ pub struct GateRun {
 /// One case's verdict.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct CaseVerdict {
+    /// The case key.
     pub key: String,
+    /// The gate's verdict on the case.
     pub verdict: Verdict,
     /// current / base, and its bootstrap 95% interval.
     pub ratio: f64,
+    /// Bootstrap 95% interval of that ratio ([low, high]).
     pub ci95: [f64; 2],
 }
 
@@ -192,7 +202,9 @@ pub fn file_of(dir: &Path, class: &str) -> PathBuf {
 /// A verdict file's runs, in file order, and the lines that were not runs.
 #[derive(Clone, Debug, Default)]
 pub struct Verdicts {
+    /// The readable runs, in file order.
     pub runs: Vec<GateRun>,
+    /// The lines that were not runs, left out.
     pub bad: Vec<BadLine>,
 }
 

@@ -30,6 +30,7 @@ mod page;
 mod save;
 #[cfg(all(test, feature = "plot"))]
 mod tests;
+#[cfg(feature = "plot")]
 mod text;
 
 pub use spec::{Axis, Chart, Scale, Series, SeriesStyle, Unit};
@@ -38,20 +39,34 @@ pub(crate) use spec::{Rendered, StackedBars};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// Why a figure was not drawn or written.
 #[derive(Debug, Error)]
 pub enum PlotError {
+    /// This build lacks the `plot` cargo feature, so nothing can be drawn.
     #[error("built without the `plot` feature; rebuild with `--features plot` to draw figures")]
     Disabled,
+    /// The figure's stem (given here) is empty, starts with '.' or has characters other than
+    /// letters, digits, '-', '_' and '.', so it could land outside its directory.
     #[error("figure name {0:?} is not a plain file name: use letters, digits, '-', '_' or '.'")]
     BadName(String),
+    /// The directory the figure goes into could not be created.
     #[error("cannot create the figure directory {path}: {source}")]
     Dir {
+        /// The directory.
         path: PathBuf,
+        /// The error creating it.
         #[source]
         source: std::io::Error,
     },
+    /// plotters failed drawing the SVG, or resvg failed rasterizing it to the PNG.
     #[error("cannot draw {path}: {message}")]
-    Draw { path: PathBuf, message: String },
+    Draw {
+        /// The file being drawn (`stem.svg` or `stem.png`).
+        path: PathBuf,
+        /// The drawing library's error message.
+        message: String,
+    },
+    /// Writing the drawn SVG or PNG atomically into place failed.
     #[error(transparent)]
     Write(#[from] nbody_engine::output::WriteError),
 }

@@ -20,11 +20,16 @@ pub(crate) const REFERENCE: (u8, u8, u8) = (0x55, 0x55, 0x55);
 /// The colour index that draws in [`REFERENCE`] grey (ideal lines, hardware ceilings).
 pub(crate) const REFERENCE_INDEX: usize = usize::MAX;
 
+/// The shape drawn at a series' data points (and in its legend swatch), from [`marker`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Marker {
+    /// A filled disc; palette index 0's shape.
     Circle,
+    /// An axis-aligned filled square.
     Square,
+    /// A filled triangle pointing up.
     Triangle,
+    /// A filled square standing on a corner; also reference series' shape.
     Diamond,
 }
 

@@ -8,20 +8,27 @@ use std::path::PathBuf;
 /// horizontal reference lines and shaded x-ranges. The legend lists every labelled item.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Chart {
+    /// The heading drawn above the plot.
     pub title: String,
     /// One line under the plot, typically the machine and commit the data came from.
     pub caption: String,
+    /// The horizontal axis.
     pub x: Axis,
+    /// The vertical axis.
     pub y: Axis,
+    /// The data and fitted curves, drawn in order (later ones on top).
     pub series: Vec<Series>,
+    /// Shaded bands (confidence bands of fits), drawn beneath the series.
     pub bands: Vec<Band>,
     pub(crate) hlines: Vec<RefLine>,
+    /// Shaded vertical strips (e.g. where a curve is extrapolated), drawn beneath everything else.
     pub regions: Vec<Region>,
     /// Legend text explaining hollow markers; shown only when some point is hollow.
     pub(crate) hollow_label: String,
 }
 
 impl Chart {
+    /// An empty chart titled `title` over the axes `x` and `y`, with no caption.
     pub fn new(title: impl Into<String>, x: Axis, y: Axis) -> Self {
         Chart {
             title: title.into(),
@@ -36,14 +43,17 @@ impl Chart {
         }
     }
 
+    /// The chart with `caption` as the line under the plot.
     pub fn caption(mut self, caption: impl Into<String>) -> Self {
         self.caption = caption.into();
         self
     }
 }
 
+/// How values are spaced along an axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scale {
+    /// Equal steps for equal differences.
     Linear,
     /// Base-10 logarithmic. Falls back to linear when any value on the axis is not positive.
     Log,
@@ -64,10 +74,13 @@ pub enum Unit {
     Bytes,
 }
 
+/// One axis of a [`Chart`]: its title, scale, unit of the tick labels and range.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Axis {
     pub(crate) label: String,
+    /// Linear or logarithmic spacing.
     pub scale: Scale,
+    /// How tick labels are written (plain, seconds, counts, percent, bytes).
     pub unit: Unit,
     /// Fixed bounds; `None` fits the data. Points outside a fixed range are not drawn.
     pub range: Option<(f64, f64)>,
@@ -78,6 +91,7 @@ pub struct Axis {
 }
 
 impl Axis {
+    /// A linear axis titled `label`, plain numbers, fitted to the data.
     pub fn linear(label: impl Into<String>) -> Self {
         Axis {
             label: label.into(),
@@ -89,6 +103,7 @@ impl Axis {
         }
     }
 
+    /// A base-10 logarithmic axis titled `label`, plain numbers, fitted to the data.
     pub fn log(label: impl Into<String>) -> Self {
         Axis {
             scale: Scale::Log,
@@ -103,11 +118,13 @@ impl Axis {
         }
     }
 
+    /// The axis with its tick labels written in `unit`.
     pub fn unit(mut self, unit: Unit) -> Self {
         self.unit = unit;
         self
     }
 
+    /// The axis fixed to `[lo, hi]` instead of fitted to the data.
     pub fn range(mut self, lo: f64, hi: f64) -> Self {
         self.range = Some((lo, hi));
         self
@@ -119,19 +136,27 @@ impl Axis {
     }
 }
 
+/// How a series is drawn.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum SeriesStyle {
+    /// A solid line through the points, no markers.
     Line,
+    /// Markers only, no line (measurements that are not a curve).
     Markers,
+    /// A solid line with a marker at each point.
     LineMarkers,
+    /// A dashed line, no markers (ideals and models, e.g. `S = p`).
     Dashed,
 }
 
+/// One labelled sequence of points on a [`Chart`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Series {
     /// Legend text; an empty label keeps the series out of the legend.
     pub(crate) label: String,
+    /// The points in drawing order; lines join them in this order.
     pub points: Vec<Point>,
+    /// Line, markers, both, or dashed line.
     pub style: SeriesStyle,
     /// Index into the palette ([`super::palette::PALETTE`], wrapping); `None` uses the
     /// series' position in the chart. Give a kernel's points and its fit the same index.
@@ -139,6 +164,7 @@ pub struct Series {
 }
 
 impl Series {
+    /// A series labelled `label` (empty: not in the legend) coloured by its position.
     pub fn new(label: impl Into<String>, points: Vec<Point>, style: SeriesStyle) -> Self {
         Series {
             label: label.into(),
@@ -158,6 +184,7 @@ impl Series {
         Series::new(label, points, style)
     }
 
+    /// The series drawn with palette colour (and marker) `index` instead of its position's.
     pub fn color(mut self, index: usize) -> Self {
         self.color = Some(index);
         self

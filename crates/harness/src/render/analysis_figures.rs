@@ -17,7 +17,9 @@ use std::path::Path;
 /// A drawn figure: its file stem (the files are `<stem>.svg` and `<stem>.png`) and title.
 #[derive(Clone, Debug, Serialize)]
 pub struct Figure {
+    /// File name without extension, e.g. `speedup-lj-box`; its prefix says the figure's kind.
     pub stem: String,
+    /// The chart's title, also its alt text in Markdown.
     pub title: String,
 }
 

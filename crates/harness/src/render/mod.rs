@@ -14,8 +14,11 @@ use std::path::{Path, PathBuf};
 
 /// What `write` produced.
 pub struct Written {
+    /// The analysis as JSON, `<dir>/fits.json`.
     pub fits: PathBuf,
+    /// The Markdown summary, `<dir>/summary.md`.
     pub summary: PathBuf,
+    /// The figures drawn, each as `<dir>/<stem>.svg` and `.png`.
     pub figures: Vec<analysis_figures::Figure>,
     /// Figures that could not be drawn (the fits and summary are written regardless).
     pub figure_errors: Vec<String>,

@@ -6,6 +6,7 @@ use super::tables;
 use crate::analysis::Analysis;
 use std::fmt::Write;
 
+/// The text of `summary.md` for `a`, linking `figures` as `<stem>.svg` beside it.
 pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     let mut md = String::new();
     let _ = writeln!(

@@ -200,13 +200,18 @@ pub fn speedups_table(speedups: &[Speedup]) -> Table {
 mod tests {
     use super::*;
 
-    #[test]
-    fn speedups_are_against_the_one_thread_twin_and_the_ceiling() {
+    /// The committed results of `configs/quick.toml`.
+    fn quick() -> ResultsFile {
         let path = concat!(
             env!("CARGO_MANIFEST_DIR"),
             "/../../results/quick/results.json"
         );
-        let results = ResultsFile::load(std::path::Path::new(path)).unwrap();
+        ResultsFile::load(std::path::Path::new(path)).unwrap()
+    }
+
+    #[test]
+    fn speedups_are_against_the_one_thread_twin_and_the_ceiling() {
+        let results = quick();
         let found = speedups(&results);
         assert!(!found.is_empty(), "quick has 2-thread cases");
         for s in &found {
@@ -228,11 +233,7 @@ mod tests {
 
     #[test]
     fn every_case_has_a_row_and_a_missing_value_is_a_dash() {
-        let path = concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../../results/quick/results.json"
-        );
-        let results = ResultsFile::load(std::path::Path::new(path)).unwrap();
+        let results = quick();
         let text = cases(&results).text();
         assert_eq!(text.lines().count(), results.cases.len() + 1);
         assert!(

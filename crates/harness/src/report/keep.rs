@@ -5,14 +5,27 @@
 use std::collections::BTreeMap;
 use thiserror::Error;
 
+/// Why the kept regions of a document cannot be read; lines are 1-based.
 #[derive(Debug, Error, PartialEq)]
 pub enum KeepError {
+    /// An opening marker with no closing marker after it.
     #[error(
         "line {line}: `<!-- keep:{name} -->` is never closed; add `<!-- /keep:{name} -->` after the text to keep"
     )]
-    Unclosed { name: String, line: usize },
+    Unclosed {
+        /// The region's name.
+        name: String,
+        /// The line of its opening marker (when merging a generated document: its last line).
+        line: usize,
+    },
+    /// Two regions of the same name.
     #[error("line {line}: the kept region `{name}` appears twice; rename one of them")]
-    Duplicate { name: String, line: usize },
+    Duplicate {
+        /// The repeated name.
+        name: String,
+        /// The line of the second region's opening marker.
+        line: usize,
+    },
 }
 
 /// The opening marker of a kept region.

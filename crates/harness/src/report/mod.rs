@@ -18,44 +18,64 @@ use nbody_records::results::{ResultsError, ResultsFile};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// Why `report` wrote nothing; the report already on disk is left as it was.
 #[derive(Debug, Error)]
 pub enum ReportError {
+    /// The results directory (or a sweep directory in it) could not be listed.
     #[error(
         "cannot read the results directory {path}: {source}; pass --results DIR with one sub-directory per sweep"
     )]
     Dir {
+        /// The directory that could not be listed.
         path: PathBuf,
+        /// The I/O error listing it.
         source: std::io::Error,
     },
+    /// No sub-directory of the results directory holds a `results.json`.
     #[error(
         "no results files (<sweep>/results.json) under {path}; run the sweeps first: scripts/report.sh"
     )]
-    NoResults { path: PathBuf },
+    NoResults {
+        /// The results directory searched.
+        path: PathBuf,
+    },
+    /// A results file could not be loaded.
     #[error(transparent)]
     Results(#[from] ResultsError),
+    /// A sweep's results could not be analysed.
     #[error(transparent)]
     Analysis(#[from] analysis::AnalysisError),
+    /// The existing report's kept-region markers are broken (unclosed or repeated).
     #[error("{path}: {source}; fix or remove the kept-region markers and run again")]
     Keep {
+        /// The report file.
         path: PathBuf,
+        /// What is wrong with its markers.
         source: keep::KeepError,
     },
+    /// The existing report exists but could not be read (its kept regions would be lost).
     #[error("cannot read the existing report {path}: {source}")]
     ReadOld {
+        /// The report file.
         path: PathBuf,
+        /// The I/O error reading it.
         source: std::io::Error,
     },
+    /// An analysis file or the report could not be written.
     #[error(transparent)]
     Write(#[from] nbody_engine::output::WriteError),
+    /// An `mpi-bench*.json` file under the results directory could not be loaded (the message).
     #[error("{0}")]
     Bench(String),
 }
 
 /// One analysed sweep and where its figures are, relative to the report.
 pub struct Sweep {
+    /// The sweep's results analysed.
     pub analysis: Analysis,
     /// Directory of the figures relative to the report's directory, with `/` separators.
     pub(crate) figures_dir: String,
+    /// The figures drawn for it into its `analysis/` directory.
     pub figures: Vec<crate::render::analysis_figures::Figure>,
 }
 
@@ -71,9 +91,13 @@ impl Sweep {
 
 /// What `generate` wrote.
 pub struct Generated {
+    /// The report written (the `out` given).
     pub path: PathBuf,
+    /// Sweeps analysed, one per results file.
     pub sweeps: usize,
+    /// Figures drawn for the sweeps' analyses, all sweeps together.
     pub figures: usize,
+    /// Figures that could not be drawn, each "stem: error" (the report is written regardless).
     pub figure_errors: Vec<String>,
     /// Figures written by hand in a kept region, by region: each belongs in a generated
     /// section (a number in a kept region goes stale when the results change).

@@ -32,14 +32,21 @@ const TREE_CHECK_BODIES: usize = 4000;
 /// What to run on every rank.
 #[derive(Clone, Debug)]
 pub struct MpiSpec {
+    /// The force kernel every rank runs (and rank 0's serial check).
     pub kernel: KernelKind,
+    /// Its parameters (θ, expansion order, skin...).
     pub params: KernelParams,
+    /// How the particles and the work are split over the ranks.
     pub decomp: Decomposition,
+    /// Timed steps, after the warm-up.
     pub steps: u64,
+    /// Untimed steps before the timed ones.
     pub warmup: u64,
     /// Threads per rank.
     pub threads: usize,
+    /// Rank grid and rebalancing of `--decomp domain` (ignored by the other decompositions).
     pub domain: DomainOptions,
+    /// Where rank 0 writes the final state and forces; `None`: not written.
     pub dump_state: Option<PathBuf>,
     /// Also integrate serially on rank 0 and compare the final states (`mpi-check`).
     pub check: bool,
@@ -47,7 +54,9 @@ pub struct MpiSpec {
 
 /// What rank 0 ends up with.
 pub struct RootResult {
+    /// The run's timings, work and energies, with the per-rank MPI report.
     pub outcome: RunOutcome,
+    /// The comparison with a serial run of the same steps; `Some` only when `check` was asked.
     pub check: Option<CheckReport>,
 }
 

@@ -71,10 +71,12 @@ impl Mpi {
         Ok(mpi)
     }
 
+    /// This process's rank in the world communicator, 0-based (rank 0 gathers the results).
     pub fn rank(&self) -> usize {
         self.comm.rank()
     }
 
+    /// The number of ranks in the job.
     pub fn size(&self) -> usize {
         self.comm.size()
     }

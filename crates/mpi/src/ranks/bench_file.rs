@@ -9,10 +9,14 @@ use thiserror::Error;
 
 pub(crate) const MPI_BENCH_SCHEMA: &str = "nbody-bench/mpi-bench/v1";
 
+/// An `mpi-bench` results file: who ran it where, and the two timing series.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MpiBenchFile {
+    /// Always `nbody-bench/mpi-bench/v1` in a file this version loads.
     pub schema: String,
+    /// The nbody-bench version that wrote the file.
     pub tool_version: String,
+    /// `git rev-parse HEAD` where it ran; "unknown" outside a git checkout.
     pub git_commit: String,
     /// UTC, ISO 8601.
     pub started: String,
@@ -20,10 +24,13 @@ pub struct MpiBenchFile {
     pub ranks: usize,
     /// Rank 0's processor name, and every rank's.
     pub host: String,
+    /// Every rank's processor name, by rank.
     pub hosts: Vec<String>,
     /// The MPI library's version string and the MPI standard version it implements.
     pub mpi_library: String,
+    /// The MPI standard version, "major.minor".
     pub mpi_standard: String,
+    /// Logical CPUs of rank 0's machine.
     pub logical_cpus: usize,
     /// More ranks than logical CPUs: timings include time-sharing of the CPUs.
     pub oversubscribed: bool,
@@ -48,29 +55,48 @@ pub struct Series {
     pub ranks: usize,
     /// Untimed repetitions before the timed ones, per size.
     pub warmup: usize,
+    /// One entry per message size, smallest first.
     pub points: Vec<SizeTimings>,
 }
 
 /// Every timed repetition at one message size.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SizeTimings {
+    /// The message size, bytes (per rank, for Allgatherv).
     pub bytes: u64,
+    /// Each timed repetition, seconds (finite and >= 0 in a loaded file).
     pub seconds: Vec<f64>,
 }
 
+/// Why an `mpi-bench` file could not be loaded; every variant names the file.
 #[derive(Debug, Error)]
 pub enum BenchFileError {
+    /// The file could not be read (missing, unreadable, not UTF-8).
     #[error("cannot read {path}: {source}")]
     Read {
+        /// The mpi-bench file.
         path: PathBuf,
+        /// The I/O error reading it.
         source: std::io::Error,
     },
+    /// The text is not JSON, not the file's shape, or has a missing or impossible timing.
     #[error(
         "{path} is not a valid mpi-bench file ({detail}); it may be truncated or from another tool"
     )]
-    Corrupt { path: PathBuf, detail: String },
+    Corrupt {
+        /// The mpi-bench file.
+        path: PathBuf,
+        /// What is wrong, from the JSON parser or the timing check.
+        detail: String,
+    },
+    /// The file's `schema` is not this version's ("(none)" when it has none).
     #[error("{path} has schema `{found}`, this version reads `{MPI_BENCH_SCHEMA}`")]
-    Schema { path: PathBuf, found: String },
+    Schema {
+        /// The mpi-bench file.
+        path: PathBuf,
+        /// The schema it declares.
+        found: String,
+    },
 }
 
 /// The byte-transfer layers this process's MPI runs were restricted to, if any.
@@ -88,6 +114,7 @@ impl MpiBenchFile {
             .is_some_and(|t| t.split(',').any(|l| l.trim() == "tcp"))
     }
 
+    /// Reads and checks an mpi-bench file ([`MpiBenchFile::parse`]).
     pub fn load(path: &Path) -> Result<MpiBenchFile, BenchFileError> {
         let text = crate::input::read_text(path).map_err(|source| BenchFileError::Read {
             path: path.into(),

@@ -87,6 +87,7 @@ impl JobDigest {
 pub struct Difference;
 
 impl Difference {
+    /// The ranks were given different commands or arguments.
     pub const COMMAND: u8 = 1;
     pub(crate) const BUILD: u8 = 2;
 

@@ -167,21 +167,26 @@ pub enum Steps {
     Scaled(ScaledSteps),
 }
 
+/// A step count that falls as n grows: `work / grows(n)` steps per run (`steps = { work, grows }`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ScaledSteps {
     /// The cost of one run, in the units of `grows` (pair interactions for `"n^2"`).
     pub work: f64,
+    /// How one step's cost grows with n, written "n", "n log n" or "n^2".
     pub grows: Growth,
 }
 
 /// How the cost of one step grows with n.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Growth {
+    /// `"n"`: a step costs n units (a cell list, a particle-mesh code).
     #[serde(rename = "n")]
     Linear,
+    /// `"n log n"`: a step costs n·log₂ n units (a tree code); log₂ n is taken as at least 1.
     #[serde(rename = "n log n")]
     NLogN,
+    /// `"n^2"`: a step costs n² units, the pair interactions of a direct code.
     #[serde(rename = "n^2")]
     Quadratic,
 }
@@ -191,6 +196,7 @@ pub enum Growth {
 pub const MAX_STEPS: u64 = 1 << 40;
 
 impl Growth {
+    /// How the config writes it: "n", "n log n" or "n^2".
     pub fn name(self) -> &'static str {
         match self {
             Growth::Linear => "n",
@@ -252,29 +258,40 @@ pub enum TimeSource {
     Regex(TimeRegex),
 }
 
+/// The string `"wall"` of `time = "wall"` (its only value).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum WallTag {
+    /// `"wall"`: time the whole process.
     Wall,
 }
 
+/// `time = { regex, unit }`: the run's time is the number the program prints.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeRegex {
+    /// Its first group is the time; the last match in the output counts.
     pub regex: String,
+    /// The unit of the printed number.
     pub unit: TimeUnit,
 }
 
+/// The unit of a number an external program prints: `"s"`, `"ms"`, `"us"` or `"ns"`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum TimeUnit {
+    /// Seconds (`"s"`).
     S,
+    /// Milliseconds (`"ms"`).
     Ms,
+    /// Microseconds (`"us"`).
     Us,
+    /// Nanoseconds (`"ns"`).
     Ns,
 }
 
 impl TimeUnit {
+    /// Seconds in one of this unit: a printed number times this is seconds.
     pub fn seconds(self) -> f64 {
         match self {
             TimeUnit::S => 1.0,
@@ -291,7 +308,9 @@ impl TimeUnit {
 pub struct PhaseSource {
     /// Its first group is the phase's time over the whole run.
     pub regex: String,
+    /// The unit of the printed number.
     pub unit: TimeUnit,
+    /// How the analysis reads it; parallel when the config says nothing.
     #[serde(default)]
     pub kind: PhaseKind,
 }
@@ -310,6 +329,7 @@ pub enum PhaseKind {
 }
 
 impl PhaseKind {
+    /// How the config and the reports write it: "parallel", "serial" or "comm".
     pub fn name(self) -> &'static str {
         match self {
             PhaseKind::Parallel => "parallel",

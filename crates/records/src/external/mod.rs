@@ -29,6 +29,7 @@ pub struct ExternalRound {
     /// The set-up command failed: no sample was taken.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub setup_error: Option<SampleError>,
+    /// Problems worth a reader's attention (launch overhead unknown or too large a share).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub warnings: Vec<String>,
 }
@@ -55,14 +56,19 @@ pub struct ExternalRun {
 /// A failed run: what went wrong and the program's last lines of output.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SampleError {
+    /// What went wrong, as a sentence ("timed out after 600 s and was killed").
     pub what: String,
+    /// The command line that ran, as a person would type it (for messages only).
     pub command: String,
+    /// The last lines of its standard error, else of its standard output (at most 20).
     pub output_tail: Vec<String>,
 }
 
 /// An external's version line, in the results metadata.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ExternalVersion {
+    /// The program's name in the config (`[[external]] name`).
     pub name: String,
+    /// The first line its version command printed, or why there is none, in parentheses.
     pub version: String,
 }

@@ -13,18 +13,31 @@ pub(crate) const CASE_PLACEHOLDERS: [&str; 8] = [
 /// Placeholders known before any case (the only ones `version` may use).
 pub(crate) const SWEEP_PLACEHOLDERS: [&str; 2] = ["config_dir", "nbody_bench"];
 
+/// Why a command token's placeholders cannot be replaced; each names the token as written.
 #[derive(Debug, Error, PartialEq)]
 pub enum PlaceholderError {
+    /// A `{name}` that is not a placeholder, or not one available there (a case's in `version`).
     #[error("`{token}` has an unknown placeholder `{{{name}}}`; known: {known}")]
     Unknown {
+        /// The token as written in the config.
         token: String,
+        /// The name between the braces.
         name: String,
+        /// The placeholders allowed there, braced and space-separated.
         known: String,
     },
+    /// A `{` with no `}` after it.
     #[error("`{token}` has an unclosed `{{`; write `{{{{` for a literal brace")]
-    Unclosed { token: String },
+    Unclosed {
+        /// The token as written in the config.
+        token: String,
+    },
+    /// A `}` that closes nothing and is not doubled.
     #[error("`{token}` has a lone `}}`; write `}}}}` for a literal brace")]
-    LoneClose { token: String },
+    LoneClose {
+        /// The token as written in the config.
+        token: String,
+    },
 }
 
 /// Values of the placeholders.
@@ -68,6 +81,7 @@ impl Vars {
         })
     }
 
+    /// Every token of a command with its placeholders replaced; the first error otherwise.
     pub fn substitute_all(&self, tokens: &[String]) -> Result<Vec<String>, PlaceholderError> {
         tokens.iter().map(|t| self.substitute(t)).collect()
     }

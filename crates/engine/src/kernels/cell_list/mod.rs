@@ -34,6 +34,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 use strips::Strips;
 
+/// The `cell-list` kernel for the short-range law `L` (see the module doc).
 pub struct CellList<L, T, const D: usize> {
     law: L,
     /// The cutoff, in f64 for the bin geometry.
@@ -42,6 +43,7 @@ pub struct CellList<L, T, const D: usize> {
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
+    /// The kernel for `law`; refused when the law has no finite positive cutoff.
     pub fn new(law: L) -> Result<Self, KernelError> {
         let rc = match law.cutoff() {
             Some(rc) if rc.is_finite() && rc > T::zero() => rc.as_f64(),

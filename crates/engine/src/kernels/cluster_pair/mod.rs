@@ -64,6 +64,7 @@ const MIN_PART_CLUSTERS: usize = 128;
 /// evaluations, the unit of `worth_parallel`.
 const RUN_COST: u64 = (CLUSTER * LANES) as u64;
 
+/// The `cluster-pair` kernel for the short-range law `L`: a Verlet list of 4-particle clusters.
 pub struct ClusterPair<L, T, const D: usize> {
     law: L,
     skin: f64,
@@ -85,6 +86,8 @@ pub struct ClusterPair<L, T, const D: usize> {
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
+    /// The kernel for `law` with list skin `skin` (length units); refused without a finite cutoff
+    /// or a positive skin.
     pub fn new(law: L, skin: f64) -> Result<Self, KernelError> {
         let rc = list_cutoff::<T, L, D>(&law, skin, "the cluster-pair list")?;
         let radius = rc + skin;

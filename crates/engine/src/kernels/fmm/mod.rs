@@ -70,6 +70,7 @@ pub(crate) const DEFAULT_LEAF_SIZE: usize = 64;
 /// Cells (M2L) or leaves (near field, L2P) per parallel task.
 const CELLS_PER_TASK: usize = 16;
 
+/// The `fmm` kernel for the inverse-square law `L` (see the module doc).
 pub struct Fmm<L: PairLaw<T>, T: Real, const D: usize> {
     law: L,
     /// The law in f64, for the expansions.

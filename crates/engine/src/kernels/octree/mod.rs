@@ -75,8 +75,10 @@ pub enum Multipole {
 }
 
 impl Multipole {
+    /// Both orders, lowest first.
     pub const ALL: [Multipole; 2] = [Multipole::Monopole, Multipole::Quadrupole];
 
+    /// The order's name on the command line and in results.
     pub fn name(self) -> &'static str {
         match self {
             Multipole::Monopole => "monopole",
@@ -85,6 +87,8 @@ impl Multipole {
     }
 }
 
+/// The `octree` kernel (a quadtree in 2-D) for the inverse-square law `L`: Barnes-Hut with opening
+/// angle θ.
 pub struct Octree<L, T, const D: usize> {
     law: L,
     tree: Tree<T, D>,

@@ -56,6 +56,8 @@ pub use work::{parts_for, step_work};
 /// still be in the list (f32 rounds `r²` by a few parts in 1e7).
 const LIST_MARGIN: f64 = 1e-5;
 
+/// The `verlet` kernel for the short-range law `L`: a half neighbour list within the cutoff plus a
+/// skin.
 pub struct Verlet<L, T, const D: usize> {
     law: L,
     skin: f64,
@@ -75,6 +77,8 @@ pub struct Verlet<L, T, const D: usize> {
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
+    /// The kernel for `law` with list skin `skin` (length units); refused without a finite cutoff
+    /// or a positive skin.
     pub fn new(law: L, skin: f64) -> Result<Self, KernelError> {
         let rc = list_cutoff::<T, L, D>(&law, skin, "the Verlet list")?;
         let radius = rc + skin;

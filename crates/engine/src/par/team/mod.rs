@@ -39,10 +39,20 @@ pub struct Stopped;
 pub enum TeamError {
     /// A worker's closure returned this error.
     #[error("worker {worker}: {message}")]
-    Failed { worker: usize, message: String },
+    Failed {
+        /// The worker's index in the team, from 0.
+        worker: usize,
+        /// The error, as text.
+        message: String,
+    },
     /// A worker panicked with this message.
     #[error("worker {worker} panicked: {message}")]
-    Panicked { worker: usize, message: String },
+    Panicked {
+        /// The worker's index in the team, from 0.
+        worker: usize,
+        /// The panic's message, or `(no message)` when it carried no text.
+        message: String,
+    },
     /// The team's threads could not be started.
     #[error("cannot start the team's threads: {0}")]
     Spawn(String),

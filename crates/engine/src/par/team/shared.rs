@@ -19,6 +19,7 @@ unsafe impl<T: Send + Sync> Sync for SharedSlice<'_, T> {}
 unsafe impl<T: Send> Send for SharedSlice<'_, T> {}
 
 impl<'a, T> SharedSlice<'a, T> {
+    /// Lends `slice` to the workers for as long as it is borrowed.
     pub fn new(slice: &'a mut [T]) -> Self {
         SharedSlice {
             ptr: slice.as_mut_ptr(),
@@ -32,10 +33,12 @@ impl<'a, T> SharedSlice<'a, T> {
         parts.map(SharedSlice::new)
     }
 
+    /// Number of elements.
     pub fn len(&self) -> usize {
         self.len
     }
 
+    /// Whether the slice has no elements.
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }

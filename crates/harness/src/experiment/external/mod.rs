@@ -15,33 +15,50 @@ pub(crate) const OVERHEAD_WARN: f64 = 0.05;
 /// The version command is killed after this many seconds.
 const VERSION_TIMEOUT_S: f64 = 30.0;
 
+/// Why an external program's case could not be run (a failed run is a sample's error, not this).
 #[derive(Debug, Error)]
 pub enum ExternalError {
+    /// A program the entry names (its command, set-up, version or empty command, or the MPI
+    /// launcher) is not an executable file, checked before the sweep starts.
     #[error(
         "external `{name}`: program `{program}` not found{where_}: {why}; install it (for the peers of \
          configs/vs-*.toml: scripts/install-peers.sh) or fix `command` (or the PATH its `env` \
          sets)"
     )]
     NotFound {
+        /// The `[[external]]` entry's `name`.
         name: String,
+        /// The program as written, placeholders substituted.
         program: String,
+        /// Empty for the `command`, else which field named it, e.g. " (its `setup`)".
         where_: String,
+        /// Why it cannot be started, from [`process::resolve`].
         why: String,
     },
+    /// A placeholder in the command, set-up or `env` could not be substituted for the case.
     #[error("external `{name}`: {source}")]
     Placeholder {
+        /// The `[[external]]` entry's `name`.
         name: String,
+        /// Which placeholder and why.
         source: placeholders::PlaceholderError,
     },
+    /// One of the entry's regular expressions (check, time, force error, phases) is invalid.
     #[error("external `{name}`: the regular expression `{regex}` does not compile: {source}")]
     Regex {
+        /// The `[[external]]` entry's `name`.
         name: String,
+        /// The expression as written.
         regex: String,
+        /// The regex crate's error.
         source: regex::Error,
     },
+    /// A case's work directory, under the results' `work/`, could not be created.
     #[error("cannot create the work directory {path}: {source}")]
     Workdir {
+        /// The directory.
         path: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
 }
@@ -50,7 +67,9 @@ pub enum ExternalError {
 /// reads it from its task file).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct Context {
+    /// What `{config_dir}` stands for in commands: absolute, the current directory by default.
     pub config_dir: PathBuf,
+    /// What `{nbody_bench}` stands for: this program, absolute (a batch job runs it too).
     pub nbody_bench: PathBuf,
     /// Case work directories are made under this one.
     pub(crate) work_root: PathBuf,

@@ -19,10 +19,13 @@ const TAIL_BYTES: u64 = 64 << 10;
 /// A process that ran, or was killed at its timeout.
 #[derive(Debug)]
 pub struct Finished {
+    /// Wall time from start to exit (or to the kill at the timeout), seconds.
     pub wall_s: f64,
     /// `None` when killed at the timeout.
     pub status: Option<ExitStatus>,
+    /// What it wrote to standard output (`stdout.txt`), as read back.
     pub stdout: Output,
+    /// What it wrote to standard error (`stderr.txt`), as read back.
     pub stderr: Output,
 }
 
@@ -59,7 +62,9 @@ impl Finished {
 /// A command ready to start.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Launch {
+    /// The program and its arguments, run without a shell; the program is found by [`resolve`].
     pub argv: Vec<String>,
+    /// Variables set on top of the sweep's own environment, in order.
     pub env: Vec<(String, String)>,
 }
 

@@ -39,24 +39,51 @@ const CALL_LIMIT: Duration = Duration::from_secs(120);
 /// Failed looks at the queue in a row before the sweep gives up on it (it can be resumed).
 const QUEUE_FAILURES: usize = 5;
 
+/// Why work could not be run as a Slurm job, or waited for.
 #[derive(Debug, Error)]
 pub enum SlurmError {
+    /// A job directory could not be created, or a stale file in it removed.
     #[error("cannot prepare the job directory {path}: {source}")]
     Dir {
+        /// The directory or the stale file.
         path: PathBuf,
+        /// The system's error.
         source: std::io::Error,
     },
+    /// A file of the job (`task.json`, `job.sh`, `job-id`) could not be serialized or written.
     #[error("cannot write {path}: {detail}")]
-    Write { path: PathBuf, detail: String },
+    Write {
+        /// The file.
+        path: PathBuf,
+        /// The error's message.
+        detail: String,
+    },
+    /// `sbatch`, `squeue` or `scontrol` could not be run or failed (Slurm missing or its
+    /// controller unreachable); the message says which call and how.
     #[error("{0}; is Slurm installed and its controller reachable (`sinfo`)?")]
     Call(String),
+    /// `sbatch` failed or printed no job id.
     #[error("`sbatch` refused the job of {what}: {message}")]
-    Refused { what: String, message: String },
+    Refused {
+        /// The work, e.g. `KEY round 2` or `calibration (start)`.
+        what: String,
+        /// The last line of `sbatch`'s error output (else its output).
+        message: String,
+    },
+    /// `squeue` failed several times in a row while waiting for a job; the job is left as it
+    /// is, for `--resume`.
     #[error(
         "the queue could not be read {QUEUE_FAILURES} times in a row while waiting for job \
          {id} ({last}); the job is left as it is: run the sweep again with --resume to pick it up"
     )]
-    Queue { id: String, last: String },
+    Queue {
+        /// The Slurm job id.
+        id: String,
+        /// The last line of the last failed `squeue`'s error output.
+        last: String,
+    },
+    /// A job has run (or shown no state) for longer than its time limit plus the grace
+    /// margin; it is left in the queue for `--resume`.
     #[error(
         "job {id} ({what}) {seen} for {waited} s, longer than its time limit ({limit}) plus a \
          margin of {grace_s} s ({} sets it); the job is left as it is: check it with \
@@ -64,14 +91,21 @@ pub enum SlurmError {
         queue::GRACE_ENV
     )]
     Overdue {
+        /// The Slurm job id.
         id: String,
+        /// The work, e.g. `KEY round 2` or `calibration (start)`.
         what: String,
         /// What was seen of the job: that it ran, or no state at all.
         seen: String,
+        /// Seconds waited since the job was seen running (or last seen queued).
         waited: u64,
+        /// The `[scheduler]`'s `time_limit`, as the config writes it (e.g. `10:00`).
         limit: String,
+        /// The margin past the time limit, seconds.
         grace_s: u64,
     },
+    /// [`GRACE_ENV`], the margin past a job's time limit, is set but is not a number of
+    /// seconds in (0, 604800].
     #[error("{0}")]
     Grace(String),
 }

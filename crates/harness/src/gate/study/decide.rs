@@ -20,6 +20,7 @@ pub enum Mode {
 }
 
 impl Mode {
+    /// The mode as the study's tables name it: "A/B" or "fast path".
     pub fn name(self) -> &'static str {
         match self {
             Mode::Ab => "A/B",
@@ -42,11 +43,15 @@ pub const RULES: [Judged; 3] = [Judged::Normalized, Judged::Raw, Judged::Both];
 /// Decisions of one kind, counted.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Tally {
+    /// How the decisions were measured.
     pub mode: Mode,
+    /// The ratio the cases were judged on.
     pub rule: Judged,
+    /// Threshold the cases were judged at (0.05 = 5%), one of [`Mode::candidates`].
     pub threshold: f64,
     /// The slowed kernel's factor; 1 for unchanged code (A/A).
     pub slowdown: f64,
+    /// Decisions made (those the gate could not make are not counted).
     pub decisions: usize,
     /// Decisions that flagged some case as regressed.
     pub any_flagged: usize,
@@ -73,8 +78,11 @@ impl Tally {
 /// The median widths of A/A decisions' per-case 95% intervals of the ratio.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Widths {
+    /// How the decisions were measured.
     pub mode: Mode,
+    /// Median width of the normalised ratio's interval, relative to the ratio (0.02 = ±1%).
     pub normalized: f64,
+    /// Median width of the raw ratio's interval, relative to the raw ratio.
     pub raw: f64,
 }
 
@@ -83,9 +91,13 @@ pub struct Widths {
 /// applies the walls, which the knob leaves alone).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct StepRatio {
+    /// How the decisions were measured.
     pub mode: Mode,
+    /// The factor the knob slowed the kernel's force computation by, one of [`super::SLOWDOWNS`].
     pub slowdown: f64,
+    /// Median normalised ratio of the slowed kernel's cases.
     pub normalized: f64,
+    /// Median raw ratio of the slowed kernel's cases.
     pub raw: f64,
 }
 

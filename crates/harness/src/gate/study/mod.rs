@@ -49,6 +49,7 @@ pub struct Block {
     pub wall_s: f64,
     /// Side A's and B's records of every case, in the config's case order.
     pub a: Vec<CaseRecord>,
+    /// Side B's records of every case, likewise (the same code as A).
     pub b: Vec<CaseRecord>,
     /// For each slowdown of [`SLOWDOWNS`], the slowed kernel's cases' records (the others are
     /// B's: the knob changes nothing else).
@@ -59,17 +60,25 @@ pub struct Block {
 /// directory; the study file keeps the summary).
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RawStudy {
+    /// Schema of the raw file, [`STUDY_SCHEMA`].
     pub schema: String,
+    /// The build and host the run measured with.
     pub metadata: Metadata,
+    /// The machine's calibration taken before the blocks.
     pub calibration: Calibration,
+    /// What else ran on the machine meanwhile.
     pub load: Load,
     /// Both sides measured at the same moment, one per CPU.
     pub duet: bool,
+    /// The kernel whose force computation the slowed sides made slower.
     pub slowed_kernel: KernelKind,
     /// The gate's config the blocks measured (the class's baseline's).
     pub config: nbody_records::config::SweepConfig,
+    /// Rounds of every case per side in a block: one gate decision's, [`crate::gate::AB_ROUNDS`].
     pub rounds: usize,
+    /// Samples of every case in each round.
     pub samples_per_round: usize,
+    /// The blocks measured, in order; each gives one decision per mode and slowdown.
     pub blocks: Vec<Block>,
 }
 
@@ -77,35 +86,53 @@ pub struct RawStudy {
 /// noise study measured there, run by run, summarised.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StudyFile {
+    /// Schema of the study file, [`STUDY_SCHEMA`].
     pub schema: String,
+    /// CPU model of the machine class, from the calibration.
     pub cpu_model: String,
+    /// Vendor, family, model and stepping of the class; `None` when not recorded.
     pub cpu_signature: Option<String>,
+    /// Logical CPUs of the machine class.
     pub logical_cpus: usize,
+    /// The SIMD level the kernels ran with.
     pub simd: String,
     /// The gate's config the decisions were made on, and the baseline file the fast-path
     /// decisions compared with (none: no fast-path decisions).
     pub config_name: String,
+    /// File name of that baseline in the baseline folder; `None`: no fast-path decisions.
     pub baseline: Option<String>,
+    /// The study's runs, at most one per load and mode (duet or not).
     pub runs: Vec<StudyRun>,
 }
 
 /// One measuring run of the study, summarised.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct StudyRun {
+    /// UTC, ISO 8601, when the run started.
     pub started: String,
+    /// Commit the measuring build came from.
     pub git_commit: String,
+    /// Whether that build had uncommitted changes.
     pub git_dirty: bool,
+    /// What else ran on the machine meanwhile.
     pub load: Load,
+    /// Both sides were measured at the same moment, one per CPU (A/A decisions only).
     pub duet: bool,
+    /// The kernel made slower for the power decisions.
     pub slowed_kernel: KernelKind,
+    /// Blocks measured, each one decision per mode and slowdown.
     pub blocks: usize,
+    /// Rounds of every case per side in a block.
     pub rounds: usize,
+    /// Samples of every case in each round.
     pub samples_per_round: usize,
     /// Median wall time of one block (all its sides), seconds.
     pub block_wall_s: f64,
     /// Median wall time of measuring one decision's two sides (A and B), seconds.
     pub decision_measure_s: f64,
+    /// Decisions counted per mode, rule, threshold and slowdown.
     pub tallies: Vec<decide::Tally>,
+    /// Median relative widths of the A/A decisions' per-case intervals, per mode.
     pub widths: Vec<decide::Widths>,
     /// What each slowdown of the force computation made of the slowed kernel's step.
     #[serde(default)]

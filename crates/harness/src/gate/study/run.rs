@@ -18,18 +18,25 @@ pub struct StudyOptions {
     pub baselines: PathBuf,
     /// The config when this class has no reproducible baseline (then no fast-path decisions).
     pub config: Option<(SweepConfig, String)>,
+    /// Blocks to measure: one decision per mode and slowdown each.
     pub blocks: usize,
+    /// What else runs on the machine meanwhile.
     pub load: Load,
+    /// Measure both sides at the same moment, one per CPU (A/A decisions only).
     pub duet: bool,
+    /// The kernel made slower for the power decisions; the config must have cases of it.
     pub slowed: KernelKind,
     /// Where the study files are (`results/gate-study`) and where the raw run goes.
     pub out: PathBuf,
+    /// Root of the run directories (`results`): the raw run goes to `runs/gate-study/<UTC time>/`.
     pub runs_root: PathBuf,
 }
 
 /// Where a run left its files.
 pub struct StudyPaths {
+    /// The class's study file the summary was added to.
     pub study: PathBuf,
+    /// The raw measurements of every block, `raw.json` in the run's directory.
     pub raw: PathBuf,
 }
 

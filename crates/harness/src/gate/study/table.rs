@@ -10,6 +10,7 @@ use crate::render::tables::{Align, Table};
 /// Marks of the generated region in docs/explanation/gate.md.
 pub const BEGIN: &str =
     "<!-- generated from results/gate-study/ by `nbody-bench gate-study --docs`: do not edit -->";
+/// End mark of the generated region in docs/explanation/gate.md.
 pub const END: &str = "<!-- end of generated region -->";
 
 fn threshold(mode: Mode) -> f64 {

@@ -67,6 +67,7 @@ impl Direction {
         }
     }
 
+    /// The direction as the answer words it: "slower" or "faster".
     pub fn name(self) -> &'static str {
         match self {
             Direction::Slower => "slower",
@@ -100,11 +101,17 @@ pub struct Settings {
 /// Two commits measured side by side: `to`'s median over `from`'s.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Comparison {
+    /// Full hash of the commit measured as the reference side.
     pub from: String,
+    /// Full hash of the commit measured against it.
     pub to: String,
+    /// Median of `to`'s samples over median of `from`'s (above 1: `to` is slower).
     pub ratio: f64,
+    /// Bootstrap 95% interval of the ratio; NaN when a side has too few samples for one.
     pub ci95: [f64; 2],
+    /// The gate's verdict on `to` against `from` at the bisection's threshold.
     pub verdict: Verdict,
+    /// Samples of `from` and of `to` it was judged on, over every round of the pair so far.
     pub samples: [usize; 2],
 }
 
@@ -126,34 +133,57 @@ impl Comparison {
 #[serde(tag = "finding", rename_all = "snake_case")]
 pub enum Finding {
     /// The first slow commit: it and its parent differ at the gate's confidence.
-    Named { culprit: String, step: Comparison },
+    Named {
+        /// Full hash of the first slow commit.
+        culprit: String,
+        /// Its parent against it, side by side.
+        step: Comparison,
+    },
     /// The step is between a fast and a slow commit with only commits that do not build (or
     /// run the case) between them.
     Among {
+        /// The fast commit against the slow one.
         step: Comparison,
+        /// Full hashes of the commits between them that do not build or cannot run the case.
         unbuilt: Vec<String>,
     },
     /// Adjacent commits, one fast and one slow by the bisection, do not differ side by side:
     /// the slowdown is spread over several commits (a drift) rather than made by one.
-    Spread { step: Comparison },
+    Spread {
+        /// The last fast commit against the first slow one: no difference at the gate's
+        /// confidence.
+        step: Comparison,
+    },
     /// A commit between the ends is faster than the fast end or slower than the slow one.
-    NotMonotone { commit: String, against: Comparison },
+    NotMonotone {
+        /// Full hash of the commit between the ends.
+        commit: String,
+        /// The measurement against the end it went past.
+        against: Comparison,
+    },
     /// BAD is not slower than GOOD at the gate's confidence: there is nothing to bisect.
-    NoStep { ends: Comparison },
+    NoStep {
+        /// GOOD against BAD, side by side.
+        ends: Comparison,
+    },
 }
 
 /// A bisection's answer and how it got there.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct Bisection {
+    /// Full hash of the GOOD end.
     pub good: String,
+    /// Full hash of the BAD end.
     pub bad: String,
     /// Whether BAD was the slower or the faster end.
     pub direction: Direction,
     /// The commits after GOOD up to BAD along the first parents.
     pub commits: usize,
+    /// What the bisection concluded.
     pub finding: Finding,
     /// Commits built (or found built), in order, and the ones that failed with why.
     pub builds: Vec<String>,
+    /// Commits that failed to build or to run the case, each with why.
     pub skipped: Vec<(String, String)>,
     /// Every side-by-side measurement, in order (judged on the pair's samples so far).
     pub comparisons: Vec<Comparison>,

@@ -24,32 +24,44 @@ pub use html::html;
 /// The page's file name inside the output folder.
 pub const PAGE_FILE: &str = "index.html";
 
+/// Why the history page cannot be made or written.
 #[derive(Debug, Error)]
 pub enum PublishError {
+    /// The history folder does not exist.
     #[error(
         "{0} does not exist: there is no history to publish (record one with `nbody-bench \
          history record RESULTS`, `sweep --record` or `gate --record`, or name the folder \
          that holds it with --dir)"
     )]
     NoDir(PathBuf),
+    /// The history folder cannot be listed.
     #[error("cannot list {path}: {source}")]
     List {
+        /// The folder.
         path: PathBuf,
+        /// The underlying error.
         source: std::io::Error,
     },
+    /// The folder holds no `<class>.jsonl` with a readable record.
     #[error(
         "{0} holds no history record (no <class>.jsonl with a readable line): record one with \
          `nbody-bench history record RESULTS`, or name another folder with --dir"
     )]
     Empty(PathBuf),
+    /// A history or verdict file exists but cannot be read.
     #[error(transparent)]
     History(#[from] HistoryError),
+    /// A series holds a value that is not a time, so its steps cannot be found.
     #[error("the series of {case} on {class}: {source}")]
     Series {
+        /// The case key.
         case: String,
+        /// The machine class.
         class: String,
+        /// What is wrong with the series.
         source: ChangeError,
     },
+    /// The page, or its folder, cannot be written.
     #[error("cannot write the page: {0}; choose a folder you can write to with --out")]
     Write(#[from] nbody_engine::output::WriteError),
 }
@@ -57,15 +69,20 @@ pub enum PublishError {
 /// The history files of one machine class, read.
 #[derive(Clone, Debug)]
 pub struct ClassFiles {
+    /// The machine class, as its file names are (`<class>.jsonl`).
     pub class: String,
+    /// Its readable history records, in file order.
     pub records: Vec<Record>,
+    /// Its gate runs, from `<class>.gate.jsonl` (none when that file is missing).
     pub verdicts: Verdicts,
 }
 
 /// Every class of a history folder, and a warning for each line that was left out.
 #[derive(Clone, Debug)]
 pub struct Loaded {
+    /// Every class with at least one readable record, in the order of their names.
     pub classes: Vec<ClassFiles>,
+    /// One for each line left out of a file, naming the file, the line and what is wrong.
     pub warnings: Vec<String>,
 }
 
@@ -128,15 +145,20 @@ pub fn load(dir: &Path) -> Result<Loaded, PublishError> {
 /// One chart: a case's series on one class, its steps, and the latest gate verdict on it.
 #[derive(Clone, Debug)]
 pub struct Chart {
+    /// The case's series on one class and config.
     pub series: Series,
+    /// The steps found in it, oldest first.
     pub steps: Vec<Step>,
+    /// The case's verdict in the class's latest gate run; `None` without one, or not judged there.
     pub verdict: Option<CaseVerdict>,
 }
 
 /// A case and its charts, one per class (and config) that measured it.
 #[derive(Clone, Debug)]
 pub struct CaseView {
+    /// The case key.
     pub key: String,
+    /// Its charts, by class then config.
     pub charts: Vec<Chart>,
     /// The classes with no record of the case.
     pub absent: Vec<String>,
@@ -145,19 +167,26 @@ pub struct CaseView {
 /// What the page says of one machine class.
 #[derive(Clone, Debug)]
 pub struct ClassView {
+    /// The machine class.
     pub class: String,
+    /// History records of the class, dirty builds included.
     pub records: usize,
     /// Commits in the class's series (the clean ones), and the newest measurement.
     pub commits: usize,
+    /// UTC start of the class's newest measurement; `None` without records.
     pub newest: Option<String>,
+    /// The class's latest gate run; `None` when it has no verdicts.
     pub latest_gate: Option<GateRun>,
 }
 
+/// What the history page and the pull-request summary show: every class, case and figure.
 #[derive(Clone, Debug)]
 pub struct Page {
+    /// Every machine class with records, in the order of their names.
     pub classes: Vec<ClassView>,
     /// By case key.
     pub cases: Vec<CaseView>,
+    /// The figures of REPORT.md linked from the page, in REPORT.md's order.
     pub figures: Vec<Figure>,
 }
 

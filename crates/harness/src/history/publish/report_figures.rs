@@ -8,8 +8,11 @@ use std::path::{Component, Path, PathBuf};
 /// sweeps' figures can share a title), and its link from the page.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Figure {
+    /// REPORT.md's alternative text of the image.
     pub title: String,
+    /// The image's path as REPORT.md writes it, relative to REPORT.md.
     pub path: String,
+    /// Link to the image relative to the page's folder.
     pub href: String,
 }
 

@@ -9,7 +9,9 @@ use crate::plot::spec::{
 /// Seconds per step spent in each phase of one case, phases named.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PhaseTimes {
+    /// The case's label, the bar's name.
     pub case: String,
+    /// `(phase name, seconds per step)` in the order the bar's segments are stacked.
     pub phases: Vec<(String, f64)>,
 }
 
@@ -75,10 +77,15 @@ pub fn phase_shares(cases: &[PhaseTimes], caption: &str) -> StackedBars {
 /// Step-time percentiles of one kernel, in seconds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Percentiles {
+    /// The row's label: the case (kernel and its settings).
     pub kernel: String,
+    /// The median step time, seconds.
     pub p50: f64,
+    /// The 90th-percentile step time, seconds.
     pub p90: f64,
+    /// The 99th-percentile step time, seconds.
     pub p99: f64,
+    /// The slowest step, seconds.
     pub max: f64,
 }
 
@@ -109,15 +116,20 @@ pub fn step_percentiles(rows: &[Percentiles], caption: &str) -> Chart {
 /// precision), cost (seconds per step) and median relative force error.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ThetaPoint {
+    /// The label written next to the point, e.g. `θ=0.5`.
     pub setting: String,
+    /// The cost, seconds per step (the x of the figure).
     pub seconds: f64,
+    /// The median relative force error (the y), dimensionless.
     pub error: f64,
 }
 
 /// Runs of one code over its accuracy settings, in the order to join them (usually by θ).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ThetaSweep {
+    /// The code's name, its legend text.
     pub name: String,
+    /// Its runs, joined by a line in this order.
     pub points: Vec<ThetaPoint>,
 }
 
@@ -150,7 +162,9 @@ pub struct CommTimes {
     /// The x axis, e.g. `Axis::linear("ranks")` or `Axis::log("message size").unit(Unit::Bytes)`;
     /// the time axis uses the same scale.
     pub x: Axis,
+    /// The measured communication times per step, seconds, with their intervals.
     pub measured: Vec<Measured>,
+    /// The model's prediction, seconds per step, with its uncertainty band.
     pub predicted: Curve,
 }
 

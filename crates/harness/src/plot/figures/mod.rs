@@ -19,14 +19,18 @@ use super::spec::{Axis, Band, Chart, Point, Scale, Series, SeriesStyle};
 /// One measured value at `x`: the median over repetitions and its confidence interval.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Measured {
+    /// Where it was measured, in the figure's x unit (threads, particles, bytes…).
     pub x: f64,
+    /// The median over repetitions, in the figure's y unit (seconds, speedup…).
     pub median: f64,
+    /// The confidence interval `(lo, hi)` drawn as an error bar; `None` draws none.
     pub ci: Option<(f64, f64)>,
     /// Drawn hollow: the case ran more threads × ranks than the machine has logical CPUs.
     pub oversubscribed: bool,
 }
 
 impl Measured {
+    /// A median at `x` without an interval, not oversubscribed.
     pub fn new(x: f64, median: f64) -> Self {
         Measured {
             x,
@@ -36,6 +40,7 @@ impl Measured {
         }
     }
 
+    /// A median at `x` with its confidence interval `[ci_lo, ci_hi]`.
     pub fn with_ci(x: f64, median: f64, ci_lo: f64, ci_hi: f64) -> Self {
         Measured {
             ci: Some((ci_lo, ci_hi)),
@@ -43,6 +48,7 @@ impl Measured {
         }
     }
 
+    /// The value marked (drawn hollow) when `oversubscribed` is true.
     pub fn oversubscribed(mut self, oversubscribed: bool) -> Self {
         self.oversubscribed = oversubscribed;
         self
@@ -62,11 +68,14 @@ impl Measured {
 pub struct Curve {
     /// Legend text, e.g. `naive: T ∝ n^1.98` or `Amdahl f = 0.031`.
     pub(crate) label: String,
+    /// `(x, y)` samples of the curve in increasing x, joined by a dashed line.
     pub points: Vec<(f64, f64)>,
+    /// `(x, lo, hi)` of the curve's confidence band, shaded; empty draws no band.
     pub band: Vec<(f64, f64, f64)>,
 }
 
 impl Curve {
+    /// A curve through `points` with legend text `label` and no band.
     pub fn new(label: impl Into<String>, points: Vec<(f64, f64)>) -> Self {
         Curve {
             label: label.into(),
@@ -80,6 +89,7 @@ impl Curve {
         Curve::new(label, xs.iter().map(|&x| (x, f(x))).collect())
     }
 
+    /// The curve with the confidence band `(x, lo, hi)` shaded around it.
     pub fn with_band(mut self, band: Vec<(f64, f64, f64)>) -> Self {
         self.band = band;
         self
@@ -112,12 +122,17 @@ fn extent(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
 /// One kernel's measurements and, optionally, the model fitted to them.
 #[derive(Clone, Debug, PartialEq)]
 pub struct KernelSeries {
+    /// The kernel's name, the legend text of its measurements.
     pub name: String,
+    /// The measured values, one per x.
     pub measured: Vec<Measured>,
+    /// The model fitted to them, drawn dashed in the same colour; `None` joins the
+    /// measurements with a line instead.
     pub fit: Option<Curve>,
 }
 
 impl KernelSeries {
+    /// A kernel's measurements without a fitted curve.
     pub fn new(name: impl Into<String>, measured: Vec<Measured>) -> Self {
         KernelSeries {
             name: name.into(),
@@ -136,6 +151,7 @@ impl KernelSeries {
         KernelSeries::new(name, measured)
     }
 
+    /// The series with `fit` drawn through its measurements.
     pub fn with_fit(mut self, fit: Curve) -> Self {
         self.fit = Some(fit);
         self
