@@ -109,35 +109,27 @@ fn text(report: &GateReport) -> String {
         judged_on(report.judged_on),
         percent(report.family_alpha)
     );
-    let width = report
-        .cases
-        .iter()
-        .map(|c| c.key.len())
-        .max()
-        .unwrap_or(4)
-        .max(4);
-    let _ = writeln!(
-        s,
-        "{:<width$} {:>11} {:>11} {:>7} {:>17} {:>7}  verdict",
-        "case", "baseline", "current", "ratio", "95% CI", "raw"
-    );
+    let r = Align::Right;
+    let header = [
+        "case", "baseline", "current", "ratio", "95% CI", "raw", "verdict",
+    ];
+    let mut table = Table::new(header).aligned([Align::Default, r, r, r, r, r, Align::Default]);
     for c in &report.cases {
-        let _ = writeln!(
-            s,
-            "{:<width$} {:>11} {:>11} {:>7.3} {:>17} {:>7.3}  {}{}",
-            c.key,
-            Duration(c.baseline_median_s),
-            Duration(c.current_median_s),
-            c.ratio,
+        let verdict = match c.verdict {
+            Verdict::Regressed => verdict_word(c).to_uppercase(),
+            _ => verdict_word(c),
+        };
+        table.row([
+            c.key.clone(),
+            Duration(c.baseline_median_s).to_string(),
+            Duration(c.current_median_s).to_string(),
+            format!("{:.3}", c.ratio),
             format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),
-            c.raw_ratio,
-            match c.verdict {
-                Verdict::Regressed => verdict_word(c).to_uppercase(),
-                _ => verdict_word(c),
-            },
-            notes(c).map(|n| format!("  ({n})")).unwrap_or_default()
-        );
+            format!("{:.3}", c.raw_ratio),
+            verdict + &notes(c).map(|n| format!("  ({n})")).unwrap_or_default(),
+        ]);
     }
+    s += &table.text();
     for line in findings(report) {
         let _ = writeln!(s, "{line}");
     }
