@@ -1,10 +1,10 @@
 //! `fit`: a scaling model fitted to a CSV of measurements from any code.
 
-use super::fit_tables;
 use crate::cli::args::{CostModel, FitArgs, FitModel};
 use anyhow::{Context, bail};
 use nbody_harness::fit::csv::{self, WeakTable};
 use nbody_harness::fit::{ComplexityClass, fit_power, fit_strong, fit_weak, fit_weak_with_n};
+use nbody_harness::render::fit_tables;
 use serde::Serialize;
 use std::path::Path;
 
@@ -34,7 +34,7 @@ pub fn fit(args: FitArgs) -> anyhow::Result<i32> {
         FitModel::Amdahl => {
             let samples = csv::parse_threads(&text).map_err(in_csv)?;
             let fit = fit_strong(&samples, &[], args.seed)?;
-            fit_tables::print_strong(&name, &fit);
+            out!("{}", fit_tables::strong(&name, &fit));
             write_json(&args, "amdahl", &fit)?;
         }
         FitModel::Gustafson => {
@@ -52,13 +52,13 @@ pub fn fit(args: FitArgs) -> anyhow::Result<i32> {
                     fit_weak_with_n(&samples, cost, args.seed)?
                 }
             };
-            fit_tables::print_weak(&name, &fit);
+            out!("{}", fit_tables::weak(&name, &fit));
             write_json(&args, "gustafson", &fit)?;
         }
         FitModel::Power => {
             let samples = csv::parse_sizes(&text).map_err(in_csv)?;
             let fit = fit_power(&samples, args.seed)?;
-            fit_tables::print_power(&name, &fit);
+            out!("{}", fit_tables::power(&name, &fit));
             write_json(&args, "power", &fit)?;
         }
     }

@@ -10,7 +10,6 @@ mod dry_run;
 mod export;
 mod export_results;
 mod fit;
-mod fit_tables;
 mod gate;
 mod gate_study;
 mod history;

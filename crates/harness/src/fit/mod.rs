@@ -23,7 +23,7 @@ mod overhead;
 pub mod power;
 pub mod strong;
 #[cfg(test)]
-mod synthetic;
+pub(crate) mod synthetic;
 pub mod timed;
 pub mod weak;
 

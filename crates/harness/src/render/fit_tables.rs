@@ -1,16 +1,27 @@
-//! The readable tables `fit` prints.
+//! The readable tables of a fit (`nbody-bench fit`): the points with their intervals, then
+//! the model's parameters, its goodness of fit and the notes, as text for a terminal.
 
-use nbody_harness::fit::{CiMethod, ComplexityClass, Input, PowerFit, StrongFit, WeakFit};
-use nbody_harness::render::tables::{Align, Table};
-use nbody_harness::units::{Duration, Number, WithCi};
+use super::tables::{Align, Table};
+use crate::fit::{CiMethod, ComplexityClass, Input, PowerFit, StrongFit, WeakFit};
+use crate::units::{Duration, Number, WithCi};
+use std::fmt::Write;
 
 fn r2(r2: Option<f64>) -> String {
     r2.map_or("-".to_string(), |r| format!("{r:.4}"))
 }
 
-fn header(title: &str, file: &str, inputs: &[Input], what: &str, method: CiMethod, n: usize) {
+fn header(
+    s: &mut String,
+    title: &str,
+    file: &str,
+    inputs: &[Input],
+    what: &str,
+    method: CiMethod,
+    n: usize,
+) {
     let samples: usize = inputs.iter().map(|i| i.samples).sum();
-    outln!(
+    let _ = writeln!(
+        s,
         "{title} fit of {file}: {} {what}, {samples} samples; 95% intervals from {n} bootstrap \
          replicates, {}",
         inputs.len(),
@@ -18,14 +29,19 @@ fn header(title: &str, file: &str, inputs: &[Input], what: &str, method: CiMetho
     );
 }
 
-fn print_notes(notes: &[String]) {
+fn notes(s: &mut String, notes: &[String]) {
     for n in notes {
-        outln!("note: {n}");
+        let _ = writeln!(s, "note: {n}");
     }
 }
 
-pub fn print_strong(file: &str, fit: &StrongFit) {
+/// The Amdahl fit of `file`: its points, serial fraction, T1, the Karp-Flatt trend and the
+/// overhead terms tried.
+pub fn strong(file: &str, fit: &StrongFit) -> String {
+    let mut s = String::new();
+    let s = &mut s;
     header(
+        s,
         "Amdahl",
         file,
         &fit.inputs,
@@ -33,9 +49,10 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         fit.ci_method,
         fit.resamples,
     );
-    outln!("\n{}", strong_points(fit).text().trim_end());
-    outln!();
-    outln!(
+    let _ = writeln!(s, "\n{}", strong_points(fit).text().trim_end());
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
         "serial fraction f   {}{}",
         WithCi::of(&fit.serial_fraction, Number),
         if fit.clamped {
@@ -44,12 +61,14 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
             ""
         }
     );
-    outln!("T1                  {}", WithCi::of(&fit.t1, Duration));
-    outln!(
+    let _ = writeln!(s, "T1                  {}", WithCi::of(&fit.t1, Duration));
+    let _ = writeln!(
+        s,
         "max speedup 1/f     {}",
         WithCi::of(&fit.max_speedup, Number)
     );
-    outln!(
+    let _ = writeln!(
+        s,
         "fit of T(p)         r2 {}, SMAPE {:.2}%",
         r2(fit.goodness.r2),
         fit.goodness.smape_percent
@@ -61,13 +80,15 @@ pub fn print_strong(file: &str, fit: &StrongFit) {
         .map_or(String::new(), |s| {
             format!(" (slope per doubling of p {})", WithCi::of(s, Number))
         });
-    outln!(
+    let _ = writeln!(
+        s,
         "Karp-Flatt trend    {}{slope}: {}",
         trend.verdict.name(),
         trend.meaning
     );
-    print_overhead(fit);
-    print_notes(&fit.notes);
+    overhead(s, fit);
+    notes(s, &fit.notes);
+    std::mem::take(s)
 }
 
 /// Each thread count: its median, speedup, efficiency, Karp-Flatt e(p) and the speedup over
@@ -102,7 +123,7 @@ fn strong_points(fit: &StrongFit) -> Table {
 }
 
 /// The overhead terms tried beside Amdahl's law, and the one kept.
-fn print_overhead(fit: &StrongFit) {
+fn overhead(s: &mut String, fit: &StrongFit) {
     let loo: Vec<String> = fit
         .overhead
         .candidates
@@ -115,23 +136,29 @@ fn print_overhead(fit: &StrongFit) {
             format!("{name} {smape}")
         })
         .collect();
-    match &fit.overhead.kept {
-        Some(k) => outln!(
+    let _ = match &fit.overhead.kept {
+        Some(k) => writeln!(
+            s,
             "overhead term       {} kept: c = {} s, f with it {} (leave-one-out SMAPE: {})",
             k.term.name(),
             WithCi::of(&k.coefficient, Number),
             WithCi::of(&k.serial_fraction, Number),
             loo.join(", ")
         ),
-        None => outln!(
+        None => writeln!(
+            s,
             "overhead terms      none kept (leave-one-out SMAPE: {})",
             loo.join(", ")
         ),
-    }
+    };
 }
 
-pub fn print_weak(file: &str, fit: &WeakFit) {
+/// The Gustafson fit of `file`: its points, serial fraction and cost model.
+pub fn weak(file: &str, fit: &WeakFit) -> String {
+    let mut s = String::new();
+    let s = &mut s;
     header(
+        s,
         "Gustafson",
         file,
         &fit.inputs,
@@ -158,9 +185,10 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
             work.map_or(String::new(), |w| format!("{} ({:.3})", w[i].n, w[i].ratio)),
         ]);
     }
-    outln!("\n{}", table.text().trim_end());
-    outln!();
-    outln!(
+    let _ = writeln!(s, "\n{}", table.text().trim_end());
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
         "serial fraction     alpha = {}{}  (S = p - alpha (p - 1))",
         WithCi::of(&fit.serial_fraction, Number),
         if fit.clamped {
@@ -170,18 +198,25 @@ pub fn print_weak(file: &str, fit: &WeakFit) {
         }
     );
     if let Some(cost) = fit.cost_model {
-        outln!("cost model          g(n) = {}", cost.name());
+        let _ = writeln!(s, "cost model          g(n) = {}", cost.name());
     }
-    outln!(
+    let _ = writeln!(
+        s,
         "fit of S(p)         r2 {}, SMAPE {:.2}%",
         r2(fit.goodness.r2),
         fit.goodness.smape_percent
     );
-    print_notes(&fit.notes);
+    notes(s, &fit.notes);
+    std::mem::take(s)
 }
 
-pub fn print_power(file: &str, fit: &PowerFit) {
+/// The power-law fit of `file`: its points, exponent, the selected complexity class and every
+/// candidate class's leave-one-out error.
+pub fn power(file: &str, fit: &PowerFit) -> String {
+    let mut s = String::new();
+    let s = &mut s;
     header(
+        s,
         "Power-law",
         file,
         &fit.inputs,
@@ -195,13 +230,15 @@ pub fn print_power(file: &str, fit: &PowerFit) {
         let median = Duration(input.median).to_string();
         table.row([input.x.to_string(), median, input.samples.to_string()]);
     }
-    outln!("\n{}", table.text().trim_end());
-    outln!();
-    outln!(
+    let _ = writeln!(s, "\n{}", table.text().trim_end());
+    let _ = writeln!(s);
+    let _ = writeln!(
+        s,
         "exponent k          {}  (T = c*n^k)",
         WithCi::of(&fit.exponent, Number)
     );
-    outln!(
+    let _ = writeln!(
+        s,
         "c                   {} s; log-log r2 {}",
         WithCi::of(&fit.coefficient, Number),
         r2(fit.power_law_goodness.r2)
@@ -216,7 +253,8 @@ pub fn print_power(file: &str, fit: &PowerFit) {
     } else {
         format!("c*{}", sel.class.name())
     };
-    outln!(
+    let _ = writeln!(
+        s,
         "complexity class    {} ({model}, c = {}); leave-one-out SMAPE {:.2}%, chosen by {:.0}% \
          of bootstrap replicates",
         sel.class.name(),
@@ -248,7 +286,62 @@ pub fn print_power(file: &str, fit: &PowerFit) {
             String::new(),
         ]);
     }
-    outln!("\n{}", table.text().trim_end());
-    outln!("(in parentheses: a negative constant or coefficient; not selectable)");
-    print_notes(&fit.notes);
+    let _ = writeln!(s, "\n{}", table.text().trim_end());
+    let _ = writeln!(
+        s,
+        "(in parentheses: a negative constant or coefficient; not selectable)"
+    );
+    notes(s, &fit.notes);
+    std::mem::take(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fit::synthetic::{THREADS, noisy};
+    use crate::fit::{fit_power, fit_strong, fit_weak};
+
+    /// Whether some line of `text` starts (after its padding) with `first` and a space.
+    fn has_row(text: &str, first: impl std::fmt::Display) -> bool {
+        let first = format!("{first} ");
+        text.lines().any(|l| l.trim_start().starts_with(&first))
+    }
+
+    #[test]
+    fn the_amdahl_table_has_a_row_per_thread_count_and_the_model() {
+        let samples = noisy(&THREADS, 6, 0.02, 1, |p| 0.1 + 0.9 / p);
+        let text = strong("strong.csv", &fit_strong(&samples, &[], 1).unwrap());
+        assert!(text.starts_with("Amdahl fit of strong.csv: 5 thread counts, 30 samples"));
+        assert!(THREADS.iter().all(|&p| has_row(&text, p)), "{text}");
+        for line in [
+            "serial fraction f",
+            "max speedup 1/f",
+            "Karp-Flatt trend",
+            "overhead term",
+        ] {
+            assert!(text.contains(line), "no {line:?} in:\n{text}");
+        }
+    }
+
+    #[test]
+    fn the_gustafson_and_power_tables_have_their_rows() {
+        let samples = noisy(&[1.0, 2.0, 4.0, 8.0], 5, 0.02, 2, |p| 1.0 + 0.05 * p);
+        let text = weak("weak.csv", &fit_weak(&samples, 2).unwrap());
+        assert!(
+            text.starts_with("Gustafson fit of weak.csv: 4 worker counts"),
+            "{text}"
+        );
+        assert!([1, 2, 4, 8].iter().all(|p| has_row(&text, p)), "{text}");
+        assert!(text.contains("serial fraction     alpha = "), "{text}");
+        let sizes = [1e3, 2e3, 4e3, 8e3, 1.6e4];
+        let samples = noisy(&sizes, 4, 0.02, 3, |n| 2e-9 * n * n);
+        let text = power("sizes.csv", &fit_power(&samples, 3).unwrap());
+        assert!(
+            text.starts_with("Power-law fit of sizes.csv: 5 sizes"),
+            "{text}"
+        );
+        assert!(sizes.iter().all(|&n| has_row(&text, n)), "{text}");
+        let classes = ComplexityClass::ALL.iter();
+        assert!(classes.clone().all(|c| has_row(&text, c.name())), "{text}");
+    }
 }
