@@ -151,14 +151,16 @@ fn paragraphs(doc: &str) -> Vec<String> {
     let mut out: Vec<String> = Vec::new();
     let mut open = false;
     for line in doc.lines().map(str::trim) {
-        match (line.is_empty(), open) {
-            (true, _) => open = false,
-            (false, true) => {
-                let last = out.last_mut().expect("an open paragraph");
+        if line.is_empty() {
+            open = false;
+            continue;
+        }
+        match out.last_mut() {
+            Some(last) if open => {
                 last.push(' ');
                 last.push_str(line);
             }
-            (false, false) => {
+            _ => {
                 out.push(line.to_string());
                 open = true;
             }
