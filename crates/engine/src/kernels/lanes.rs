@@ -57,6 +57,16 @@ pub(crate) unsafe fn same<A, B>(a: &A) -> &B {
     unsafe { &*(a as *const A).cast::<B>() }
 }
 
+/// `a` as a mutable `B`.
+///
+/// # Safety
+/// As [`same`]: `A` and `B` must be the same type.
+#[inline(always)]
+pub(crate) unsafe fn same_mut<A, B>(a: &mut A) -> &mut B {
+    // SAFETY: the same type, so the same layout and validity.
+    unsafe { &mut *(a as *mut A).cast::<B>() }
+}
+
 /// One register of `WIDTH` lanes of `Elem`.
 ///
 /// # Safety
@@ -83,6 +93,37 @@ pub(super) unsafe trait Lanes: Copy {
     unsafe fn zero_where_less(self, a: Self, b: Self) -> Self;
     /// `self`, with zeros in the lanes where `a == b`.
     unsafe fn zero_where_equal(self, a: Self, b: Self) -> Self;
+    /// `self` in the lanes where `a < b`, zeros elsewhere (also where either is NaN).
+    unsafe fn keep_where_less(self, a: Self, b: Self) -> Self;
+    /// `self / b`, correctly rounded.
+    unsafe fn div(self, b: Self) -> Self;
+    /// `x` in every lane.
+    unsafe fn constant(x: f64) -> Self;
+    /// `scale · self^{−3/2}` to within a few units in the last place: the hardware estimate y
+    /// of `1/√self` and, with `e = 1 − self · y²`, the series
+    /// `y³ (1 − e)^{−3/2} = y³ (1 + 3/2 e + 15/8 e² + 35/16 e³ + …)` cut where the next term
+    /// is below rounding (fewer operations than Newton steps followed by the cube).
+    unsafe fn rsqrt_cubed_scaled(self, scale: Self) -> Self;
+}
+
+/// Coefficients of `(1 − e)^{−3/2} = Σ_k C_k e^k`: `C_k = C_{k−1} (2k + 1) / (2k)`.
+const CUBE_SERIES: [f64; 6] = [1.0, 1.5, 1.875, 2.1875, 2.4609375, 2.70703125];
+
+/// `scale · x^{−3/2}` from the estimate `y` of `1/√x`, the series cut after `TERMS` powers
+/// of `e = 1 − x y²`: the relative error is about `C_{TERMS+1} |e|^{TERMS+1}`.
+#[inline(always)]
+unsafe fn cube_series<V: Lanes, const TERMS: usize>(x: V, y: V, scale: V) -> V {
+    // SAFETY: the caller runs with V's features.
+    unsafe {
+        let y2 = y.mul(y);
+        let e = x.neg_mul_add(y2, V::constant(1.0));
+        let y3 = y2.mul(y.mul(scale));
+        let mut p = V::constant(CUBE_SERIES[TERMS]);
+        for k in (0..TERMS).rev() {
+            p = e.mul_add(p, V::constant(CUBE_SERIES[k]));
+        }
+        y3.mul(p)
+    }
 }
 
 /// One Newton step towards `1/√x` from `y`, with `half = x/2`: `y · (3/2 − half · y²)`.
@@ -96,7 +137,9 @@ macro_rules! lanes {
     ($name:ident, $reg:ty, $elem:ty, $width:expr,
      splat $splat:ident, load $load:ident, store $store:ident, add $add:ident, sub $sub:ident, mul $mul:ident,
      fma $fma:ident, fnma $fnma:ident, rsqrt |$x:ident| $rsqrt:expr, newton_steps $steps:expr,
-     less |$a:ident, $b:ident, $v:ident| $less:expr, equal |$ea:ident, $eb:ident, $ev:ident| $equal:expr) => {
+     less |$a:ident, $b:ident, $v:ident| $less:expr, equal |$ea:ident, $eb:ident, $ev:ident| $equal:expr,
+     keep_less |$ka:ident, $kb:ident, $kv:ident| $keep_less:expr, div $div:ident,
+     cube_terms $terms:expr) => {
         #[cfg(target_arch = "x86_64")]
         #[derive(Clone, Copy)]
         pub(super) struct $name($reg);
@@ -166,33 +209,63 @@ macro_rules! lanes {
                     $name($equal)
                 }
             }
+            #[inline(always)]
+            unsafe fn keep_where_less(self, a: Self, b: Self) -> Self {
+                unsafe {
+                    let ($ka, $kb, $kv) = (a.0, b.0, self.0);
+                    $name($keep_less)
+                }
+            }
+            #[inline(always)]
+            unsafe fn div(self, b: Self) -> Self {
+                unsafe { $name($div(self.0, b.0)) }
+            }
+            #[inline(always)]
+            unsafe fn constant(x: f64) -> Self {
+                unsafe { Self::splat(x as $elem) }
+            }
+            #[inline(always)]
+            unsafe fn rsqrt_cubed_scaled(self, scale: Self) -> Self {
+                unsafe {
+                    let $x = self.0;
+                    cube_series::<Self, $terms>(self, $name($rsqrt), scale)
+                }
+            }
         }
     };
 }
 
 // AVX-512: a 14-bit estimate (relative error below 2^-14); f64 takes two Newton steps
-// (6.1e-5 → 5.6e-9 → 4.7e-17, rounding), f32 one (→ 5.6e-9, below its rounding).
+// (6.1e-5 → 5.6e-9 → 4.7e-17, rounding), f32 one (→ 5.6e-9, below its rounding). For the
+// cube |e| < 2^-13: f64 cuts the series after e³ (2.5 e⁴ = 5.5e-16, two units in the last
+// place), f32 after e (1.9 e² = 2.8e-8, below its rounding).
 lanes!(Avx512F64, __m512d, f64, 8, 
     splat _mm512_set1_pd, load _mm512_loadu_pd, store _mm512_storeu_pd, add _mm512_add_pd, sub _mm512_sub_pd,
     mul _mm512_mul_pd, fma _mm512_fmadd_pd, fnma _mm512_fnmadd_pd, rsqrt |x| _mm512_rsqrt14_pd(x), newton_steps 2,
     less |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_LT_OQ>(a, b), v),
-    equal |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, b), v));
+    equal |a, b, v| _mm512_maskz_mov_pd(!_mm512_cmp_pd_mask::<_CMP_EQ_OQ>(a, b), v),
+    keep_less |a, b, v| _mm512_maskz_mov_pd(_mm512_cmp_pd_mask::<_CMP_LT_OQ>(a, b), v), div _mm512_div_pd, cube_terms 3);
 lanes!(Avx512F32, __m512, f32, 16, 
     splat _mm512_set1_ps, load _mm512_loadu_ps, store _mm512_storeu_ps, add _mm512_add_ps, sub _mm512_sub_ps,
     mul _mm512_mul_ps, fma _mm512_fmadd_ps, fnma _mm512_fnmadd_ps, rsqrt |x| _mm512_rsqrt14_ps(x), newton_steps 1,
     less |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b), v),
-    equal |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b), v));
+    equal |a, b, v| _mm512_maskz_mov_ps(!_mm512_cmp_ps_mask::<_CMP_EQ_OQ>(a, b), v),
+    keep_less |a, b, v| _mm512_maskz_mov_ps(_mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b), v), div _mm512_div_ps, cube_terms 1);
 // AVX2: the 12-bit f32 estimate (relative error below 1.5 · 2^-12 = 3.7e-4); f64 converts to
 // f32 and back around it and takes three steps (→ 2.0e-7 → 6.0e-14 → rounding), f32 two
 // (→ 2.0e-7 → rounding). The f32 estimate needs x in f32's normal range (1.2e-38 to 3.4e38).
+// For the cube |e| < 7.4e-4: f64 cuts the series after e⁵ (2.9 e⁶ = 4.5e-19), f32 after e²
+// (2.2 e³ = 8.8e-10).
 lanes!(Avx2F64, __m256d, f64, 4, 
     splat _mm256_set1_pd, load _mm256_loadu_pd, store _mm256_storeu_pd, add _mm256_add_pd, sub _mm256_sub_pd,
     mul _mm256_mul_pd, fma _mm256_fmadd_pd, fnma _mm256_fnmadd_pd,
     rsqrt |x| _mm256_cvtps_pd(_mm_rsqrt_ps(_mm256_cvtpd_ps(x))), newton_steps 3,
     less |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(a, b), v),
-    equal |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(a, b), v));
+    equal |a, b, v| _mm256_andnot_pd(_mm256_cmp_pd::<_CMP_EQ_OQ>(a, b), v),
+    keep_less |a, b, v| _mm256_and_pd(_mm256_cmp_pd::<_CMP_LT_OQ>(a, b), v), div _mm256_div_pd, cube_terms 5);
 lanes!(Avx2F32, __m256, f32, 8, 
     splat _mm256_set1_ps, load _mm256_loadu_ps, store _mm256_storeu_ps, add _mm256_add_ps, sub _mm256_sub_ps,
     mul _mm256_mul_ps, fma _mm256_fmadd_ps, fnma _mm256_fnmadd_ps, rsqrt |x| _mm256_rsqrt_ps(x), newton_steps 2,
     less |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b), v),
-    equal |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(a, b), v));
+    equal |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(a, b), v),
+    keep_less |a, b, v| _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b), v), div _mm256_div_ps, cube_terms 2);

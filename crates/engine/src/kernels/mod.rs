@@ -25,6 +25,7 @@ pub mod rows;
 mod share;
 mod symmetric;
 pub mod teamed;
+mod triangle;
 pub mod verlet;
 
 pub use cell_list::CellList;

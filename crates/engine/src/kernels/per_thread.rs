@@ -1,123 +1,147 @@
-//! `per-thread`: the symmetric pair work split over the rayon pool's threads, each scattering
-//! into its own force buffer, then a parallel reduction (the form of the OpenMP source code).
+//! `per-thread`: the symmetric pair work split into parts over the rayon pool's threads, each
+//! part scattering into its own force buffer, then a parallel reduction (the form of the
+//! OpenMP source code).
 //!
-//! Memory: one buffer of n × D values per thread, allocated on the first step and reused.
-//! Steps too small to pay for a fork/join run the serial symmetric path instead.
+//! The triangle's rows are uneven, so a step is cut into [`PARTS`] parts of equal pair work,
+//! several per thread, which the pool balances as it goes. The cut depends on n alone, never
+//! on the thread count, and the buffers are added in part order: the forces are the same bits
+//! on any number of threads. A part writes only its own targets and the particles after them,
+//! so its buffer is cleared and reduced over that stretch alone.
+//!
+//! Memory: one buffer of n × D values per part, allocated on the first step that forks and
+//! reused. Steps too small to pay for a fork/join run as one part, straight into the forces.
 
-use super::symmetric::{add_tiles, blocks, pairs_of, split_tiles};
-use super::{ForceKernel, ForceReport, KernelKind, Share, WorkCounters, worth_parallel};
+use super::triangle::{self, pair_work, split};
+use super::{ForceKernel, ForceReport, KernelKind, MIN_PARALLEL_PAIRS, Share, WorkCounters};
 use crate::par::{chunk_len, for_chunks};
 use crate::physics::PairLaw;
 use crate::real::Real;
-use crate::simd;
 use crate::state::{Field, State, zero_field};
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// The `per-thread` kernel: symmetric pairs over the pool's threads, one force buffer each.
+/// Parts of a step that forks: eight per thread on two, enough that the last part to finish
+/// costs the other thread little waiting.
+pub const PARTS: usize = 16;
+
+/// Fewest elements a thread reduces: below it the fork costs more than the additions.
+const MIN_REDUCE: usize = 1024;
+
+/// The `per-thread` kernel: symmetric pairs in parts over the pool's threads, one force
+/// buffer each.
 pub struct PerThread<L, T: Real, const D: usize> {
     law: L,
     buffers: Vec<Field<T, D>>,
-    partition: Vec<Range<usize>>,
-    /// (n, tiles, parts) of the cached partition.
-    partition_key: (usize, Range<usize>, usize),
+    /// The targets of each part, for `split_key`.
+    parts: Vec<Range<usize>>,
+    /// (n, targets) of the cached parts.
+    split_key: (usize, Range<usize>),
+}
+
+/// Whether the targets `targets` of n particles are cut into parts (the step forks when the
+/// pool has more than one thread): the rule of [`super::worth_parallel`] on the pair work,
+/// without the thread count.
+pub fn splits(n: usize, targets: Range<usize>) -> bool {
+    pair_work(n, targets) >= MIN_PARALLEL_PAIRS
 }
 
 impl<L, T: Real, const D: usize> PerThread<L, T, D> {
-    /// The kernel for `law`; its buffers are allocated on the first step.
+    /// The kernel for `law`; its buffers are allocated on the first step that forks.
     pub fn new(law: L) -> Self {
         PerThread {
             law,
             buffers: Vec::new(),
-            partition: Vec::new(),
-            partition_key: (0, 0..0, 0),
+            parts: Vec::new(),
+            split_key: (0, 0..0),
         }
     }
 
-    /// Splits the target tiles `tiles` into `parts` contiguous ranges of near-equal pair work.
-    fn partition(&mut self, n: usize, tiles: Range<usize>, parts: usize) {
-        let key = (n, tiles.clone(), parts);
-        if self.partition_key == key {
+    /// Cuts `targets` into [`PARTS`] parts of equal pair work, with a buffer each.
+    fn split(&mut self, n: usize, targets: Range<usize>) {
+        let key = (n, targets.clone());
+        if self.split_key == key {
             return;
         }
-        self.partition = split_tiles(n, tiles, parts);
-        if self.buffers.len() != self.partition.len() || self.buffers[0][0].len() != n {
-            self.buffers = (0..self.partition.len()).map(|_| zero_field(n)).collect();
+        self.parts = split(n, targets, PARTS);
+        if self.buffers.len() != PARTS || self.buffers[0][0].len() != n {
+            self.buffers = (0..PARTS).map(|_| zero_field(n)).collect();
         }
-        self.partition_key = key;
+        self.split_key = key;
     }
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> PerThread<L, T, D> {
-    /// Overwrites `forces` with the forces of the pairs of target tiles `tiles` (both ends),
-    /// on one thread.
-    fn serial_tiles<const PROBE: bool>(
-        &self,
+    /// Overwrites `forces` with the forces of the pairs of `targets` (both ends), in parts on
+    /// the pool's threads when the step is large enough; returns the pair work.
+    fn forces_of(
+        &mut self,
         state: &State<T, D>,
-        tiles: Range<usize>,
+        targets: Range<usize>,
         forces: &mut Field<T, D>,
-    ) -> (f64, u64) {
-        let law = &self.law;
+    ) -> u64 {
+        let n = state.len();
         for f in forces.iter_mut() {
             f.fill(T::zero());
         }
-        let mut out = forces.each_mut().map(|f| f.as_mut_slice());
-        let total = simd::dispatch(
-            #[inline(always)]
-            || add_tiles::<T, L, D, PROBE>(law, state, tiles, &mut out),
-        );
-        (total.energy.as_f64(), total.interacting)
+        if !splits(n, targets.clone()) {
+            let mut out = forces.each_mut().map(|f| f.as_mut_slice());
+            triangle::add::<T, L, D, false>(&self.law, state, targets.clone(), &mut out);
+            return pair_work(n, targets);
+        }
+        self.split(n, targets.clone());
+        let law = &self.law;
+        let part = |(buf, part): (&mut Field<T, D>, &Range<usize>)| {
+            if part.is_empty() {
+                return;
+            }
+            let mut out = buf.each_mut().map(|f| &mut f[..]);
+            for f in out.iter_mut() {
+                f[part.start..].fill(T::zero());
+            }
+            triangle::add::<T, L, D, false>(law, state, part.clone(), &mut out);
+        };
+        let forked = rayon::current_num_threads() > 1;
+        if forked {
+            self.buffers
+                .par_iter_mut()
+                .zip(self.parts.par_iter())
+                .for_each(part);
+        } else {
+            self.buffers
+                .iter_mut()
+                .zip(self.parts.iter())
+                .for_each(part);
+        }
+        self.reduce(targets.start, forces, forked);
+        pair_work(n, targets)
     }
 
-    /// Overwrites `forces` with the forces of the pairs of target tiles `tiles` (both ends),
-    /// the tiles split over the pool's threads, each into its own buffer, then reduced.
-    fn parallel_tiles(
-        &mut self,
-        state: &State<T, D>,
-        tiles: Range<usize>,
-        forces: &mut Field<T, D>,
-    ) {
-        let n = state.len();
-        self.partition(n, tiles, rayon::current_num_threads());
-        let law = &self.law;
-        self.buffers
-            .par_iter_mut()
-            .zip(self.partition.par_iter())
-            .for_each(|(buf, tiles)| {
-                for f in buf.iter_mut() {
-                    f.fill(T::zero());
-                }
-                let mut out = buf.each_mut().map(|f| f.as_mut_slice());
-                simd::dispatch(
-                    #[inline(always)]
-                    || add_tiles::<T, L, D, false>(law, state, tiles.clone(), &mut out),
-                );
-            });
-        let buffers = &self.buffers;
-        let out = forces.each_mut().map(|f| f.as_mut_slice());
-        for_chunks(out, 0, chunk_len(n).max(4096), &|offset, chunk| {
-            for d in 0..D {
-                let dst = &mut *chunk[d];
-                dst.copy_from_slice(&buffers[0][d][offset..offset + dst.len()]);
-                for b in &buffers[1..] {
-                    for (x, y) in dst.iter_mut().zip(&b[d][offset..]) {
+    /// Adds the parts' buffers into `forces` from slot `from` on, each over the slots its part
+    /// wrote, in part order; on the pool's threads when `forked`.
+    fn reduce(&self, from: usize, forces: &mut Field<T, D>, forked: bool) {
+        let (buffers, parts) = (&self.buffers, &self.parts);
+        let add = |offset: usize, chunk: [&mut [T]; D]| {
+            let end = offset + chunk[0].len();
+            for (d, dst) in chunk.into_iter().enumerate() {
+                for (buf, part) in buffers.iter().zip(parts).filter(|(_, p)| !p.is_empty()) {
+                    let lo = part.start.max(offset);
+                    if lo >= end {
+                        // Later parts start later still.
+                        break;
+                    }
+                    for (x, y) in dst[lo - offset..].iter_mut().zip(&buf[d][lo..end]) {
                         *x += *y;
                     }
                 }
             }
-        });
-    }
-
-    /// Forces of the pairs of target tiles `tiles`, in parallel when it pays.
-    fn tiles(&mut self, state: &State<T, D>, tiles: Range<usize>, forces: &mut Field<T, D>) -> u64 {
-        let pair_checks = pairs_of(state.len(), tiles.clone());
-        if !worth_parallel(pair_checks) || tiles.len() < 2 {
-            // Small steps lose to fork/join.
-            self.serial_tiles::<false>(state, tiles, forces);
+        };
+        let out = forces.each_mut().map(|f| &mut f[from..]);
+        if forked {
+            let len = chunk_len(out[0].len()).max(MIN_REDUCE);
+            for_chunks(out, from, len, &add);
         } else {
-            self.parallel_tiles(state, tiles, forces);
+            add(from, out);
         }
-        pair_checks
     }
 }
 
@@ -132,21 +156,25 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, 
         forces: &mut Field<T, D>,
         probe: bool,
     ) -> ForceReport {
-        let tiles = 0..blocks(state.len());
+        let n = state.len();
         if probe {
             // The probe runs outside the timed steps, on one thread.
-            let (energy, interacting) = self.serial_tiles::<true>(state, tiles.clone(), forces);
+            for f in forces.iter_mut() {
+                f.fill(T::zero());
+            }
+            let mut out = forces.each_mut().map(|f| f.as_mut_slice());
+            let total = triangle::add::<T, L, D, true>(&self.law, state, 0..n, &mut out);
             return ForceReport {
-                energy: Some(energy),
+                energy: Some(total.energy.as_f64()),
                 build_s: 0.0,
                 work: WorkCounters {
-                    pair_checks: pairs_of(state.len(), tiles),
-                    pairs_interacting: interacting,
+                    pair_checks: pair_work(n, 0..n),
+                    pairs_interacting: total.interacting,
                     ..Default::default()
                 },
             };
         }
-        let pair_checks = self.tiles(state, tiles, forces);
+        let pair_checks = self.forces_of(state, 0..n, forces);
         ForceReport {
             work: WorkCounters {
                 pair_checks,
@@ -156,7 +184,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, 
         }
     }
 
-    /// A balanced share of the target tiles, split again over the pool's threads.
+    /// A balanced share of the targets, cut again into parts over the pool's threads.
     fn compute_share(
         &mut self,
         state: &State<T, D>,
@@ -164,8 +192,8 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, 
         forces: &mut Field<T, D>,
     ) -> ForceReport {
         let n = state.len();
-        let tiles = split_tiles(n, 0..blocks(n), share.count)[share.index].clone();
-        let pair_checks = self.tiles(state, tiles, forces);
+        let targets = split(n, 0..n, share.count)[share.index].clone();
+        let pair_checks = self.forces_of(state, targets, forces);
         ForceReport {
             work: WorkCounters {
                 pair_checks,
@@ -173,5 +201,70 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for PerThread<L, 
             },
             ..Default::default()
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::{Coulomb, Gravity, LennardJones};
+    use crate::testing::SEED_1;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64Mcg;
+
+    /// A state of `n` particles in a cube of side `side`, strengths of both signs.
+    fn state<T: Real>(n: usize, side: f64) -> State<T, 3> {
+        let mut rng = Pcg64Mcg::seed_from_u64(SEED_1);
+        let mut state = State::<T, 3>::new(n);
+        for i in 0..n {
+            for d in 0..3 {
+                state.pos[d][i] = T::of(side * rng.random::<f64>());
+            }
+            state.source[i] = T::of(if i % 3 == 0 { -1.0 } else { 1.0 });
+        }
+        state
+    }
+
+    /// The forces of a step that forks, on a pool of `threads`.
+    fn forces_on<T: Real, L: PairLaw<T>>(
+        law: L,
+        state: &State<T, 3>,
+        threads: usize,
+    ) -> Field<T, 3> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a pool");
+        let mut forces = zero_field(state.len());
+        pool.install(|| PerThread::new(law).compute(state, &mut forces, false));
+        forces
+    }
+
+    /// Bitwise the same forces on 1, 2 and 3 threads, in every law and both precisions, at
+    /// an n that is cut into parts and ends inside a vector.
+    #[test]
+    fn forces_are_the_same_bits_at_every_thread_count() {
+        let n = 1203;
+        assert!(splits(n, 0..n));
+        fn same<T: Real, L: PairLaw<T>>(law: L, state: &State<T, 3>) {
+            let one = forces_on(law, state, 1);
+            for threads in [2, 3] {
+                let many = forces_on(law, state, threads);
+                for d in 0..3 {
+                    for (a, b) in one[d].iter().zip(&many[d]) {
+                        assert_eq!(
+                            a.as_f64().to_bits(),
+                            b.as_f64().to_bits(),
+                            "{threads} threads"
+                        );
+                    }
+                }
+            }
+        }
+        same(Gravity::<f64>::new(1.0, 0.01), &state(n, 1.0));
+        same(Coulomb::<f64>::new(1e-3), &state(n, 1.0));
+        same(Gravity::<f32>::new(1.0, 0.01), &state(n, 1.0));
+        same(LennardJones::<f32>::new(1.0, 0.01, 0.025), &state(n, 0.3));
+        same(LennardJones::<f64>::new(1.0, 0.01, 0.025), &state(n, 0.3));
     }
 }

@@ -88,6 +88,14 @@ impl<T: Real> PairLaw<T> for LennardJones<T> {
     fn softening2(&self) -> T {
         T::zero()
     }
+
+    fn lennard_jones(&self) -> Option<super::LennardJonesTerms<T>> {
+        Some(super::LennardJonesTerms {
+            epsilon24: self.epsilon24,
+            sigma2: self.sigma2,
+            rc2: self.rc2,
+        })
+    }
 }
 
 #[cfg(test)]

@@ -161,6 +161,25 @@ pub trait PairLaw<T: Real>: Copy + Send + Sync + 'static {
     fn inverse_square(&self) -> Option<InverseSquare<T>> {
         None
     }
+
+    /// The law as [`LennardJonesTerms`], for the batched SIMD pair kernels; `None` for a law
+    /// of another form.
+    fn lennard_jones(&self) -> Option<LennardJonesTerms<T>> {
+        None
+    }
+}
+
+/// A truncated Lennard-Jones law as the batched kernels evaluate it: the coefficient is
+/// `24ε · u (1 − 2u) / r²` with `u = (σ²/r²)³`, zero where `r² ≥ rc²` (the form of
+/// [`LennardJones`]'s `coeff`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LennardJonesTerms<T> {
+    /// 24 times the well depth ε.
+    pub epsilon24: T,
+    /// σ², the squared particle size.
+    pub sigma2: T,
+    /// The squared cutoff radius.
+    pub rc2: T,
 }
 
 /// A law whose coefficient is `k · s_i · s_j · (r² + ε²)^{−3/2}`, zero where `r² + ε²` is

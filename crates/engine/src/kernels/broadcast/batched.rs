@@ -206,8 +206,7 @@ where
                         dx[d] = xj[d].sub(self.x[d][k]);
                         r2 = dx[d].mul_add(dx[d], r2);
                     }
-                    let inv = r2.rsqrt();
-                    let mut c = inv.mul(inv).mul(inv.mul(sj));
+                    let mut c = r2.rsqrt_cubed_scaled(sj);
                     if QUENCH {
                         c = c.zero_where_less(r2, self.quench2);
                     }
