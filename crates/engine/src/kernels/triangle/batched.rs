@@ -88,7 +88,7 @@ pub(super) unsafe fn add_on<T: Real, L: PairLaw<T>, const D: usize>(
             match isa {
                 Isa::Avx512 => run_avx512(
                     #[inline(always)]
-                    || by_form::<Avx512F64, D, 4>(form, pos, s, targets, out),
+                    || by_form::<Avx512F64, D, 2>(form, pos, s, targets, out),
                 ),
                 Isa::Avx2 => run_avx2(
                     #[inline(always)]
