@@ -24,8 +24,9 @@ pub struct Figure {
     pub title: String,
 }
 
+/// A figure to draw; the chart is boxed, being the larger by far.
 enum Drawing {
-    Chart(Chart),
+    Chart(Box<Chart>),
     Bars(StackedBars),
 }
 
@@ -129,7 +130,7 @@ fn cost_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         );
         out.push((
             format!("time-vs-n-{scenario}-{precision}-p{threads}-r{ranks}"),
-            Drawing::Chart(chart),
+            Drawing::Chart(Box::new(chart)),
         ));
     }
     out
@@ -162,19 +163,25 @@ fn strong_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         if let Some(label) = &one_thread {
             chart.crossed_label.clone_from(label);
         }
-        out.push((format!("speedup-{stem}"), Drawing::Chart(chart)));
+        out.push((format!("speedup-{stem}"), Drawing::Chart(Box::new(chart))));
         let eff: Vec<KernelSeries> = same.iter().map(|s| efficiency_series(s)).collect();
         let mut chart = fig::efficiency(&eff, workers, cap);
         chart.title = format!("{title}: parallel efficiency");
         if let Some(label) = one_thread {
             chart.crossed_label = label;
         }
-        out.push((format!("efficiency-{stem}"), Drawing::Chart(chart)));
+        out.push((
+            format!("efficiency-{stem}"),
+            Drawing::Chart(Box::new(chart)),
+        ));
         let kf: Vec<KernelSeries> = same.iter().filter_map(|s| karp_flatt_series(s)).collect();
         if kf.iter().any(|k| !k.measured.is_empty()) {
             let mut chart = fig::karp_flatt(&kf, workers, cap);
             chart.title = format!("{title}: Karp-Flatt serial fraction e(p)");
-            out.push((format!("karp-flatt-{stem}"), Drawing::Chart(chart)));
+            out.push((
+                format!("karp-flatt-{stem}"),
+                Drawing::Chart(Box::new(chart)),
+            ));
         }
     }
     out
@@ -255,7 +262,10 @@ fn weak_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         if let Some(label) = forking::legend(found) {
             chart.crossed_label = label;
         }
-        out.push((format!("weak-efficiency-{scenario}"), Drawing::Chart(chart)));
+        out.push((
+            format!("weak-efficiency-{scenario}"),
+            Drawing::Chart(Box::new(chart)),
+        ));
     }
     out
 }
@@ -294,7 +304,10 @@ fn scenario_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         bars.title = format!("{scen}: time per step by phase");
         out.push((format!("phases-{}", slug(scen)), Drawing::Bars(bars)));
         if let Some(chart) = percentiles_chart(&cases, scen, cap) {
-            out.push((format!("percentiles-{}", slug(scen)), Drawing::Chart(chart)));
+            out.push((
+                format!("percentiles-{}", slug(scen)),
+                Drawing::Chart(Box::new(chart)),
+            ));
         }
     }
     out
@@ -362,7 +375,7 @@ fn octree_accuracy_figure(a: &Analysis, cap: &str) -> Option<(String, Drawing)> 
     }
     Some((
         "octree-accuracy".into(),
-        Drawing::Chart(fig::octree_accuracy(&sweeps, cap)),
+        Drawing::Chart(Box::new(fig::octree_accuracy(&sweeps, cap))),
     ))
 }
 
