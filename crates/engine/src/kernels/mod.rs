@@ -136,6 +136,27 @@ impl KernelKind {
         !matches!(self, KernelKind::Symmetric)
     }
 
+    /// Whether a step of `work` naive pair evaluations per process (the unit of
+    /// [`worth_parallel`]) is split over a pool of several threads: the kernel uses threads
+    /// and the step is worth a fork. The one statement of that rule outside the kernels, for
+    /// the sweep's estimate and for the tables and figures that say a case ran on one thread.
+    pub fn forks_at(self, work: f64) -> bool {
+        self.uses_threads() && work >= MIN_PARALLEL_PAIRS as f64
+    }
+
+    /// Whether the pair checks a step counts are exactly the work the kernel weighs before it
+    /// forks, so that [`KernelKind::forks_at`] on them tells what a measured step did: naive
+    /// and per-thread count the pairs they evaluate, the octree the last step's pair checks,
+    /// and symmetric never forks. The list and cell kernels add a cost per particle row and
+    /// the fmm its cell-cell terms, which the work counters do not give: for them the pair
+    /// checks only approximate the rule.
+    pub fn forks_on_pair_checks(self) -> bool {
+        matches!(
+            self,
+            KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread | KernelKind::Octree
+        )
+    }
+
     /// Whether the build phase (binning and sorting) runs on the pool's threads when the
     /// particles are many (from `par::MIN_FORK_ELEMENTS` on).
     pub fn parallel_build(self) -> bool {

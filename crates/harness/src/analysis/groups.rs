@@ -59,6 +59,10 @@ pub struct Point {
     pub ns_per_particle_step: f64,
     /// `None` when the code counted no pair (an external program).
     pub pair_evals_per_s: Option<f64>,
+    /// Candidate pairs examined per step, the work counter that rate is of (whether a step
+    /// was worth a fork is decided on it); `None` when the code counted no pair.
+    #[serde(skip)]
+    pub pair_checks_per_step: Option<f64>,
     /// Seconds per step in each of the engine's phases, averaged over rounds.
     pub phases: PhaseTimes,
     /// The phases an external program timed itself (`phases`), by name.
@@ -422,6 +426,7 @@ fn point(r: &CaseRecord, ext: Option<&External>) -> Option<Point> {
         oversubscribed: r.oversubscribed,
         ns_per_particle_step: s.ns_per_particle_step,
         pair_evals_per_s: s.pair_evals_per_s,
+        pair_checks_per_step: s.pair_evals_per_s.map(|_| s.pair_checks_per_step),
         phases: s.phases,
         named_phases,
         step_ns: s.step_ns,

@@ -5,6 +5,8 @@
 //! file always gives the same analysis.
 
 pub mod comm_model;
+pub mod family;
+pub mod forking;
 pub mod groups;
 pub mod peers;
 pub mod tree_comm;
@@ -147,6 +149,10 @@ pub struct Analysis {
     pub weak: Vec<WeakAnalysis>,
     /// Every accuracy series (over θ or an external family's settings).
     pub theta: Vec<ThetaAnalysis>,
+    /// The O(n²) family (naive, symmetric, per-thread) side by side at each scenario and n
+    /// that has at least two of them.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub family: Vec<family::Family>,
     /// Our kernels next to the external programs of the same sweep.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub peers: Vec<peers::PeerRatio>,
@@ -229,6 +235,7 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
         })
         .collect::<Vec<_>>();
     let peers_equal_error = peers::equal_error(&theta);
+    let family = family::families(&groups.cases, calibration.as_ref());
     Ok(Analysis {
         schema: FITS_SCHEMA.into(),
         source: source.display().to_string(),
@@ -241,6 +248,7 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
         strong,
         weak,
         theta,
+        family,
         peers: peers::ratios(&groups.cases),
         peers_equal_error,
         external_runs: results.config.external.clone(),

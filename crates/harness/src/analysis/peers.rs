@@ -426,6 +426,7 @@ mod tests {
             oversubscribed: false,
             ns_per_particle_step: median_s * 1e9 / n as f64,
             pair_evals_per_s: None,
+            pair_checks_per_step: None,
             phases: Default::default(),
             named_phases: Vec::new(),
             step_ns: None,

@@ -14,7 +14,7 @@
 //! of a 2-vCPU machine whose vCPUs are SMT siblings can be 1.0, not 1.9).
 
 use super::runner::samples_in_round;
-use nbody_engine::kernels::{Complexity, KernelKind, MIN_PARALLEL_PAIRS, Multipole};
+use nbody_engine::kernels::{Complexity, KernelKind, Multipole};
 use nbody_engine::run::RunError;
 use nbody_engine::scenario::{Precision, ScenarioKind, Setup, SetupError};
 use nbody_engine::stepper::{Stepper, stepper};
@@ -88,8 +88,9 @@ impl Probe {
 
 /// Expected speedup of a step over one thread: each worker beyond the first adds
 /// [`EXTRA_THREAD_GAIN`], workers beyond the logical CPUs add nothing. Threads count only for a
-/// kernel that uses them and a step large enough to fork (as `kernels::worth_parallel`);
-/// MPI ranks are processes and always share the work.
+/// kernel that uses them and a step large enough to fork (`KernelKind::forks_at`, on the
+/// pair checks: for the kernels that weigh more than those, a rule of thumb); MPI ranks are
+/// processes and always share the work.
 pub fn speedup(
     kernel: KernelKind,
     threads: usize,
@@ -98,7 +99,7 @@ pub fn speedup(
     logical_cpus: usize,
 ) -> f64 {
     let ranks = ranks.max(1);
-    let forks = kernel.uses_threads() && pair_checks / ranks as f64 >= MIN_PARALLEL_PAIRS as f64;
+    let forks = kernel.forks_at(pair_checks / ranks as f64);
     let workers = ranks * if forks { threads.max(1) } else { 1 };
     let p = workers.min(logical_cpus.max(1));
     1.0 + EXTRA_THREAD_GAIN * (p - 1) as f64

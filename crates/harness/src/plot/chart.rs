@@ -199,19 +199,32 @@ fn draw_markers(
     axes: (&ResolvedAxis, &ResolvedAxis),
 ) -> Result<bool, String> {
     let mut drew = false;
-    for (i, s) in chart.series.iter().enumerate() {
-        if matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
+    // Crossed markers last, so that no other series' marker hides a cross.
+    for crossed in [false, true] {
+        for (i, s) in chart.series.iter().enumerate() {
+            if !matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers) {
+                continue;
+            }
             let color = series_color(i, s.color);
             let marker = palette::marker(s.color.unwrap_or(i));
-            let shown: Vec<&Point> = s.points.iter().filter(|p| on_axes(p, axes)).collect();
+            let shown: Vec<&Point> = s
+                .points
+                .iter()
+                .filter(|p| on_axes(p, axes) && p.crossed == crossed)
+                .collect();
+            // The second pass draws nothing where nothing is crossed: a figure without a
+            // crossed point is drawn exactly as before.
+            if crossed && shown.is_empty() {
+                continue;
+            }
             let markers = shown.iter().map(|p| {
-                let hollow = p.hollow;
                 Glyph(
                     (p.x, p.y),
                     Swatch::Marker {
                         color,
                         marker,
-                        hollow,
+                        hollow: p.hollow,
+                        crossed: p.crossed,
                     },
                 )
             });
@@ -290,6 +303,7 @@ fn legend(chart: &Chart) -> Vec<(String, Swatch)> {
                 color,
                 marker: shape,
                 hollow: false,
+                crossed: false,
             },
             style => Swatch::Line {
                 color,
@@ -329,8 +343,23 @@ fn legend(chart: &Chart) -> Vec<(String, Swatch)> {
             color,
             marker: Marker::Circle,
             hollow: true,
+            crossed: false,
         };
         entries.push((chart.hollow_label.clone(), hollow));
+    }
+    if chart
+        .series
+        .iter()
+        .flat_map(|s| &s.points)
+        .any(|p| p.crossed)
+    {
+        let crossed = Swatch::Marker {
+            color: rgb(REFERENCE),
+            marker: Marker::Circle,
+            hollow: false,
+            crossed: true,
+        };
+        entries.push((chart.crossed_label.clone(), crossed));
     }
     entries
 }

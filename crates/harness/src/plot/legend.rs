@@ -32,11 +32,13 @@ pub(crate) enum Swatch {
         dashed: bool,
         marker: Option<Marker>,
     },
-    /// Filled, or hollow: white inside, so that grid lines and error bars do not show through.
+    /// Filled, or hollow: white inside, so that grid lines and error bars do not show through;
+    /// crossed: a black × over it.
     Marker {
         color: RGBColor,
         marker: Marker,
         hollow: bool,
+        crossed: bool,
     },
     /// A patch of `color` at the given opacity, as the band or region it stands for.
     Fill(RGBColor, f64),
@@ -89,7 +91,14 @@ impl<C, DB: DrawingBackend> Drawable<DB> for Glyph<C> {
                 color,
                 marker,
                 hollow,
-            } => draw_marker(backend, (x, y), marker, color, hollow),
+                crossed,
+            } => {
+                draw_marker(backend, (x, y), marker, color, hollow)?;
+                match crossed {
+                    true => draw_cross(backend, (x, y)),
+                    false => Ok(()),
+                }
+            }
             Swatch::Fill(color, alpha) => {
                 let style = color.mix(alpha).filled();
                 backend.draw_rect((x - half, y - 7), (x + half, y + 7), &style, true)
@@ -121,6 +130,17 @@ fn draw_marker<DB: DrawingBackend>(
     let outline: Vec<_> = outline.iter().map(|(dx, dy)| (x + dx, y + dy)).collect();
     backend.fill_polygon(outline.clone(), &fill)?;
     backend.draw_path(outline.iter().chain(&outline[..1]).copied(), &ring)
+}
+
+/// A black × a little wider than a marker, centred on it: it reads over any marker's colour.
+fn draw_cross<DB: DrawingBackend>(
+    backend: &mut DB,
+    (x, y): BackendCoord,
+) -> Result<(), DrawingErrorKind<DB::ErrorType>> {
+    let r = MARKER_RADIUS + 3;
+    let ink = BLACK.stroke_width(2);
+    backend.draw_line((x - r, y - r), (x + r, y + r), &ink)?;
+    backend.draw_line((x - r, y + r), (x + r, y - r), &ink)
 }
 
 /// Legend entries laid out for the page: each label in one or two lines.

@@ -25,6 +25,8 @@ pub struct Chart {
     pub regions: Vec<Region>,
     /// Legend text explaining hollow markers; shown only when some point is hollow.
     pub(crate) hollow_label: String,
+    /// Legend text explaining crossed markers; shown only when some point is crossed.
+    pub crossed_label: String,
 }
 
 impl Chart {
@@ -40,6 +42,7 @@ impl Chart {
             hlines: Vec::new(),
             regions: Vec::new(),
             hollow_label: "hollow: oversubscribed".into(),
+            crossed_label: "crossed: ran on 1 thread".into(),
         }
     }
 
@@ -200,6 +203,9 @@ pub struct Point {
     pub(crate) y_err: Option<(f64, f64)>,
     /// Drawn as an outline marker, e.g. for an oversubscribed measurement.
     pub(crate) hollow: bool,
+    /// Drawn with a cross over the marker, e.g. for a case that ran on one thread although
+    /// given several.
+    pub(crate) crossed: bool,
     /// Text written next to the marker, e.g. `θ=0.5`.
     pub(crate) label: Option<String>,
 }
@@ -211,6 +217,7 @@ impl Point {
             y,
             y_err: None,
             hollow: false,
+            crossed: false,
             label: None,
         }
     }
@@ -222,6 +229,11 @@ impl Point {
 
     pub(crate) fn hollow(mut self, hollow: bool) -> Self {
         self.hollow = hollow;
+        self
+    }
+
+    pub(crate) fn crossed(mut self, crossed: bool) -> Self {
+        self.crossed = crossed;
         self
     }
 

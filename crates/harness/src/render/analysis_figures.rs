@@ -3,6 +3,7 @@
 //! step-time percentiles, and octree error vs cost. Each states machine, commit and sweep in
 //! its caption.
 
+use crate::analysis::forking;
 use crate::analysis::groups::{Point, workers_noun};
 use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis, ThetaAnalysis, WeakAnalysis};
 use crate::plot::figures::{
@@ -23,8 +24,9 @@ pub struct Figure {
     pub title: String,
 }
 
+/// A figure to draw; the chart is boxed, being the larger by far.
 enum Drawing {
-    Chart(Chart),
+    Chart(Box<Chart>),
     Bars(StackedBars),
 }
 
@@ -128,7 +130,7 @@ fn cost_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         );
         out.push((
             format!("time-vs-n-{scenario}-{precision}-p{threads}-r{ranks}"),
-            Drawing::Chart(chart),
+            Drawing::Chart(Box::new(chart)),
         ));
     }
     out
@@ -150,18 +152,36 @@ fn strong_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
                 .flat_map(|s| &s.points)
                 .map(|c| (c.threads, c.ranks)),
         );
+        // The crossed markers' legend names the reasons the group's cases ran on one thread.
+        let one_thread = forking::legend(same.iter().flat_map(|s| {
+            s.measured
+                .iter()
+                .filter_map(|p| forking::at_workers(&s.points, p.p))
+        }));
         let mut chart = fig::speedup(&speed, &ceiling, workers, cap);
         chart.title = format!("{title}: speedup vs {workers}");
-        out.push((format!("speedup-{stem}"), Drawing::Chart(chart)));
+        if let Some(label) = &one_thread {
+            chart.crossed_label.clone_from(label);
+        }
+        out.push((format!("speedup-{stem}"), Drawing::Chart(Box::new(chart))));
         let eff: Vec<KernelSeries> = same.iter().map(|s| efficiency_series(s)).collect();
         let mut chart = fig::efficiency(&eff, workers, cap);
         chart.title = format!("{title}: parallel efficiency");
-        out.push((format!("efficiency-{stem}"), Drawing::Chart(chart)));
+        if let Some(label) = one_thread {
+            chart.crossed_label = label;
+        }
+        out.push((
+            format!("efficiency-{stem}"),
+            Drawing::Chart(Box::new(chart)),
+        ));
         let kf: Vec<KernelSeries> = same.iter().filter_map(|s| karp_flatt_series(s)).collect();
         if kf.iter().any(|k| !k.measured.is_empty()) {
             let mut chart = fig::karp_flatt(&kf, workers, cap);
             chart.title = format!("{title}: Karp-Flatt serial fraction e(p)");
-            out.push((format!("karp-flatt-{stem}"), Drawing::Chart(chart)));
+            out.push((
+                format!("karp-flatt-{stem}"),
+                Drawing::Chart(Box::new(chart)),
+            ));
         }
     }
     out
@@ -197,6 +217,7 @@ fn efficiency_series(s: &StrongAnalysis) -> KernelSeries {
                 p.efficiency.ci95[1],
             )
             .oversubscribed(oversubscribed_at(&s.points, p.p))
+            .one_thread(forking::at_workers(&s.points, p.p).is_some())
         })
         .collect();
     KernelSeries::new(s.label.clone(), m)
@@ -233,7 +254,18 @@ fn weak_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         );
         let mut chart = fig::weak_efficiency(&series, workers, cap);
         chart.title = format!("{scenario}: weak-scaling efficiency T(1)/T(p)");
-        out.push((format!("weak-efficiency-{scenario}"), Drawing::Chart(chart)));
+        let found = same.iter().flat_map(|o| {
+            o.measured
+                .iter()
+                .filter_map(|e| forking::at_workers(&o.points, e.p))
+        });
+        if let Some(label) = forking::legend(found) {
+            chart.crossed_label = label;
+        }
+        out.push((
+            format!("weak-efficiency-{scenario}"),
+            Drawing::Chart(Box::new(chart)),
+        ));
     }
     out
 }
@@ -246,6 +278,7 @@ fn weak_series(o: &WeakAnalysis) -> KernelSeries {
         .map(|e| {
             Measured::with_ci(e.p, e.e.estimate, e.e.ci95[0], e.e.ci95[1])
                 .oversubscribed(oversubscribed_at(&o.points, e.p))
+                .one_thread(forking::at_workers(&o.points, e.p).is_some())
         })
         .collect();
     KernelSeries::new(o.label.clone(), m)
@@ -271,7 +304,10 @@ fn scenario_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         bars.title = format!("{scen}: time per step by phase");
         out.push((format!("phases-{}", slug(scen)), Drawing::Bars(bars)));
         if let Some(chart) = percentiles_chart(&cases, scen, cap) {
-            out.push((format!("percentiles-{}", slug(scen)), Drawing::Chart(chart)));
+            out.push((
+                format!("percentiles-{}", slug(scen)),
+                Drawing::Chart(Box::new(chart)),
+            ));
         }
     }
     out
@@ -339,7 +375,7 @@ fn octree_accuracy_figure(a: &Analysis, cap: &str) -> Option<(String, Drawing)> 
     }
     Some((
         "octree-accuracy".into(),
-        Drawing::Chart(fig::octree_accuracy(&sweeps, cap)),
+        Drawing::Chart(Box::new(fig::octree_accuracy(&sweeps, cap))),
     ))
 }
 
@@ -429,6 +465,7 @@ fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
                 p.speedup.ci95[1],
             )
             .oversubscribed(oversubscribed_at(&s.points, p.p))
+            .one_thread(forking::at_workers(&s.points, p.p).is_some())
         })
         .collect();
     let Some(f) = &s.fit.fit else {

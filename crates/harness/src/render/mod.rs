@@ -4,6 +4,7 @@
 //! quantity is formatted by `crate::units`.
 
 pub mod analysis_figures;
+pub mod family_tables;
 pub mod fit_tables;
 pub mod runs;
 pub mod summary;

@@ -40,12 +40,21 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.crossovers.is_empty() {
         let _ = writeln!(md, "## Crossovers\n\n{}", tables::crossovers(a));
     }
+    if !a.family.is_empty() {
+        let _ = write!(
+            md,
+            "## The O(n²) family side by side\n\n{}\n\n{}",
+            super::family_tables::note(),
+            super::family_tables::markdown(&a.family)
+        );
+    }
     if !a.strong.is_empty() {
         let _ = writeln!(
             md,
             "## Strong scaling\n\n* = more workers than logical CPUs (oversubscribed).\n\n{}",
             tables::strong(a)
         );
+        md.push_str(&tables::strong_one_thread_notes(a));
         let comparisons = tables::serial_comparisons(a);
         if !comparisons.is_empty() {
             let _ = writeln!(md, "Timed vs fitted serial fraction:\n\n{comparisons}");
@@ -57,6 +66,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             "## Weak scaling\n\n* = oversubscribed.\n\n{}",
             tables::weak(a)
         );
+        md.push_str(&tables::weak_one_thread_notes(a));
     }
     let phases = super::runs::external_phases(a);
     if !phases.is_empty() {

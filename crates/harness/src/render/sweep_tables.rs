@@ -4,6 +4,7 @@
 //! embarrassingly parallel loop at the same thread count).
 
 use super::tables::{Align, NONE, Table};
+use crate::analysis::forking::{self, OneThread};
 use crate::experiment::estimate::Estimate;
 use crate::units::{Duration, WallTime};
 use nbody_records::config::SweepConfig;
@@ -138,6 +139,9 @@ pub struct Speedup {
     pub ceiling: Option<f64>,
     /// More threads than logical CPUs: not a parallel measurement.
     pub oversubscribed: bool,
+    /// Why the case ran on one thread although given several; `None` when it forked (or the
+    /// work counters cannot tell).
+    pub one_thread: Option<OneThread>,
 }
 
 /// Each multi-thread case with a measured one-thread twin, in the results' order.
@@ -159,6 +163,11 @@ pub fn speedups(results: &ResultsFile) -> Vec<Speedup> {
                 speedup: base.median_s / s.median_s,
                 ceiling: calibration.and_then(|cal| cal.ceiling(c.case.threads)),
                 oversubscribed: c.oversubscribed,
+                one_thread: c.case.kernel.kernel().and_then(|k| {
+                    // An external program counts no pairs: nothing to decide on.
+                    s.pair_evals_per_s?;
+                    forking::one_thread(k, c.case.threads, c.case.ranks, s.pair_checks_per_step)
+                }),
             });
         }
     }
@@ -186,14 +195,19 @@ pub fn speedups_table(speedups: &[Speedup]) -> Table {
             format!("{:.2}", s.speedup / s.threads as f64),
             ceiling.map_or(NONE.to_string(), |h| format!("{:.2}", s.speedup / h)),
             ceiling.map_or(NONE.to_string(), |h| format!("{h:.2}x")),
-            match s.oversubscribed {
-                true => "oversubscribed: not a parallel measurement",
-                false => "",
-            }
-            .to_string(),
+            note(s),
         ]);
     }
     t
+}
+
+/// The last column of a speedup's row: what keeps it from being a parallel speedup.
+fn note(s: &Speedup) -> String {
+    let mut notes: Vec<&str> = s.one_thread.iter().map(|o| o.label()).collect();
+    if s.oversubscribed {
+        notes.push("oversubscribed: not a parallel measurement");
+    }
+    notes.join("; ")
 }
 
 #[cfg(test)]
@@ -225,6 +239,26 @@ mod tests {
         }
         let text = speedups_table(&found).text();
         assert_eq!(text.lines().count(), found.len() + 1);
+        // n = 500 is under the fork threshold: naive and per-thread say so, symmetric never
+        // forks; n = 2000 forks, and the cell list's counters tell nothing.
+        let label = |key: &str| found.iter().find(|s| s.key == key).unwrap().one_thread;
+        let key = |kernel: &str, n: usize| format!("lj-box/{kernel}/n={n}/p=2/r=1/seed=1");
+        assert_eq!(label(&key("naive", 500)), Some(OneThread::TooSmall));
+        assert_eq!(label(&key("per-thread", 500)), Some(OneThread::TooSmall));
+        assert_eq!(
+            label(&key("symmetric", 2000)),
+            Some(OneThread::SerialKernel)
+        );
+        assert_eq!(label(&key("naive", 2000)), None);
+        assert_eq!(label(&key("cell-list", 500)), None);
+        let row = text
+            .lines()
+            .find(|l| l.starts_with(&key("naive", 500)))
+            .unwrap();
+        assert!(
+            row.ends_with("ran on 1 thread (too small to fork)"),
+            "{row}"
+        );
         assert!(
             text.starts_with("speedup over the same case on 1 thread"),
             "{text}"

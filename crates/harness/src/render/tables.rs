@@ -4,6 +4,7 @@
 //! REPORT.md both print these, so a number, a marker or a word reads the same in both: an
 //! oversubscribed case is marked `*`, an unbounded speedup is `∞`, a missing value `–`.
 
+use crate::analysis::forking;
 use crate::analysis::groups::Point;
 use crate::analysis::{Analysis, Fitted};
 use crate::units::{Duration, Percent, Plain, WithCi};
@@ -238,9 +239,10 @@ pub fn strong(a: &Analysis) -> String {
                     .map(|e| format!(" (÷ {:.2})", e.estimate))
                     .unwrap_or_default();
                 format!(
-                    "{}{}: {:.2}{rel}",
+                    "{}{}{}: {:.2}{rel}",
                     p.p,
                     over(oversubscribed_at(&st.points, p.p)),
+                    forking::at_workers(&st.points, p.p).map_or("", |o| o.marker()),
                     WithCi::of(&p.speedup, Plain)
                 )
             })
@@ -263,6 +265,42 @@ pub fn strong(a: &Analysis) -> String {
         ]));
     }
     table.markdown()
+}
+
+/// The notes of the one-thread markers ([`forking::OneThread::marker`]) that the strong
+/// table of `a` shows, each a paragraph; empty when it shows none.
+pub(crate) fn strong_one_thread_notes(a: &Analysis) -> String {
+    let found = a
+        .strong
+        .iter()
+        .filter(|st| st.fit.fit.is_some())
+        .flat_map(|st| {
+            st.measured
+                .iter()
+                .filter(|p| p.p > 1.0)
+                .filter_map(|p| forking::at_workers(&st.points, p.p))
+        });
+    forking::notes(found)
+}
+
+/// `notes` to follow a table: after a blank line, ending in one newline; empty without notes,
+/// so that a table without a marked case is followed as before.
+pub(crate) fn after_table(notes: &str) -> String {
+    match notes.trim_end() {
+        "" => String::new(),
+        notes => format!("\n{notes}\n"),
+    }
+}
+
+/// [`strong_one_thread_notes`] for the weak table of `a`.
+pub(crate) fn weak_one_thread_notes(a: &Analysis) -> String {
+    let found = a.weak.iter().filter(|w| w.fit.fit.is_some()).flat_map(|w| {
+        w.measured
+            .iter()
+            .filter_map(|e| w.points.iter().find(|c| c.has_workers(e.p)))
+            .filter_map(forking::of_point)
+    });
+    forking::notes(found)
 }
 
 /// The notes of each complexity fit (a class not firmly determined, a range of n too short to
@@ -310,9 +348,10 @@ pub fn weak(a: &Analysis) -> String {
             .map(|e| {
                 let c = w.points.iter().find(|c| c.has_workers(e.p));
                 format!(
-                    "{}{}: n={}, {:.2}",
+                    "{}{}{}: n={}, {:.2}",
                     e.p,
                     over(c.is_some_and(|c| c.oversubscribed)),
+                    c.and_then(forking::of_point).map_or("", |o| o.marker()),
                     c.map_or(0, |c| c.n),
                     WithCi::of(&e.e, Plain)
                 )

@@ -7,6 +7,7 @@
 //! same files always give the same text.
 
 mod comm_section;
+mod family_section;
 pub mod keep;
 mod sections;
 mod sources_section;

@@ -33,6 +33,7 @@ pub fn document(
     md.push_str(&region("summary", NO_NOTES));
     machine(&mut md, sweeps);
     complexity(&mut md, sweeps);
+    super::family_section::section(&mut md, sweeps, NO_NOTES);
     strong(&mut md, sweeps);
     weak(&mut md, sweeps);
     super::comm_section::section(&mut md, sweeps, comm, NO_NOTES);
@@ -42,14 +43,6 @@ pub fn document(
     sanity(&mut md, sweeps);
     super::sources_section::section(&mut md, sweeps, NO_NOTES);
     md
-}
-
-/// The sweeps of a section: not those that redo a source document's study (the comparison with
-/// the source documents shows them).
-fn own(sweeps: &[Sweep]) -> impl Iterator<Item = &Sweep> {
-    sweeps
-        .iter()
-        .filter(|s| !super::sources_section::redoes_a_source_study(&s.analysis))
 }
 
 fn machine(md: &mut String, sweeps: &[Sweep]) {
@@ -221,7 +214,7 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
 
 fn strong(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Strong scaling: what limits the speedup\n\n");
-    let with: Vec<&Sweep> = own(sweeps)
+    let with: Vec<&Sweep> = super::sources_section::own(sweeps)
         .filter(|s| s.analysis.study == Study::Strong && !s.analysis.strong.is_empty())
         .collect();
     if with.is_empty() {
@@ -237,6 +230,7 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
             a.source
         );
         md.push_str(&tables::strong(a));
+        md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
         md.push_str("\nTimed vs fitted serial fraction (the Barnes-Hut report's method next to the fit):\n\n");
         md.push_str(&tables::serial_comparisons(a));
         md.push('\n');
@@ -249,7 +243,7 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
 
 fn weak(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Weak scaling\n\n");
-    let with: Vec<&Sweep> = own(sweeps)
+    let with: Vec<&Sweep> = super::sources_section::own(sweeps)
         .filter(|s| !s.analysis.weak.is_empty())
         .collect();
     if with.is_empty() {
@@ -265,6 +259,7 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
             a.source
         );
         md.push_str(&tables::weak(a));
+        md.push_str(&tables::after_table(&tables::weak_one_thread_notes(a)));
         md.push('\n');
         s.figure_links(md, "weak-efficiency-");
     }
@@ -296,7 +291,7 @@ fn octree(md: &mut String, sweeps: &[Sweep]) {
 
 fn peers(md: &mut String, sweeps: &[Sweep]) {
     md.push_str("\n## Against established codes\n\n");
-    let with: Vec<&Sweep> = own(sweeps)
+    let with: Vec<&Sweep> = super::sources_section::own(sweeps)
         .filter(|s| !s.analysis.peers.is_empty())
         .collect();
     if with.is_empty() {
@@ -338,6 +333,7 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
         if !a.strong.is_empty() {
             md.push_str("Scaling of each code from 1 to 2 workers (speedup with 95% CI, ÷ the calibrated ceiling):\n\n");
             md.push_str(&tables::strong(a));
+            md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
             md.push('\n');
         }
         s.figure_links(md, "octree-accuracy");

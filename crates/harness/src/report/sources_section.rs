@@ -26,6 +26,14 @@ pub(crate) fn redoes_a_source_study(a: &Analysis) -> bool {
     SOURCE_STUDIES.contains(&a.name.as_str())
 }
 
+/// The sweeps of a section: not those that redo a source document's study (the comparison with
+/// the source documents shows them).
+pub(crate) fn own(sweeps: &[Sweep]) -> impl Iterator<Item = &Sweep> {
+    sweeps
+        .iter()
+        .filter(|s| !redoes_a_source_study(&s.analysis))
+}
+
 fn named<'a>(sweeps: &'a [Sweep], name: &str) -> Option<&'a Sweep> {
     sweeps.iter().find(|s| s.analysis.name == name)
 }
@@ -69,6 +77,7 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
                 a.source
             );
             md.push_str(&tables::strong(a));
+            md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
             md.push('\n');
             md.push_str(&tables::serial_comparisons(a));
             md.push('\n');
@@ -96,6 +105,7 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
                     a.source
                 );
                 md.push_str(&tables::weak(a));
+                md.push_str(&tables::after_table(&tables::weak_one_thread_notes(a)));
                 md.push('\n');
             }
         }
@@ -127,6 +137,7 @@ fn lj_box(md: &mut String, sweeps: &[Sweep]) {
     if !a.strong.is_empty() {
         md.push_str("Every code over its workers (÷ the calibrated ceiling for threads):\n\n");
         md.push_str(&tables::strong(a));
+        md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
         md.push('\n');
     }
     if !a.complexity.is_empty() {

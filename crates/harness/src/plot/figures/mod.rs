@@ -27,6 +27,8 @@ pub struct Measured {
     pub ci: Option<(f64, f64)>,
     /// Drawn hollow: the case ran more threads × ranks than the machine has logical CPUs.
     pub oversubscribed: bool,
+    /// Drawn crossed: the case ran on one thread although given several (the kernel's choice).
+    pub one_thread: bool,
 }
 
 impl Measured {
@@ -37,6 +39,7 @@ impl Measured {
             median,
             ci: None,
             oversubscribed: false,
+            one_thread: false,
         }
     }
 
@@ -54,8 +57,16 @@ impl Measured {
         self
     }
 
+    /// The value marked (drawn crossed) when it ran on one thread although given several.
+    pub fn one_thread(mut self, one_thread: bool) -> Self {
+        self.one_thread = one_thread;
+        self
+    }
+
     fn point(&self) -> Point {
-        let point = Point::new(self.x, self.median).hollow(self.oversubscribed);
+        let point = Point::new(self.x, self.median)
+            .hollow(self.oversubscribed)
+            .crossed(self.one_thread);
         match self.ci {
             Some((lo, hi)) => point.err(lo, hi),
             None => point,
