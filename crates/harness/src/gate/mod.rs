@@ -26,6 +26,7 @@ mod compare;
 pub mod drive;
 pub mod family;
 mod format;
+pub mod guard;
 pub mod route;
 pub mod save;
 pub mod study;
