@@ -60,7 +60,12 @@ pub(super) fn record(
         &outcome.report,
         &nbody_harness::gate::route::this_machine(),
     );
+    // A run the file already holds (a save's accepted run, appended just before) is not
+    // appended again, and not reported.
     for (to, count) in nbody_harness::history::verdicts::append(dir, &[run])? {
+        if count == 0 {
+            continue;
+        }
         eprintln!(
             "gate: the verdicts of {count} gate run(s) appended to {}",
             to.display()
