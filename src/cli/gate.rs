@@ -27,59 +27,10 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
     let outcome = drive::run(&request, &mut |line| eprintln!("gate: {line}"))?;
     out!("{}", formatted(&outcome.report, args.format));
     if let Some(history) = &args.record {
-        record(history, &outcome, args.current.as_deref())?;
+        super::history::record_gate_run(history, &outcome, args.current.as_deref())?;
     }
     if let Some(why) = outcome.incomplete() {
         eprintln!("error: {why}");
     }
     Ok(outcome.exit_code())
-}
-
-/// Appends what the gate measured to the history under `dir`: the A/B run's two sides (the
-/// baseline's revision and this build), the fast path's sweep, or the `--current` file; and
-/// the run's verdicts to the class's verdict file beside it.
-pub(super) fn record(
-    dir: &std::path::Path,
-    outcome: &drive::Outcome,
-    current: Option<&std::path::Path>,
-) -> anyhow::Result<()> {
-    let files: Vec<std::path::PathBuf> = match (&outcome.kept_in, current) {
-        (Some(kept), _) => ["base.json", "current.json", "results.json"]
-            .iter()
-            .map(|f| kept.join(f))
-            .filter(|p| p.is_file())
-            .collect(),
-        (None, Some(current)) => vec![nbody_records::locate::find_results(
-            current,
-            std::path::Path::new("results"),
-        )?],
-        (None, None) => Vec::new(),
-    };
-    // The verdicts beside the records: the page shows each class's latest gate run.
-    let run = nbody_harness::history::verdicts::GateRun::of(
-        &outcome.report,
-        &nbody_harness::gate::route::this_machine(),
-    );
-    // A run the file already holds (a save's accepted run, appended just before) is not
-    // appended again, and not reported.
-    for (to, count) in nbody_harness::history::verdicts::append(dir, &[run])? {
-        if count == 0 {
-            continue;
-        }
-        eprintln!(
-            "gate: the verdicts of {count} gate run(s) appended to {}",
-            to.display()
-        );
-    }
-    for path in files {
-        let file = nbody_records::results::ResultsFile::load(&path)?;
-        for (to, count) in super::history::append_results(dir, &file, "gate")? {
-            eprintln!(
-                "gate: {count} records of {} appended to {}",
-                path.display(),
-                to.display()
-            );
-        }
-    }
-    Ok(())
 }

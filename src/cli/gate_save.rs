@@ -35,7 +35,7 @@ pub fn save(args: &GateArgs, results: &Path, a_b: Request) -> anyhow::Result<i32
         Judgement::Refused(refusal) => {
             out!("{}", formatted(&refusal.outcome.report, args.format));
             if let Some(dir) = &args.record {
-                super::gate::record(dir, &refusal.outcome, None)?;
+                super::history::record_gate_run(dir, &refusal.outcome, None)?;
             }
             eprintln!("error: {}", refusal.message);
             return Ok(1);
@@ -71,7 +71,7 @@ pub fn save(args: &GateArgs, results: &Path, a_b: Request) -> anyhow::Result<i32
             }
         }
         if let Some(dir) = &args.record {
-            super::gate::record(dir, &replaced.outcome, None)?;
+            super::history::record_gate_run(dir, &replaced.outcome, None)?;
         }
         let accepted: Vec<String> = replaced.accepted.iter().map(|r| r.describe()).collect();
         eprintln!(

@@ -87,7 +87,7 @@ impl Outcome {
              baseline's config to completion (sweep --resume), or refresh the baseline if the \
              cases were removed on purpose",
             why.len(),
-            super::save::listed(&why)
+            super::listed(&why)
         ))
     }
 }

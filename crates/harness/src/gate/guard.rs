@@ -111,7 +111,7 @@ pub enum GuardError {
     #[error(
         "--accept {}: not a case of the results being saved; its cases are: {}",
         .unknown.join(", "),
-        super::save::listed(.cases)
+        super::listed(.cases)
     )]
     NotACase {
         /// The accepted keys that are no case.
@@ -141,7 +141,7 @@ pub enum GuardError {
     #[error(
         "the A/B run could not compare {}, so it cannot vouch for the new baseline: {}",
         if .0.len() == 1 { "a case".to_string() } else { format!("{} cases", .0.len()) },
-        super::save::listed(.0)
+        super::listed(.0)
     )]
     Incomplete(Vec<String>),
 }

@@ -77,6 +77,21 @@ pub const MIN_CI_SAMPLES: usize = 6;
 /// Schema of the JSON rendering of a [`GateReport`].
 pub(crate) const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
 
+/// The first few of `items`, "; "-separated, with how many more there are.
+pub fn listed(items: &[String]) -> String {
+    const SHOWN: usize = 5;
+    let mut text = items
+        .iter()
+        .take(SHOWN)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join("; ");
+    if items.len() > SHOWN {
+        text += &format!("; and {} more", items.len() - SHOWN);
+    }
+    text
+}
+
 /// How to compare.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GateOptions {

@@ -5,6 +5,7 @@
 
 use super::drive::{self, Outcome};
 use super::guard::{self, Acceptance, Decision, Regression};
+use super::listed;
 use super::{BUSY_BASELINE_CPUS, GateOptions, RunInfo, background_cpus, baselines, compare};
 use nbody_records::config::SweepConfig;
 use nbody_records::locate;
@@ -253,19 +254,4 @@ pub fn unfit_as_baseline(file: &ResultsFile) -> Option<String> {
         }
     }
     (!why.is_empty()).then(|| listed(&why))
-}
-
-/// The first few of `items`, "; "-separated, with how many more there are.
-pub fn listed(items: &[String]) -> String {
-    const SHOWN: usize = 5;
-    let mut text = items
-        .iter()
-        .take(SHOWN)
-        .cloned()
-        .collect::<Vec<_>>()
-        .join("; ");
-    if items.len() > SHOWN {
-        text += &format!("; and {} more", items.len() - SHOWN);
-    }
-    text
 }
