@@ -30,8 +30,7 @@ const SYMMETRIC: &str = "lj-box/symmetric/n=1000/p=1/r=1/seed=1";
 
 /// SAVE_TINY swept without calibration (its 20 s are not what is tested), then given a
 /// calibration of this machine's class taken from the committed baseline, so that the file is a
-/// baseline of this class; `commit` is the commit it records. Returns (JSON, its class's file
-/// name in a baseline folder).
+/// baseline of this class. Returns (its JSON, its class's file name in a baseline folder).
 fn swept_as_this_class(dir: &Path) -> (serde_json::Value, String) {
     let config = dir.join("save-tiny.toml");
     std::fs::write(&config, SAVE_TINY).unwrap();
@@ -60,6 +59,7 @@ fn swept_as_this_class(dir: &Path) -> (serde_json::Value, String) {
     (v, nbody_harness::gate::baselines::file_name(&info))
 }
 
+/// Writes `v` to `path` as results measured at `commit`.
 fn write_with_commit(v: &serde_json::Value, commit: &str, path: &Path) -> PathBuf {
     let mut v = v.clone();
     v["metadata"]["git_commit"] = commit.into();
