@@ -651,11 +651,16 @@ pub struct FitArgs {
         target/gate-base/) and measures both builds here, interleaved case by case (A/B);\n\
         - with --against REV: always A/B against REV.\n\n\
         --save-baseline RESULTS files a sweep of the baseline's config as this machine class's \
-        baseline (scripts/refresh-baseline.sh does it from a fresh sweep).",
+        baseline (scripts/refresh-baseline.sh does it from a fresh sweep). A baseline never \
+        absorbs a regression silently: if the class has one, this build is first measured A/B \
+        against its commit, and the save is refused (exit 1) while a case regressed that \
+        --accept CASE... --reason TEXT does not name.",
     after_help = "Examples:\n  nbody-bench gate                       # CI: judge this build on any machine\n  \
     nbody-bench gate --against origin/main  # a pull request against its base\n  \
     nbody-bench gate --baseline results/baseline --current ci --format markdown\n  \
-    nbody-bench gate --save-baseline ci     # the latest ci sweep becomes this machine's baseline"
+    nbody-bench gate --save-baseline ci     # the latest ci sweep becomes this machine's baseline\n  \
+    nbody-bench gate --save-baseline ci --accept lj-box/symmetric/n=2000/p=1/r=1/seed=1 \\\n      \
+    --reason \"exact pair forces now\"   # a save that keeps an intended slowdown"
 )]
 pub struct GateArgs {
     /// The reference run: a results file, or a folder of baselines, one per machine class
@@ -664,11 +669,25 @@ pub struct GateArgs {
     #[arg(long, value_name = "FILE|DIR", default_value = "results/baseline")]
     pub baseline: PathBuf,
     /// Keep RESULTS (a results.json, a run directory or a config name) in the --baseline folder
-    /// as the baseline of the machine class it was measured on, replacing that class's file,
-    /// and measure nothing. Refused when other processes used 0.25 CPUs or more while it was
-    /// calibrated: a baseline must come from a quiet machine.
-    #[arg(long, value_name = "RESULTS", conflicts_with_all = ["current", "against"])]
+    /// as the baseline of the machine class it was measured on. Refused when other processes
+    /// used 0.25 CPUs or more while it was calibrated: a baseline must come from a quiet
+    /// machine. When that class already has a baseline, this build and the commit that
+    /// baseline records are first measured side by side (A/B, on RESULTS' config, judged as
+    /// any A/B gate run: --rounds, --threshold, --out apply), and a case that regressed
+    /// refuses the save (exit 1, the old file untouched) unless named with --accept.
+    #[arg(long, value_name = "RESULTS", conflicts_with_all = ["current", "against", "config"])]
     pub save_baseline: Option<PathBuf>,
+    /// With --save-baseline: let these regressed cases (keys as the gate prints them) into the
+    /// new baseline; needs --reason. Every case that regressed must be named, and only those:
+    /// a key that is no case of RESULTS, or did not regress, is an error (exit 2). The
+    /// acceptance (cases, ratios, reason, both commits, machine class, time) is appended to
+    /// the history's gate verdicts, DIR/<class>.gate.jsonl of --record (default
+    /// results/history).
+    #[arg(long, value_name = "CASE", num_args = 1.., requires = "save_baseline")]
+    pub accept: Vec<String>,
+    /// Why the slowdown of the --accept cases is intended, kept with them in the history.
+    #[arg(long, value_name = "TEXT", requires = "accept")]
+    pub reason: Option<String>,
     /// Results of the run to check: a results.json, a run directory or a config name (its
     /// latest run). Without it the gate measures this build itself.
     #[arg(long, value_name = "RESULTS")]
@@ -722,7 +741,7 @@ pub struct GateArgs {
     pub fail_on_work_change: bool,
     /// Append what the gate measured (this build, and the baseline's revision in an A/B run) to
     /// the performance history of this machine class, DIR/<class>.jsonl (default
-    /// results/history).
+    /// results/history), and the run's verdicts to DIR/<class>.gate.jsonl.
     #[arg(long, value_name = "DIR", num_args = 0..=1, default_missing_value = "results/history")]
     pub record: Option<PathBuf>,
 }

@@ -7,82 +7,30 @@ use nbody_harness::gate::drive::{self, Request};
 use nbody_harness::gate::formatted;
 
 pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
-    if let Some(results) = &args.save_baseline {
-        let (target, info) = nbody_harness::gate::save::save_baseline(&args.baseline, results)?;
-        eprintln!(
-            "gate: {} kept as the baseline of {} ({} logical CPUs): {}",
-            results.display(),
-            info.cpu_signature.as_deref().unwrap_or("an unknown CPU"),
-            info.logical_cpus.map_or("?".into(), |n| n.to_string()),
-            target.display()
-        );
-        return Ok(0);
-    }
     let request = Request {
-        baseline: args.baseline,
+        baseline: args.baseline.clone(),
         current: args.current.clone(),
-        against: args.against,
-        config: args.config,
+        against: args.against.clone(),
+        config: args.config.clone(),
         rounds: args.rounds,
         timeout: args.timeout,
-        out: args.out,
+        out: args.out.clone(),
         threshold: args.threshold,
         normalize: args.normalize,
         judge: args.judge,
         force: args.force,
         fail_on_work_change: args.fail_on_work_change,
     };
+    if let Some(results) = &args.save_baseline {
+        return super::gate_save::save(&args, results, request);
+    }
     let outcome = drive::run(&request, &mut |line| eprintln!("gate: {line}"))?;
     out!("{}", formatted(&outcome.report, args.format));
     if let Some(history) = &args.record {
-        record(history, &outcome, args.current.as_deref())?;
+        super::history::record_gate_run(history, &outcome, args.current.as_deref())?;
     }
     if let Some(why) = outcome.incomplete() {
         eprintln!("error: {why}");
     }
     Ok(outcome.exit_code())
-}
-
-/// Appends what the gate measured to the history under `dir`: the A/B run's two sides (the
-/// baseline's revision and this build), the fast path's sweep, or the `--current` file; and
-/// the run's verdicts to the class's verdict file beside it.
-fn record(
-    dir: &std::path::Path,
-    outcome: &drive::Outcome,
-    current: Option<&std::path::Path>,
-) -> anyhow::Result<()> {
-    let files: Vec<std::path::PathBuf> = match (&outcome.kept_in, current) {
-        (Some(kept), _) => ["base.json", "current.json", "results.json"]
-            .iter()
-            .map(|f| kept.join(f))
-            .filter(|p| p.is_file())
-            .collect(),
-        (None, Some(current)) => vec![nbody_records::locate::find_results(
-            current,
-            std::path::Path::new("results"),
-        )?],
-        (None, None) => Vec::new(),
-    };
-    // The verdicts beside the records: the page shows each class's latest gate run.
-    let run = nbody_harness::history::verdicts::GateRun::of(
-        &outcome.report,
-        &nbody_harness::gate::route::this_machine(),
-    );
-    for (to, count) in nbody_harness::history::verdicts::append(dir, &[run])? {
-        eprintln!(
-            "gate: the verdicts of {count} gate run(s) appended to {}",
-            to.display()
-        );
-    }
-    for path in files {
-        let file = nbody_records::results::ResultsFile::load(&path)?;
-        for (to, count) in super::history::append_results(dir, &file, "gate")? {
-            eprintln!(
-                "gate: {count} records of {} appended to {}",
-                path.display(),
-                to.display()
-            );
-        }
-    }
-    Ok(())
 }

@@ -339,6 +339,55 @@ fn glob(pattern: &str) -> anyhow::Result<regex::Regex> {
     regex::Regex::new(&re).with_context(|| format!("--case `{pattern}`"))
 }
 
+/// Appends what the gate measured to the history under `dir`: the A/B run's two sides (the
+/// baseline's revision and this build), the fast path's sweep, or the `--current` file; and
+/// the run's verdicts to the class's verdict file beside it.
+pub fn record_gate_run(
+    dir: &std::path::Path,
+    outcome: &nbody_harness::gate::drive::Outcome,
+    current: Option<&std::path::Path>,
+) -> anyhow::Result<()> {
+    let files: Vec<std::path::PathBuf> = match (&outcome.kept_in, current) {
+        (Some(kept), _) => ["base.json", "current.json", "results.json"]
+            .iter()
+            .map(|f| kept.join(f))
+            .filter(|p| p.is_file())
+            .collect(),
+        (None, Some(current)) => vec![nbody_records::locate::find_results(
+            current,
+            std::path::Path::new("results"),
+        )?],
+        (None, None) => Vec::new(),
+    };
+    // The verdicts beside the records: the page shows each class's latest gate run.
+    let run = nbody_harness::history::verdicts::GateRun::of(
+        &outcome.report,
+        &nbody_harness::gate::route::this_machine(),
+    );
+    // A run the file already holds (a save's accepted run, appended just before) is not
+    // appended again, and not reported.
+    for (to, count) in nbody_harness::history::verdicts::append(dir, &[run])? {
+        if count == 0 {
+            continue;
+        }
+        eprintln!(
+            "gate: the verdicts of {count} gate run(s) appended to {}",
+            to.display()
+        );
+    }
+    for path in files {
+        let file = nbody_records::results::ResultsFile::load(&path)?;
+        for (to, count) in append_results(dir, &file, "gate")? {
+            eprintln!(
+                "gate: {count} records of {} appended to {}",
+                path.display(),
+                to.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::glob;

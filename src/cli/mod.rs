@@ -11,6 +11,7 @@ mod export;
 mod export_results;
 mod fit;
 mod gate;
+mod gate_save;
 mod gate_study;
 mod history;
 mod init;

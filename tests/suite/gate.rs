@@ -2,6 +2,8 @@
 //! genuinely slower (the test-only slowdown knob) is flagged alone with exit 1, and bad input
 //! (truncated or wrong-schema JSON, another machine, missing cases) exits 2 with a message.
 
+mod save;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 

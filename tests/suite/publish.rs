@@ -98,6 +98,7 @@ fn fixture(dir: &Path) {
             ci95: [1.27, 1.33],
         }],
         missing: vec![],
+        acceptance: None,
     };
     verdicts::append(dir, &[run]).unwrap();
 }

@@ -87,7 +87,7 @@ impl Outcome {
              baseline's config to completion (sweep --resume), or refresh the baseline if the \
              cases were removed on purpose",
             why.len(),
-            super::save::listed(&why)
+            super::listed(&why)
         ))
     }
 }
@@ -150,20 +150,57 @@ fn measure_and_judge(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Re
         }
         Route::AB { rev } => Planned::AB(prepare_a_b(request, &rev, &config, &text, say)?),
     };
-    let out = match out {
-        Some(dir) => {
-            std::fs::create_dir_all(&dir)
-                .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
-            dir
-        }
-        None => locate::new_run_dir(Path::new("results"), "gate", &utc_now())?,
-    };
+    let out = created_out_dir(out)?;
     let judged = match planned {
         Planned::AB(prepared) => a_b(request, &prepared, &config, &text, &out, say),
         Planned::Fast { path, baseline } => {
             fast_path(request, &path, &baseline, &config, &text, &out, say)
         }
     };
+    kept(judged, out)
+}
+
+/// Measures this build and revision `rev` side by side on `config` (its TOML `text`) and
+/// judges them as an A/B gate run does, for a caller that chose the route and the config
+/// itself: `gate --save-baseline` against the commit of the baseline it replaces. The
+/// request's rounds, timeout, out, threshold, normalisation and judge apply; its baseline,
+/// current, against and config do not.
+pub fn a_b_run(
+    request: &Request,
+    rev: &str,
+    config: &SweepConfig,
+    text: &str,
+    say: &mut dyn FnMut(&str),
+) -> anyhow::Result<Outcome> {
+    let out = checked_out_dir(request)?;
+    let prepared = prepare_a_b(request, rev, config, text, say)?;
+    let out = created_out_dir(out)?;
+    let judged = a_b(request, &prepared, config, text, &out, say);
+    let outcome = kept(judged, out)?;
+    if outcome.report.cases.is_empty() {
+        anyhow::bail!("the A/B run compared no case: nothing was judged, which is not a pass");
+    }
+    Ok(outcome)
+}
+
+/// `--out DIR` created, or a new run directory under `results/runs/gate/`.
+fn created_out_dir(out: Option<PathBuf>) -> anyhow::Result<PathBuf> {
+    match out {
+        Some(dir) => {
+            std::fs::create_dir_all(&dir)
+                .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
+            Ok(dir)
+        }
+        None => Ok(locate::new_run_dir(
+            Path::new("results"),
+            "gate",
+            &utc_now(),
+        )?),
+    }
+}
+
+/// The judged report written to `out/gate.json`; on an error, `out` removed if it is empty.
+fn kept(judged: anyhow::Result<GateReport>, out: PathBuf) -> anyhow::Result<Outcome> {
     match judged {
         Ok(report) => {
             let json = super::formatted(&report, super::Format::Json);

@@ -26,6 +26,7 @@ mod compare;
 pub mod drive;
 pub mod family;
 mod format;
+pub mod guard;
 pub mod route;
 pub mod save;
 pub mod study;
@@ -75,6 +76,21 @@ pub const MIN_CI_SAMPLES: usize = 6;
 
 /// Schema of the JSON rendering of a [`GateReport`].
 pub(crate) const GATE_SCHEMA: &str = "nbody-bench/gate/v1";
+
+/// The first few of `items`, "; "-separated, with how many more there are.
+pub fn listed(items: &[String]) -> String {
+    const SHOWN: usize = 5;
+    let mut text = items
+        .iter()
+        .take(SHOWN)
+        .cloned()
+        .collect::<Vec<_>>()
+        .join("; ");
+    if items.len() > SHOWN {
+        text += &format!("; and {} more", items.len() - SHOWN);
+    }
+    text
+}
 
 /// How to compare.
 #[derive(Clone, Debug, PartialEq)]

@@ -1,17 +1,168 @@
 //! `gate --save-baseline`: a sweep of the baseline's config kept as its machine class's
-//! baseline, once it is fit to be one.
+//! baseline, once it is fit to be one and, when it replaces that class's earlier baseline, once
+//! an A/B run of this build against the earlier baseline's commit found no regression the user
+//! did not accept ([`super::guard`]).
 
+use super::drive::{self, Outcome};
+use super::guard::{self, Acceptance, Decision, Regression};
+use super::listed;
 use super::{BUSY_BASELINE_CPUS, GateOptions, RunInfo, background_cpus, baselines, compare};
+use nbody_records::config::SweepConfig;
 use nbody_records::locate;
-use nbody_records::results::ResultsFile;
+use nbody_records::results::{ResultsFile, read_json};
 use std::path::{Path, PathBuf};
 
-/// Keeps `results` in `folder` under its machine class's name, replacing that class's earlier
-/// file, once it compares cleanly with itself (schema, calibration, config, every case
-/// judgeable), was measured on a quiet machine, and plans again to its own cases with this
-/// build; the other classes' files stay. Every refusal leaves the folder as it was. Returns
-/// the file written and the class it was kept for.
-pub fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<(PathBuf, RunInfo)> {
+/// What `gate --save-baseline` is asked to do.
+pub struct SaveRequest {
+    /// The folder of baselines, one file per machine class (`--baseline`).
+    pub folder: PathBuf,
+    /// The results to keep (a results.json, a run directory or a config name).
+    pub results: PathBuf,
+    /// The regressions the user accepts in advance, with the reason.
+    pub accept: Acceptance,
+    /// How the A/B run against the replaced baseline's commit is measured and judged (its
+    /// rounds, timeout, out, threshold, normalisation and judge; see [`drive::a_b_run`]).
+    pub a_b: drive::Request,
+}
+
+/// A results file found fit to be its class's baseline, not yet kept.
+pub struct Candidate {
+    /// The results file, resolved.
+    pub source: PathBuf,
+    /// Where it comes from: its commit and machine class.
+    pub info: RunInfo,
+    /// Its class's file in the folder, which it would replace if present.
+    pub target: PathBuf,
+    /// Its stored config, as this build reproduces it: what the A/B run measures.
+    config: SweepConfig,
+    /// That config as TOML text.
+    text: String,
+    /// Its case keys, in its order.
+    pub cases: Vec<String>,
+}
+
+/// The baseline a candidate replaces, and what the A/B run against its commit found.
+pub struct Replaced {
+    /// The commit the replaced baseline was measured at (the A/B run's base).
+    pub commit: String,
+    /// The A/B run: its report and where its measurements are kept.
+    pub outcome: Outcome,
+    /// The regressions the user accepted (empty when nothing regressed).
+    pub accepted: Vec<Regression>,
+    /// The reason given for them (`None` when nothing was accepted).
+    pub reason: Option<String>,
+}
+
+/// A save that may go ahead: the caller records any acceptance, then calls [`Pending::keep`].
+pub struct Pending {
+    /// The results to keep.
+    pub candidate: Candidate,
+    /// The baseline it replaces; `None` when the class has none yet (nothing was compared).
+    pub replaced: Option<Replaced>,
+}
+
+/// A save refused because of unaccepted regressions: the old baseline stays as it was.
+pub struct Refusal {
+    /// The A/B run that found them.
+    pub outcome: Outcome,
+    /// What to tell the user: every regressed case with its ratio and CI, and how to accept.
+    pub message: String,
+}
+
+/// Whether the save goes ahead.
+pub enum Judgement {
+    /// Nothing regressed unaccepted (or nothing was compared): keep it.
+    Ready(Box<Pending>),
+    /// A regression was not accepted.
+    Refused(Box<Refusal>),
+}
+
+/// Checks the results ([`check`]) and the acceptance (before anything is measured), then, if
+/// the class already has a baseline, measures this build against its commit (A/B, the gate's
+/// usual rule) and decides ([`guard::decide`]). Bad input is an error; nothing is written here.
+pub fn judge_save(request: &SaveRequest, say: &mut dyn FnMut(&str)) -> anyhow::Result<Judgement> {
+    let candidate = check(&request.folder, &request.results)?;
+    let reason = request.accept.check(&candidate.cases)?;
+    if !candidate.target.exists() {
+        if !request.accept.is_empty() {
+            return Err(guard::GuardError::NothingToCompare.into());
+        }
+        say(&format!(
+            "no baseline of this machine class yet ({} does not exist): nothing to compare the \
+             new one against, so it is saved unchecked",
+            candidate.target.display()
+        ));
+        return Ok(Judgement::Ready(Box::new(Pending {
+            candidate,
+            replaced: None,
+        })));
+    }
+    let old = RunInfo::from_json(&read_json(&candidate.target)?).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{} records no commit, so the baseline it holds cannot be measured against this \
+             build; if the file is broken, restore it from git",
+            candidate.target.display()
+        )
+    })?;
+    if old.git_dirty {
+        say(&format!(
+            "the baseline {} was measured with uncommitted changes: its commit {} is measured, \
+             which may differ from it",
+            candidate.target.display(),
+            super::prefix(&old.git_commit, 12)
+        ));
+    }
+    say(&format!(
+        "{} replaces {}: measuring this build and that baseline's commit {} side by side (A/B) \
+         first, so that no regression goes into the baseline unseen",
+        candidate.source.display(),
+        candidate.target.display(),
+        super::prefix(&old.git_commit, 12)
+    ));
+    let outcome = drive::a_b_run(
+        &request.a_b,
+        &old.git_commit,
+        &candidate.config,
+        &candidate.text,
+        say,
+    )?;
+    match guard::decide(&outcome.report, &request.accept.cases)? {
+        Decision::Save { accepted } => Ok(Judgement::Ready(Box::new(Pending {
+            replaced: Some(Replaced {
+                commit: old.git_commit,
+                outcome,
+                reason: (!accepted.is_empty()).then_some(reason).flatten(),
+                accepted,
+            }),
+            candidate,
+        }))),
+        Decision::Refuse {
+            regressed,
+            unaccepted,
+        } => Ok(Judgement::Refused(Box::new(Refusal {
+            message: guard::refusal(&regressed, &unaccepted, &candidate.target, &old.git_commit),
+            outcome,
+        }))),
+    }
+}
+
+impl Pending {
+    /// Writes the candidate over its class's file (atomically: the old file stays whole until
+    /// the new one replaces it). Returns the file written and the class it was kept for.
+    pub fn keep(self) -> anyhow::Result<(PathBuf, RunInfo)> {
+        let c = self.candidate;
+        let text = nbody_engine::input::read_text(&c.source)
+            .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", c.source.display()))?;
+        nbody_engine::output::write_atomic(&c.target, text.as_bytes())?;
+        Ok((c.target, c.info))
+    }
+}
+
+/// Whether `results` is fit to be kept in `folder` as its machine class's baseline: it
+/// compares cleanly with itself (schema, calibration, config, every case judgeable), was
+/// measured on a quiet machine, and plans again to its own cases with this build. Creates the
+/// folder if needed, writes nothing else.
+pub fn check(folder: &Path, results: &Path) -> anyhow::Result<Candidate> {
     let source = locate::find_results(results, Path::new("results"))?;
     if nbody_engine::input::is_pipe(&source) {
         // It is read twice: checked, then copied byte for byte.
@@ -48,12 +199,13 @@ pub fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<(PathBuf, 
             source.display()
         );
     }
-    if let baselines::Fitness::Stale(why) = baselines::examine(&source)?.fitness {
-        anyhow::bail!(
+    let reproducible = match baselines::examine(&source)?.fitness {
+        baselines::Fitness::Stale(why) => anyhow::bail!(
             "{} cannot be a baseline: {why}; sweep the config again with this build",
             source.display()
-        );
-    }
+        ),
+        baselines::Fitness::Reproducible(r) => r,
+    };
     if folder.is_file() {
         anyhow::bail!(
             "--baseline {} is a file; --save-baseline needs the folder of baselines \
@@ -65,10 +217,14 @@ pub fn save_baseline(folder: &Path, results: &Path) -> anyhow::Result<(PathBuf, 
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", folder.display()))?;
     let info = RunInfo::of(&file);
     let target = folder.join(baselines::file_name(&info));
-    let text = nbody_engine::input::read_text(&source)
-        .map_err(|e| anyhow::anyhow!("cannot read {}: {e}", source.display()))?;
-    nbody_engine::output::write_atomic(&target, text.as_bytes())?;
-    Ok((target, info))
+    Ok(Candidate {
+        source,
+        target,
+        cases: file.cases.iter().map(|c| c.key.clone()).collect(),
+        info,
+        config: reproducible.config,
+        text: reproducible.text,
+    })
 }
 
 /// Why a results file cannot be a baseline: every check the gate makes against it must be
@@ -98,19 +254,4 @@ pub fn unfit_as_baseline(file: &ResultsFile) -> Option<String> {
         }
     }
     (!why.is_empty()).then(|| listed(&why))
-}
-
-/// The first few of `items`, "; "-separated, with how many more there are.
-pub fn listed(items: &[String]) -> String {
-    const SHOWN: usize = 5;
-    let mut text = items
-        .iter()
-        .take(SHOWN)
-        .cloned()
-        .collect::<Vec<_>>()
-        .join("; ");
-    if items.len() > SHOWN {
-        text += &format!("; and {} more", items.len() - SHOWN);
-    }
-    text
 }

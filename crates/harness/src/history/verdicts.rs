@@ -7,6 +7,7 @@
 
 use super::store::{BadLine, HistoryError, Line, append_text, parse_lines, read_lines};
 use crate::gate::baselines::class_name;
+use crate::gate::guard::Regression;
 use crate::gate::{GateReport, Judged, RunInfo, Verdict};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -43,6 +44,42 @@ pub struct GateRun {
     /// Baseline cases that could not be compared.
     #[serde(default)]
     pub missing: Vec<String>,
+    /// Set on the A/B run of a `gate --save-baseline` whose regressions the user accepted:
+    /// the new baseline was saved with them. Absent from every other run, and from files
+    /// written before it existed (a reader that does not know the field reads the run as any
+    /// other).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub acceptance: Option<Acceptance>,
+}
+
+/// Regressions accepted into a machine class's baseline (`gate --save-baseline --accept CASE...
+/// --reason TEXT`): what a later reader needs to know that the baseline absorbed them on
+/// purpose.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Acceptance {
+    /// UTC, ISO 8601, when the new baseline was saved.
+    pub accepted: String,
+    /// The machine class whose baseline was replaced, as the baselines name it.
+    pub class: String,
+    /// The commit of the baseline replaced (the A/B run's base).
+    pub replaced_commit: String,
+    /// The commit the new baseline's results were measured at.
+    pub new_commit: String,
+    /// Why the slowdown is intended, as the user gave it.
+    pub reason: String,
+    /// The accepted cases with the ratios the A/B run found.
+    pub cases: Vec<AcceptedCase>,
+}
+
+/// One accepted regression.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AcceptedCase {
+    /// The case key.
+    pub key: String,
+    /// This build / the replaced baseline's commit, the ratio the verdict was judged on.
+    pub ratio: f64,
+    /// Bootstrap 95% interval of that ratio ([low, high]).
+    pub ci95: [f64; 2],
 }
 
 /// One case's verdict.
@@ -84,6 +121,7 @@ impl GateRun {
                 })
                 .collect(),
             missing: report.missing.iter().map(|m| m.key.clone()).collect(),
+            acceptance: None,
         }
     }
 
@@ -119,7 +157,39 @@ impl GateRun {
                 })
                 .collect(),
             missing: r.missing.into_iter().map(|m| m.key).collect(),
+            acceptance: None,
         })
+    }
+
+    /// The verdicts of a `gate --save-baseline` A/B run whose regressions `accepted` the user
+    /// accepted for `reason`, at `when` (UTC), into the baseline of machine class `class` (as
+    /// the baselines name it), of results measured at `new_commit`.
+    pub fn accepted(
+        report: &GateReport,
+        machine: &RunInfo,
+        class: &str,
+        accepted: &[Regression],
+        reason: &str,
+        new_commit: &str,
+        when: &str,
+    ) -> GateRun {
+        let mut run = GateRun::of(report, machine);
+        run.acceptance = Some(Acceptance {
+            accepted: when.to_string(),
+            class: class.to_string(),
+            replaced_commit: run.base.clone(),
+            new_commit: new_commit.to_string(),
+            reason: reason.to_string(),
+            cases: accepted
+                .iter()
+                .map(|r| AcceptedCase {
+                    key: r.key.clone(),
+                    ratio: r.ratio,
+                    ci95: r.ci95,
+                })
+                .collect(),
+        });
+        run
     }
 
     /// The verdict on `key`, if the run judged it.
@@ -308,6 +378,7 @@ pub(crate) mod tests {
                 })
                 .collect(),
             missing: vec![],
+            acceptance: None,
         }
     }
 
@@ -344,6 +415,70 @@ pub(crate) mod tests {
         assert_eq!(v.bad[0].line, 2);
         assert!(v.bad[0].problem.contains("not a gate verdict line"));
         assert_eq!(v.latest(), Some(&b));
+    }
+
+    #[test]
+    fn an_acceptance_round_trips_and_files_without_one_still_load() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut accepted = run(
+            "2026-12-07T10:00:00Z",
+            "aaa",
+            "bbb",
+            &[
+                ("c", Verdict::Regressed, 1.4),
+                ("d", Verdict::Unchanged, 1.0),
+            ],
+        );
+        accepted.acceptance = Some(Acceptance {
+            accepted: "2026-12-07T10:05:00Z".into(),
+            class: accepted.class.clone(),
+            replaced_commit: "aaa".into(),
+            new_commit: "bbb".into(),
+            reason: "the exact kernel is slower on purpose".into(),
+            cases: vec![AcceptedCase {
+                key: "c".into(),
+                ratio: 1.4,
+                ci95: [1.3, 1.5],
+            }],
+        });
+        let plain = run("2026-12-06T10:00:00Z", "aaa", "aaa", &[]);
+        append(dir.path(), &[plain.clone(), accepted.clone()]).unwrap();
+        let path = file_of(dir.path(), &plain.class);
+        let text = std::fs::read_to_string(&path).unwrap();
+        // A run without an acceptance is written as before the field existed.
+        assert!(
+            !text.lines().next().unwrap().contains("acceptance"),
+            "{text}"
+        );
+        let v = read(&path).unwrap();
+        assert!(v.bad.is_empty(), "{:?}", v.bad);
+        assert_eq!(v.runs, [plain, accepted]);
+        // Readers ignore fields they do not know, so an older reader takes the line for the
+        // run it is; and a field added later is ignored here the same way.
+        let later = text
+            .lines()
+            .nth(1)
+            .unwrap()
+            .replacen('{', "{\"added_later\":1,", 1);
+        assert_eq!(parse(&later).runs.len(), 1);
+    }
+
+    /// Every verdict file committed in results/history loads whole: CI on every machine class
+    /// reads them.
+    #[test]
+    fn the_committed_verdict_files_load() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../results/history");
+        let mut seen = 0;
+        for entry in std::fs::read_dir(&dir).unwrap().flatten() {
+            let path = entry.path();
+            if path.to_string_lossy().ends_with(".gate.jsonl") {
+                let v = read(&path).unwrap();
+                assert!(v.bad.is_empty(), "{}: {:?}", path.display(), v.bad);
+                assert!(!v.runs.is_empty(), "{}", path.display());
+                seen += 1;
+            }
+        }
+        assert!(seen > 0, "no verdict file in {}", dir.display());
     }
 
     #[test]

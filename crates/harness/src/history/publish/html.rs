@@ -212,6 +212,18 @@ fn class(o: &mut String, c: &ClassView) {
             format!(", {} missing", g.missing.len())
         },
     );
+    if let Some(a) = &g.acceptance {
+        // A regression let into the baseline on purpose is shown as such, with why.
+        let keys: Vec<String> = a.cases.iter().map(|c| esc(&c.key)).collect();
+        let _ = writeln!(
+            o,
+            "<p class=\"accepted\">Accepted into the baseline when it was saved ({}): <code>{}\
+             </code>, because: {}</p>",
+            esc(&a.accepted),
+            keys.join("</code>, <code>"),
+            esc(&a.reason)
+        );
+    }
     let _ = writeln!(
         o,
         "<details><summary>Every case of that run (ratio current / base)</summary>\n<table \

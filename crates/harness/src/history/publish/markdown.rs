@@ -233,6 +233,17 @@ fn latest_gate(o: &mut String, class: &ClassView) {
             format!(", {} missing", g.missing.len())
         }
     );
+    if let Some(a) = &g.acceptance {
+        // A regression let into the baseline on purpose is shown as such, with why.
+        let keys: Vec<String> = a.cases.iter().map(|c| format!("`{}`", c.key)).collect();
+        let _ = writeln!(
+            o,
+            "Accepted into the baseline when it was saved ({}): {}, because: {}\n",
+            a.accepted,
+            keys.join(", "),
+            a.reason
+        );
+    }
     let judged: Vec<_> = g
         .cases
         .iter()

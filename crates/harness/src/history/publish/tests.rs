@@ -100,3 +100,38 @@ fn the_summary_counts_from_the_base() {
         "{after}"
     );
 }
+
+#[test]
+fn an_accepted_regression_is_shown_with_its_reason() {
+    let mut loaded = loaded();
+    let latest = &mut loaded.classes[0].verdicts.runs[1];
+    latest.acceptance = Some(crate::history::verdicts::Acceptance {
+        accepted: "2026-12-02T00:10:00Z".into(),
+        class: "A-1cpu".into(),
+        replaced_commit: "a000005".into(),
+        new_commit: "a000006".into(),
+        reason: "exact <forces>".into(),
+        cases: vec![crate::history::verdicts::AcceptedCase {
+            key: "lj-box/naive/n=1000".into(),
+            ratio: 1.25,
+            ci95: [1.2, 1.3],
+        }],
+    });
+    let page = page(&loaded, Vec::new()).unwrap();
+    let html = html(&page);
+    assert!(
+        html.contains("<code>lj-box/naive/n=1000</code>, because: exact &lt;forces&gt;"),
+        "{html}"
+    );
+    let base = Base {
+        name: "a000003".into(),
+        commit: None,
+        repo: ".".into(),
+        none: None,
+    };
+    let md = summary(&page, &base);
+    assert!(
+        md.contains("Accepted into the baseline when it was saved (2026-12-02T00:10:00Z): `lj-box/naive/n=1000`, because: exact <forces>"),
+        "{md}"
+    );
+}
