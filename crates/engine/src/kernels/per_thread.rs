@@ -3,7 +3,7 @@
 //! OpenMP source code).
 //!
 //! The triangle's rows are uneven, so a step is cut into [`PARTS`] parts of equal pair work,
-//! several per thread, which the pool balances as it goes. The cut depends on n alone, never
+//! several per thread, which the pool hands out one at a time. The cut depends on n alone, never
 //! on the thread count, and the buffers are added in part order: the forces are the same bits
 //! on any number of threads. A part writes only its own targets and the particles after them,
 //! so its buffer is cleared and reduced over that stretch alone.
@@ -20,9 +20,11 @@ use crate::state::{Field, State, zero_field};
 use rayon::prelude::*;
 use std::ops::Range;
 
-/// Parts of a step that forks: eight per thread on two, enough that the last part to finish
-/// costs the other thread little waiting.
-pub const PARTS: usize = 16;
+/// Parts of a step that forks: four per thread on two, handed out one at a time, so that the
+/// last part to finish costs the other thread little waiting; more parts cost more clearing
+/// and reduction than they save in balance at n = 2000 (16 parts: 1.61x over `symmetric` on
+/// two threads, 8 parts: 1.71x, galaxy on the Intel Xeon 6/167/1).
+pub const PARTS: usize = 8;
 
 /// Fewest elements a thread reduces: below it the fork costs more than the additions.
 const MIN_REDUCE: usize = 1024;
@@ -102,9 +104,12 @@ impl<T: Real, L: PairLaw<T>, const D: usize> PerThread<L, T, D> {
         };
         let forked = rayon::current_num_threads() > 1;
         if forked {
+            // One part per task: rayon's adaptive split would hand out runs of parts, and a
+            // thread left with the last run idles the other for a quarter of the step.
             self.buffers
                 .par_iter_mut()
                 .zip(self.parts.par_iter())
+                .with_max_len(1)
                 .for_each(part);
         } else {
             self.buffers
