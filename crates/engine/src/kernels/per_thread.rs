@@ -22,8 +22,7 @@ use std::ops::Range;
 
 /// Parts of a step that forks: four per thread on two, handed out one at a time, so that the
 /// last part to finish costs the other thread little waiting; more parts cost more clearing
-/// and reduction than they save in balance at n = 2000 (16 parts: 1.61x over `symmetric` on
-/// two threads, 8 parts: 1.71x, galaxy on the Intel Xeon 6/167/1).
+/// and reduction than they save in balance at a few thousand particles.
 pub const PARTS: usize = 8;
 
 /// Fewest elements a thread reduces: below it the fork costs more than the additions.
