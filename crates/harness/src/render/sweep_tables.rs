@@ -223,6 +223,16 @@ mod tests {
         ResultsFile::load(std::path::Path::new(path)).unwrap()
     }
 
+    /// The committed results of `configs/seeds.toml` (n from 500, where steps are too small
+    /// to fork).
+    fn seeds() -> ResultsFile {
+        let path = concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/../../results/seeds/results.json"
+        );
+        ResultsFile::load(std::path::Path::new(path)).unwrap()
+    }
+
     #[test]
     fn speedups_are_against_the_one_thread_twin_and_the_ceiling() {
         let results = quick();
@@ -239,29 +249,39 @@ mod tests {
         }
         let text = speedups_table(&found).text();
         assert_eq!(text.lines().count(), found.len() + 1);
-        // n = 500 is under the fork threshold: naive and per-thread say so, symmetric never
-        // forks; n = 2000 forks, and the cell list's counters tell nothing.
-        let label = |key: &str| found.iter().find(|s| s.key == key).unwrap().one_thread;
+        // Quick's n = 2000 forks, symmetric never does, and the cell list's counters tell
+        // nothing.
+        let label =
+            |found: &[Speedup], key: &str| found.iter().find(|s| s.key == key).unwrap().one_thread;
         let key = |kernel: &str, n: usize| format!("lj-box/{kernel}/n={n}/p=2/r=1/seed=1");
-        assert_eq!(label(&key("naive", 500)), Some(OneThread::TooSmall));
-        assert_eq!(label(&key("per-thread", 500)), Some(OneThread::TooSmall));
         assert_eq!(
-            label(&key("symmetric", 2000)),
+            label(&found, &key("symmetric", 2000)),
             Some(OneThread::SerialKernel)
         );
-        assert_eq!(label(&key("naive", 2000)), None);
-        assert_eq!(label(&key("cell-list", 500)), None);
-        let row = text
-            .lines()
-            .find(|l| l.starts_with(&key("naive", 500)))
-            .unwrap();
-        assert!(
-            row.ends_with("ran on 1 thread (too small to fork)"),
-            "{row}"
-        );
+        assert_eq!(label(&found, &key("naive", 2000)), None);
+        assert_eq!(label(&found, &key("per-thread", 2000)), None);
+        assert_eq!(label(&found, &key("cell-list", 2000)), None);
         assert!(
             text.starts_with("speedup over the same case on 1 thread"),
             "{text}"
+        );
+        // The seeds' n = 500 is under the fork threshold: naive and per-thread say so.
+        let small = speedups(&seeds());
+        assert_eq!(label(&small, &key("naive", 500)), Some(OneThread::TooSmall));
+        assert_eq!(
+            label(&small, &key("per-thread", 500)),
+            Some(OneThread::TooSmall)
+        );
+        assert_eq!(label(&small, &key("cell-list", 500)), None);
+        let row = speedups_table(&small)
+            .text()
+            .lines()
+            .find(|l| l.starts_with(&key("naive", 500)))
+            .unwrap()
+            .to_string();
+        assert!(
+            row.ends_with("ran on 1 thread (too small to fork)"),
+            "{row}"
         );
     }
 
