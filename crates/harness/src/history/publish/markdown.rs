@@ -235,13 +235,18 @@ fn latest_gate(o: &mut String, class: &ClassView) {
     );
     if let Some(a) = &g.acceptance {
         // A regression let into the baseline on purpose is shown as such, with why.
-        let keys: Vec<String> = a.cases.iter().map(|c| format!("`{}`", c.key)).collect();
+        // The reason and keys come from a history file: one line, HTML escaped, no backtick
+        // that could close the code span, so that they stay text in the job summary.
+        let keys: Vec<String> = (a.cases.iter())
+            .map(|c| format!("`{}`", c.key.replace(['`', '|'], "'")))
+            .collect();
+        let reason = a.reason.split_whitespace().collect::<Vec<_>>().join(" ");
         let _ = writeln!(
             o,
             "Accepted into the baseline when it was saved ({}): {}, because: {}\n",
             a.accepted,
             keys.join(", "),
-            a.reason
+            super::esc(&reason)
         );
     }
     let judged: Vec<_> = g

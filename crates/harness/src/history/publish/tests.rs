@@ -131,7 +131,7 @@ fn an_accepted_regression_is_shown_with_its_reason() {
     };
     let md = summary(&page, &base);
     assert!(
-        md.contains("Accepted into the baseline when it was saved (2026-12-02T00:10:00Z): `lj-box/naive/n=1000`, because: exact <forces>"),
+        md.contains("Accepted into the baseline when it was saved (2026-12-02T00:10:00Z): `lj-box/naive/n=1000`, because: exact &lt;forces&gt;"),
         "{md}"
     );
 }
