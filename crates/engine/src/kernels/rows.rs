@@ -201,9 +201,19 @@ impl<T: Real, const D: usize> Accumulator<T, D> {
         }
     }
 
-    /// Adds the lanes up.
+    /// Adds the lanes up; a run of `blocks` whole blocks (0 or more) came first. With none, the
+    /// one-pair tail summed into lane 0 is the result as it stands: the other lanes hold zeros,
+    /// and their reduction (a chain of sixteen dependent additions per component) was most of
+    /// a dilute gas's force loop, where runs are a few pairs long.
     #[inline(always)]
-    fn finish(self) -> RowSum<T, D> {
+    fn finish(self, blocks: usize) -> RowSum<T, D> {
+        if blocks == 0 {
+            return RowSum {
+                force: self.force.map(|lanes| lanes[0]),
+                energy: self.energy[0],
+                interacting: self.count[0] as u64,
+            };
+        }
         RowSum {
             force: self.force.map(|lanes| lanes.iter().copied().sum()),
             energy: self.energy.iter().copied().sum(),
@@ -366,7 +376,7 @@ pub(crate) fn gather_excluding<T: Real, L: PairLaw<T>, const D: usize, const PRO
             acc.count[0] += law.interacts(r2) as u32;
         }
     }
-    acc.finish()
+    acc.finish(full)
 }
 
 /// Force on `t` from every source in `src` that `exclude` keeps, also applying the reaction
@@ -407,7 +417,7 @@ pub fn scatter<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
             acc.count[0] += law.interacts(r2) as u32;
         }
     }
-    acc.finish()
+    acc.finish(full)
 }
 
 impl<T: Real, const D: usize> RowSum<T, D> {

@@ -74,6 +74,47 @@ fn long_cutoff_parallel() {
     long_cutoff::<f64, 3>();
 }
 
+/// The one-thread sort (ranks counted in place) and the pool's (the two-level counting sort
+/// and the parallel layout) give the same strips, order and forces, bit for bit.
+fn same_layout_on_one_thread_and_many<T: Real, const D: usize>() {
+    let law = lj::<T>(2.5 * SIGMA);
+    // Enough particles that the sort and the layout fork.
+    let n = 20_000;
+    assert!(crate::par::MIN_FORK_ELEMENTS <= n * D);
+    let side = (n as f64 / if D == 2 { 4000.0 } else { 1.2e5 }).powf(1.0 / D as f64);
+    let state = spaced_state::<T, D>(n, side, 0.8 * SIGMA, SEED_1);
+    let run = |threads| {
+        on_threads(threads, || {
+            let mut kernel = CellList::new(law).expect("LJ has a cutoff");
+            let order = kernel.spatial_order(&state).expect("the cell list sorts");
+            let mut f = zero_field::<T, D>(n);
+            kernel.compute(&state, &mut f, false);
+            let s = &kernel.strips;
+            let layout = (
+                s.pos.clone(),
+                s.src.clone(),
+                s.column.clone(),
+                s.own.clone(),
+            );
+            (order, layout, s.rank.clone(), f)
+        })
+    };
+    let one = run(1);
+    for threads in [2, 3] {
+        let many = run(threads);
+        assert!(one.0 == many.0, "order at {threads} threads");
+        assert!(one.1 == many.1, "strips at {threads} threads");
+        assert!(one.2 == many.2, "ranks at {threads} threads");
+        assert!(one.3 == many.3, "forces at {threads} threads");
+    }
+}
+
+#[test]
+fn the_layout_is_the_same_at_every_thread_count() {
+    same_layout_on_one_thread_and_many::<f32, 2>();
+    same_layout_on_one_thread_and_many::<f64, 3>();
+}
+
 /// Particles on a line (a flat bounding box) along `axis`, spaced 0.9σ.
 fn line<T: Real, const D: usize>(n: usize, axis: usize) -> State<T, D> {
     let mut s = State::new(n);
