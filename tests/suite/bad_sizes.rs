@@ -247,3 +247,37 @@ fn endless_inputs_and_report_outputs_are_refused() {
     );
     assert_eq!(std::fs::read(&quick).unwrap(), before, "input untouched");
 }
+
+#[test]
+fn a_range_of_n_past_the_limit_is_refused_with_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    for (range, what) in [
+        (
+            "{ from = 1, to = 1000000, factor = 1.0001 }",
+            "gives more than 10000 counts, the most a range may give: raise the factor",
+        ),
+        (
+            "{ from = 1000, to = 2000, factor = 1.0000000001 }",
+            "the factor is so close to 1",
+        ),
+    ] {
+        let config = dir.path().join("r.toml");
+        std::fs::write(
+            &config,
+            format!(
+                "name = \"r\"\nstudy = \"cartesian\"\nscenarios = [\"lj-box\"]\n\
+                 kernels = [\"naive\"]\nn = {range}\n"
+            ),
+        )
+        .unwrap();
+        let o = bin()
+            .args(["sweep", "--yes", "--no-calibration", "--config"])
+            .arg(&config)
+            .arg("--out")
+            .arg(dir.path().join("out"))
+            .output()
+            .unwrap();
+        refused(&o, what);
+        assert!(!dir.path().join("out").exists(), "nothing measured");
+    }
+}

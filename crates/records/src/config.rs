@@ -81,23 +81,58 @@ pub struct CountRange {
     pub factor: f64,
 }
 
+/// The most counts a range of n may give: far more cases than any sweep can measure.
+pub const MAX_RANGE_COUNTS: usize = 10_000;
+
+/// The most multiplications by the factor a range may take: a factor barely above 1 gives the
+/// same rounded count over and over before the next, and would otherwise run for ever.
+const MAX_RANGE_STEPS: usize = 1_000_000;
+
+impl CountRange {
+    /// The counts of the range, or why it cannot be expanded: more than [`MAX_RANGE_COUNTS`]
+    /// of them, or a factor so close to 1 that reaching `to` takes more than a million steps.
+    /// Validation refuses such a range, so a parsed config's range always expands.
+    pub fn counts(&self) -> Result<Vec<usize>, String> {
+        let too_many = || {
+            format!(
+                "{{ from = {}, to = {}, factor = {} }} gives more than {MAX_RANGE_COUNTS} counts, \
+                 the most a range may give: raise the factor, narrow from..to, or list the counts",
+                self.from, self.to, self.factor
+            )
+        };
+        let mut out = Vec::new();
+        let mut x = self.from as f64;
+        let mut steps = 0;
+        // Compared as floats: a count past usize::MAX would saturate and never end the loop.
+        while x.round() <= self.to as f64 {
+            let n = x.round() as usize;
+            if out.last() != Some(&n) {
+                if out.len() == MAX_RANGE_COUNTS {
+                    return Err(too_many());
+                }
+                out.push(n);
+            }
+            x *= self.factor;
+            steps += 1;
+            if steps == MAX_RANGE_STEPS {
+                return Err(format!(
+                    "{{ from = {}, to = {}, factor = {} }}: the factor is so close to 1 that \
+                     the range takes more than {MAX_RANGE_STEPS} steps to reach `to`: raise the \
+                     factor, or list the counts",
+                    self.from, self.to, self.factor
+                ));
+            }
+        }
+        Ok(out)
+    }
+}
+
 impl Counts {
-    /// The counts in increasing order of appearance.
+    /// The counts in increasing order of appearance (none for a range validation refuses).
     pub fn values(&self) -> Vec<usize> {
         match self {
             Counts::List(v) => v.clone(),
-            Counts::Range(r) => {
-                let mut out = Vec::new();
-                let mut x = r.from as f64;
-                while x.round() as usize <= r.to && out.len() < 10_000 {
-                    let n = x.round() as usize;
-                    if out.last() != Some(&n) {
-                        out.push(n);
-                    }
-                    x *= r.factor;
-                }
-                out
-            }
+            Counts::Range(r) => r.counts().unwrap_or_default(),
         }
     }
 }
@@ -233,7 +268,8 @@ crate::config_keys::documented_keys! {
         /// Particle counts; required except in weak studies, which use `weak.base_n` instead.
         ///
         /// Accepts a list of whole numbers, such as n = [1000, 2000], or a geometric range, such as
-        /// n = { from = 1000, to = 32000, factor = 2 }.
+        /// n = { from = 1000, to = 32000, factor = 2 }: each count `factor` times the last,
+        /// rounded, up to `to`, at most 10000 counts (a range that would give more is refused).
         ///
         /// Example: `n = [1000]`
         #[serde(default)]
@@ -714,6 +750,7 @@ impl SweepConfig {
                     "range needs 1 <= from <= to and factor > 1".into(),
                 ))
             }
+            Some(Counts::Range(r)) => r.counts().map(|_| ()).map_err(|why| bad("n", why)),
             Some(_) => Ok(()),
         }
     }
@@ -921,5 +958,31 @@ mod tests {
             factor: 2.0,
         });
         assert_eq!(r.values(), vec![100, 200, 400]);
+    }
+
+    #[test]
+    fn a_range_of_too_many_counts_is_refused_not_cut() {
+        let r = CountRange {
+            from: 1,
+            to: 1_000_000,
+            factor: 1.0001,
+        };
+        let why = r.counts().unwrap_err();
+        assert!(why.contains("more than 10000 counts"), "{why}");
+        assert!(why.contains("raise the factor"), "{why}");
+        // A factor so close to 1 that the count hardly moves: refused, not run for ever.
+        let r = CountRange {
+            from: 1000,
+            to: usize::MAX,
+            factor: 1.0 + f64::EPSILON,
+        };
+        assert!(r.counts().unwrap_err().contains("so close to 1"));
+        // The end of the counts is no end of the loop: it stops past usize::MAX.
+        let r = CountRange {
+            from: 1 << 62,
+            to: usize::MAX,
+            factor: 2.0,
+        };
+        assert_eq!(r.counts().unwrap().len(), 3);
     }
 }
