@@ -21,6 +21,9 @@ pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
     // Whatever the analysis writes, under whatever name, never replaces what it reads.
     nbody_engine::output::protect_inputs(&[("results", &path)]);
     let results = ResultsFile::load(&path)?;
+    for line in results.taken_out() {
+        eprintln!("warning: {}: {line}", path.display());
+    }
     let dir = args.out.unwrap_or_else(|| default_dir(&path));
     let written = run(&results, &path, &dir)?;
     print_written(&written);

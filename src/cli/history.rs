@@ -151,6 +151,9 @@ fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
             continue;
         }
         let file = ResultsFile::load(&path)?;
+        for line in file.taken_out() {
+            eprintln!("warning: {}: {line}", path.display());
+        }
         let written = append_results(dir, &file, &args.source)?;
         for (to, count) in written {
             eprintln!(

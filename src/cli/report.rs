@@ -16,6 +16,9 @@ pub fn report(args: ReportArgs) -> anyhow::Result<i32> {
         generated.sweeps,
         generated.figures
     );
+    for line in &generated.taken_out {
+        eprintln!("warning: {line}");
+    }
     for e in &generated.figure_errors {
         eprintln!("warning: figure not drawn: {e}");
     }

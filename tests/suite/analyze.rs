@@ -121,3 +121,85 @@ fn committed_sweeps_give_their_committed_summaries_byte_for_byte() {
     }
     assert!(checked >= 5, "only {checked} committed sweeps found");
 }
+
+/// A results file edited to hold times no step takes (a median of -1 s, a sample of 0 s): every
+/// reader that analyses it (`analyze`, `report`, `history record`) takes them out and says so,
+/// case by case; none uses them.
+#[test]
+fn times_no_step_takes_are_taken_out_and_named_by_every_analysis() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("sweeps/quick/results.json");
+    std::fs::create_dir_all(results.parent().unwrap()).unwrap();
+    let mut file: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("results/quick/results.json"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let cases = file["cases"].as_array_mut().unwrap();
+    // Case 0: every sample -1 s, and a summary that says so; case 1: one sample of 0 s.
+    for round in cases[0]["rounds"].as_array_mut().unwrap() {
+        for s in round["samples_s"].as_array_mut().unwrap() {
+            *s = serde_json::json!(-1.0);
+        }
+    }
+    cases[0]["summary"]["median_s"] = serde_json::json!(-1.0);
+    cases[1]["rounds"][0]["samples_s"][0] = serde_json::json!(0.0);
+    let keys = [0, 1].map(|i| cases[i]["key"].as_str().unwrap().to_string());
+    std::fs::write(&results, file.to_string()).unwrap();
+    let analyze = bin()
+        .args(["analyze"])
+        .arg(&results)
+        .arg("--out")
+        .arg(dir.path().join("analysis"))
+        .output()
+        .unwrap();
+    let report = bin()
+        .current_dir(dir.path())
+        .args(["report", "--results", "sweeps", "--out", "R.md"])
+        .output()
+        .unwrap();
+    let record = bin()
+        .current_dir(dir.path())
+        .args([
+            "history",
+            "record",
+            "sweeps/quick/results.json",
+            "--dir",
+            "hist",
+        ])
+        .output()
+        .unwrap();
+    for (what, o) in [
+        ("analyze", analyze),
+        ("report", report),
+        ("history record", record),
+    ] {
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(o.status.success(), "{what}: {err}");
+        assert!(
+            err.contains(&format!(
+                "case {}: round 0 sample 0 = -1e0 s per step: a step takes more than zero time \
+                 and 5 more, taken out; it has no sample left, so no figure",
+                keys[0]
+            )),
+            "{what}: {err}"
+        );
+        assert!(
+            err.contains(&format!(
+                "case {}: round 0 sample 0 = 0e0 s per step: a step takes more than zero time, \
+                 taken out; its median is of the other 5 samples",
+                keys[1]
+            )),
+            "{what}: {err}"
+        );
+    }
+    // The history holds no record of the case without a sample.
+    let history = std::fs::read_dir(dir.path().join("hist"))
+        .unwrap()
+        .map(|e| std::fs::read_to_string(e.unwrap().path()).unwrap())
+        .collect::<String>();
+    assert!(!history.contains(&format!("\"case\":\"{}\"", keys[0])));
+    assert!(history.contains(&format!("\"case\":\"{}\"", keys[1])));
+}

@@ -294,6 +294,31 @@ impl ResultsFile {
         Ok(())
     }
 
+    /// One line for each case some of whose raw values were taken out as impossible (a time
+    /// of zero or less, not a finite number: [`super::vet`]), saying which, why, and what the
+    /// case's figures are then of. Readers that analyse a file print them, so that a value
+    /// left out is never left out silently.
+    pub fn taken_out(&self) -> Vec<String> {
+        self.cases
+            .iter()
+            .filter_map(|c| {
+                let first = c.rejected.first()?;
+                let more = match c.rejected.len() {
+                    1 => String::new(),
+                    n => format!(" and {} more", n - 1),
+                };
+                let figures = match &c.summary {
+                    Some(s) => format!("its median is of the other {} samples", s.samples),
+                    None => "it has no sample left, so no figure".to_string(),
+                };
+                Some(format!(
+                    "case {}: round {} {} = {}: {}{more}, taken out; {figures}",
+                    c.key, first.round, first.what, first.value, first.reason
+                ))
+            })
+            .collect()
+    }
+
     /// The record of the case with this key, `None` if the file has no such case.
     pub fn record_mut(&mut self, key: &str) -> Option<&mut CaseRecord> {
         self.cases.iter_mut().find(|c| c.key == key)

@@ -100,6 +100,9 @@ pub struct Generated {
     pub figures: usize,
     /// Figures that could not be drawn, each "stem: error" (the report is written regardless).
     pub figure_errors: Vec<String>,
+    /// Raw values of the results taken out as impossible, one line per case ("FILE: case
+    /// KEY: ..."; see `ResultsFile::taken_out`).
+    pub taken_out: Vec<String>,
     /// Figures written by hand in a kept region, by region: each belongs in a generated
     /// section (a number in a kept region goes stale when the results change).
     pub kept_figures: Vec<(String, Vec<String>)>,
@@ -132,6 +135,14 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
         .into_iter()
         .map(|f| ResultsFile::load(&f).map(|r| (f, r)))
         .collect::<Result<_, _>>()?;
+    let taken_out: Vec<String> = loaded
+        .iter()
+        .flat_map(|(f, r)| {
+            r.taken_out()
+                .into_iter()
+                .map(move |line| format!("{}: {line}", f.display()))
+        })
+        .collect();
     let analyses: Vec<(PathBuf, Analysis)> = loaded
         .iter()
         .map(|(f, r)| analysis::analyze(r, &relative_source(f)).map(|a| (f.clone(), a)))
@@ -182,6 +193,7 @@ pub fn generate(results_dir: &Path, out: &Path) -> Result<Generated, ReportError
         sweeps: sweeps.len(),
         figures: sweeps.iter().map(|s| s.figures.len()).sum(),
         figure_errors,
+        taken_out,
         kept_figures: keep::figures(&kept),
     })
 }
