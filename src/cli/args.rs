@@ -834,7 +834,7 @@ pub struct ExportResultsArgs {
     #[arg(long, value_enum, default_value = "csv")]
     pub format: TidyFormat,
     /// Write the table to FILE (atomically) instead of standard output; never an input
-    /// file itself.
+    /// file itself, nor a file that holds history records.
     #[arg(long, value_name = "FILE")]
     pub out: Option<PathBuf>,
 }

@@ -3,7 +3,7 @@
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
-use nbody_harness::history::series::{Metric, Series, series};
+use nbody_harness::history::series::{Metric, Point, Series, series};
 use nbody_harness::history::steps::{Step, steps};
 use nbody_harness::history::store::{self, CommitFacts, History};
 use nbody_harness::history::verdicts::{self, GateRun};
@@ -20,9 +20,11 @@ pub const DEFAULT_DIR: &str = "results/history";
     nbody-bench history --case 'lj-box/verlet/*'  # the cases whose key matches\n  \
     nbody-bench history record runs/ci/2026-12-05T10-00-00Z/results.json\n\n\
     A series is one case of one config on one machine class, one point per commit in commit \
-    order: the median time per step over the reference workload timed before each sample when \
-    every record has it, else in seconds. Records of a build with uncommitted changes are kept \
-    but left out of the series."
+    order (by committer date read to UTC, then file order): the median time per step over the \
+    reference workload timed before each sample when every record has it, else in seconds. \
+    Records of a build with uncommitted changes are kept but left out of the series; records of \
+    a sweep outside git (no commit) are one point per measurement. A line of the file that is \
+    not a sound record of its class is named and left out (docs/reference/outputs.md)."
 )]
 pub struct HistoryArgs {
     #[command(subcommand)]
@@ -219,14 +221,9 @@ fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
             path.display()
         );
     }
-    let History { records, bad } = store::read(&path)?;
+    let History { records, bad, .. } = store::read(&path)?;
     for b in &bad {
-        eprintln!(
-            "warning: {} line {}: {}; the line is left out",
-            path.display(),
-            b.line,
-            b.problem
-        );
+        eprintln!("warning: {}", b.warning(&path));
     }
     let pattern = args.case.as_deref().map(glob).transpose()?;
     let all: Vec<Series> = series(&records)
@@ -306,11 +303,17 @@ fn print_series(f: &Found) {
             String::new()
         }
     );
-    for c in &f.changes {
+    let outside_git = s.points.iter().filter(|p| p.outside_git()).count();
+    if outside_git > 0 {
         println!(
-            "  step between {} and {}: {} → {} ({:+.1}% [{:+.1}%, {:+.1}%])",
-            short(&c.between[0]),
-            short(&c.between[1]),
+            "  {outside_git} of the points are of sweeps outside git (no commit): one point per \
+             measurement, named by when it started, never merged"
+        );
+    }
+    for c in &f.changes {
+        let [a, b] = [c.index.saturating_sub(1), c.index].map(|i| name(&s.points[i]));
+        println!(
+            "  step between {a} and {b}: {} → {} ({:+.1}% [{:+.1}%, {:+.1}%])",
             value(c.before),
             value(c.after),
             100.0 * (c.ratio - 1.0),
@@ -323,9 +326,13 @@ fn print_series(f: &Found) {
     }
 }
 
-/// A commit as read from a history file, which may hold anything: cut by characters.
-fn short(commit: &str) -> &str {
-    nbody_harness::gate::prefix(commit, 10)
+/// A point as the text names it: its commit as read from a history file, which may hold
+/// anything, cut by characters; a point of a sweep outside git by when it was measured.
+fn name(p: &Point) -> String {
+    match &p.measured {
+        Some(measured) => format!("(no commit, measured {measured})"),
+        None => nbody_harness::gate::prefix(&p.commit, 10).to_string(),
+    }
 }
 
 /// A `*` / `?` pattern as an anchored regular expression.

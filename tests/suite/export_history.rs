@@ -8,11 +8,15 @@ use serde_json::{Value, json};
 use std::path::Path;
 use std::process::{Command, Output};
 
+/// The committed history's machine class; a history file holds the records of the class it is
+/// named after.
+const CLASS: &str = "AuthenticAMD-26-2-1-2cpu";
+
 /// The committed history, with records that exercise every optional field appended, and one
-/// damaged line between them.
+/// damaged line between them, as `dir/<CLASS>.jsonl`.
 fn history_copy(dir: &Path) -> std::path::PathBuf {
-    let committed = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("results/history/AuthenticAMD-26-2-1-2cpu.jsonl");
+    let committed =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("results/history/{CLASS}.jsonl"));
     let mut text = std::fs::read_to_string(committed).unwrap();
     let first: Value = serde_json::from_str(text.lines().next().unwrap()).unwrap();
     let mut bare = first.clone();
@@ -34,7 +38,7 @@ fn history_copy(dir: &Path) -> std::path::PathBuf {
     for record in [bare, fmm] {
         text.push_str(&format!("{record}\n"));
     }
-    let path = dir.join("hist.jsonl");
+    let path = dir.join(format!("{CLASS}.jsonl"));
     std::fs::write(&path, text).unwrap();
     path
 }
@@ -119,20 +123,18 @@ fn a_history_round_trips_through_csv_and_json_lines_read_by_pandas() {
     let dir = tempfile::tempdir().unwrap();
     let history = history_copy(dir.path());
     let lines = std::fs::read_to_string(&history).unwrap().lines().count();
+    let file = format!("{CLASS}.jsonl");
     for (format, out) in [("csv", "h.csv"), ("jsonl", "h.jsonl")] {
-        let o = export(
-            dir.path(),
-            &["hist.jsonl", "--format", format, "--out", out],
-        );
+        let o = export(dir.path(), &[&file, "--format", format, "--out", out]);
         assert!(o.status.success(), "{}", text(&o.stderr));
         // The damaged line is named by its number and left out; the rest is exported.
-        let damaged = format!("hist.jsonl line {}:", lines - 2);
+        let damaged = format!("{file} line {}:", lines - 2);
         assert!(text(&o.stderr).contains(&damaged), "{}", text(&o.stderr));
         assert!(text(&o.stderr).contains(&format!("{} records", lines - 1)));
     }
     let o = Command::new(&python)
         .args(["-c", PANDAS_CHECK])
-        .args(["h.csv", "h.jsonl", "hist.jsonl"])
+        .args(["h.csv", "h.jsonl", &file])
         .current_dir(dir.path())
         .output()
         .unwrap();
@@ -152,12 +154,16 @@ fn a_folder_of_histories_exports_every_class_and_never_overwrites_one() {
     let folder = dir.path().join("history");
     std::fs::create_dir(&folder).unwrap();
     let one = history_copy(dir.path());
-    std::fs::copy(&one, folder.join("ClassA-2cpu.jsonl")).unwrap();
-    std::fs::copy(&one, folder.join("ClassB-2cpu.jsonl")).unwrap();
+    let records = std::fs::read_to_string(&one).unwrap();
+    for class in ["ClassA-2cpu", "ClassB-2cpu"] {
+        let path = folder.join(format!("{class}.jsonl"));
+        std::fs::write(path, records.replace(CLASS, class)).unwrap();
+    }
     let o = export(dir.path(), &["history"]);
     assert!(o.status.success(), "{}", text(&o.stderr));
-    let single = export(dir.path(), &["hist.jsonl"]);
+    let single = export(dir.path(), &[&format!("{CLASS}.jsonl")]);
     let rows = |o: &Output| text(&o.stdout).lines().count() - 1;
+    assert!(rows(&single) > 2000, "{}", text(&single.stderr));
     assert_eq!(rows(&o), 2 * rows(&single));
     let before = std::fs::read(folder.join("ClassA-2cpu.jsonl")).unwrap();
     refused(
@@ -194,4 +200,103 @@ fn the_help_and_the_outputs_page_name_every_history_column() {
             "outputs.md does not name `{c}`"
         );
     }
+}
+
+/// `value` as Python's `json.dumps` writes it: a space after every `:` and `,`.
+fn spaced(value: &Value) -> String {
+    match value {
+        Value::Object(map) => {
+            let fields: Vec<String> = map
+                .iter()
+                .map(|(k, v)| format!("{}: {}", Value::from(k.as_str()), spaced(v)))
+                .collect();
+            format!("{{{}}}", fields.join(", "))
+        }
+        Value::Array(items) => {
+            let items: Vec<String> = items.iter().map(spaced).collect();
+            format!("[{}]", items.join(", "))
+        }
+        other => other.to_string(),
+    }
+}
+
+#[test]
+fn a_history_is_known_by_its_records_whatever_their_spacing_or_first_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let committed = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("results/history/{CLASS}.jsonl")),
+    )
+    .unwrap();
+    let records: Vec<Value> = committed
+        .lines()
+        .take(5)
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    let folder = dir.path().join("history");
+    std::fs::create_dir(&folder).unwrap();
+    // One file as json.dumps writes it; one whose first line a writer left half-written.
+    let python: String = records.iter().map(|r| spaced(r) + "\n").collect();
+    // Keys sorted (as `json.dumps(sort_keys=True)` writes them): the schema not first.
+    assert!(python.starts_with("{\"build\": {"), "{python}");
+    assert!(
+        python.contains("\"schema\": \"nbody-bench-history/1\", "),
+        "{python}"
+    );
+    let damaged = format!(
+        "{{\"schema\": \"nbody-bench-hist\n{}",
+        records.iter().map(|r| format!("{r}\n")).collect::<String>()
+    );
+    let [spaced_file, damaged_file] =
+        ["AuthenticAMD-26-2-1-2cpu.jsonl", "Damaged-1cpu.jsonl"].map(|name| folder.join(name));
+    std::fs::write(&spaced_file, &python).unwrap();
+    std::fs::write(
+        &damaged_file,
+        damaged.replace("AuthenticAMD-26-2-1-2cpu", "Damaged-1cpu"),
+    )
+    .unwrap();
+    let rows = |o: &Output| text(&o.stdout).lines().count() - 1;
+    let o = export(dir.path(), &["history/AuthenticAMD-26-2-1-2cpu.jsonl"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(rows(&o), 5);
+    let o = export(dir.path(), &["history"]);
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    assert_eq!(rows(&o), 10, "both files, every record");
+    assert!(
+        text(&o.stderr).contains("Damaged-1cpu.jsonl line 1: not a history record"),
+        "{}",
+        text(&o.stderr)
+    );
+    // Neither is ever overwritten: each is an input of the folder's export, and a file that
+    // holds history records is no output of any export.
+    let before = [&spaced_file, &damaged_file].map(|f| std::fs::read(f).unwrap());
+    refused(
+        &export(
+            dir.path(),
+            &["history", "--out", "history/Damaged-1cpu.jsonl"],
+        ),
+        "is also an input of this command (HISTORY)",
+    );
+    let results = dir.path().join("results.json");
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("results/quick/results.json"),
+        &results,
+    )
+    .unwrap();
+    for out in [
+        "history/AuthenticAMD-26-2-1-2cpu.jsonl",
+        "history/Damaged-1cpu.jsonl",
+    ] {
+        refused(
+            &export(
+                dir.path(),
+                &["results.json", "--format", "jsonl", "--out", out],
+            ),
+            "history records (lines of schema nbody-bench-history/1): export-results never \
+             replaces a history",
+        );
+    }
+    assert_eq!(
+        [&spaced_file, &damaged_file].map(|f| std::fs::read(f).unwrap()),
+        before
+    );
 }

@@ -28,6 +28,7 @@ mod gate;
 mod gate_baselines;
 mod gate_refusals;
 mod history;
+mod history_lines;
 mod init;
 mod init_python;
 mod initial;

@@ -33,6 +33,17 @@ pub fn is_pipe(path: &Path) -> bool {
 /// ends within [`MAX_INPUT_BYTES`] and never stays silent for longer than the pipe wait.
 /// Devices are refused.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
+    String::from_utf8(read_bytes(path)?).map_err(|_| {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    })
+}
+
+/// The bytes of `path`, read as [`read_text`] reads them, for readers that take a file apart
+/// before decoding it (a JSON Lines file, where a line that is not UTF-8 costs that line).
+pub fn read_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
     use std::os::unix::fs::FileTypeExt;
     let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
     let kind = std::fs::metadata(path)?.file_type();
@@ -55,12 +66,7 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
             MAX_INPUT_BYTES >> 30
         )));
     }
-    String::from_utf8(bytes).map_err(|_| {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "stream did not contain valid UTF-8",
-        )
-    })
+    Ok(bytes)
 }
 
 /// The pipe wait: [`PIPE_WAIT_ENV`] if set (a number of seconds > 0, at most a day), else

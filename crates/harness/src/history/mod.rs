@@ -1,5 +1,6 @@
 //! The performance history: every measurement kept per commit and machine class
-//! (`results/history/<class>.jsonl`, [`store`]), the steps found in each case's series
+//! (`results/history/<class>.jsonl`, [`store`], read by one line reader, `lines`, with
+//! dates compared as [`instant`]s), the steps found in each case's series
 //! ([`changes`], scored on a generated corpus in `corpus`), the series themselves
 //! ([`series`]) and their steps ([`steps`]), the gate's verdicts kept beside them
 //! ([`verdicts`]), the commit that made a case slower ([`bisect`]), a history as a tidy table
@@ -11,6 +12,8 @@ pub mod bisect;
 pub mod changes;
 #[cfg(test)]
 mod corpus;
+pub mod instant;
+mod lines;
 pub mod publish;
 pub mod series;
 pub mod steps;

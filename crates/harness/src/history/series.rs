@@ -1,6 +1,7 @@
 //! A case's series: its records of one machine class and config, one point per commit in the
 //! order of the commits, on one metric for the whole series.
 
+use super::instant::{self, Instant};
 use super::store::Record;
 use nbody_engine::stats::median;
 use serde::Serialize;
@@ -21,6 +22,11 @@ pub enum Metric {
 pub struct Point {
     /// The commit measured, as its records name it.
     pub commit: String,
+    /// For records that name no commit (`unknown`: measured outside a git checkout; or empty),
+    /// when their measurement started: they are one point per measurement, since nothing says
+    /// two such runs measured the same code. `None` (left out of JSON) for a commit's point.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub measured: Option<String>,
     /// Its committer date, ISO 8601; `None` when git did not know the commit.
     pub commit_date: Option<String>,
     /// The median of its records' medians (one record: its median), and the widest interval
@@ -43,16 +49,25 @@ pub struct Series {
     pub case: String,
     /// What the values are, one metric for the whole series.
     pub metric: Metric,
-    /// One point per commit, ordered by commit date, then by order of measurement.
+    /// One point per commit (per measurement for records that name no commit), in commit
+    /// order (see [`series`]).
     pub points: Vec<Point>,
     /// Records measured on a build with uncommitted changes: not any commit's code, so not
     /// in the series.
     pub dirty: usize,
 }
 
+impl Point {
+    /// Whether the point is one measurement of code that names no commit.
+    pub fn outside_git(&self) -> bool {
+        self.measured.is_some()
+    }
+}
+
 /// The series of `records`, in the order each (class, config, case) first appears; the points
-/// of a series in commit order (the commit date, then the order of measurement; a record
-/// without a date goes where it was measured).
+/// of a series in commit order: by the instant of the commit date, then by the order of
+/// measurement (file order); a record without a date (or with one that is not a time) goes
+/// right after the record measured before it. That order is total, whatever the dates.
 pub fn series(records: &[Record]) -> Vec<Series> {
     let mut keys: Vec<(&str, &str, &str)> = Vec::new();
     for r in records {
@@ -83,22 +98,19 @@ fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
         (Metric::Normalized, Some(n)) => (n.median, n.ci95),
         _ => (r.median_s, r.ci95_s),
     };
-    // The commits in order of their dates; the measurement order breaks ties and places a
-    // commit without a date.
-    let mut order: Vec<(usize, &Record)> = clean.iter().copied().enumerate().collect();
-    order.sort_by(|(i, a), (j, b)| match (&a.commit_date, &b.commit_date) {
-        (Some(x), Some(y)) => x.cmp(y).then(i.cmp(j)),
-        _ => i.cmp(j),
-    });
     let mut points: Vec<Point> = Vec::new();
-    for (_, r) in order {
-        if points.iter().any(|p| p.commit == r.commit) {
+    for r in commit_order(&clean) {
+        let key = point_key(r);
+        if points
+            .iter()
+            .any(|p| (p.commit.as_str(), p.measured.as_deref()) == key)
+        {
             continue;
         }
         let same: Vec<&Record> = clean
             .iter()
             .copied()
-            .filter(|o| o.commit == r.commit)
+            .filter(|o| point_key(o) == key)
             .collect();
         let values: Vec<f64> = same.iter().map(|o| value(o).0).collect();
         let lo = same
@@ -108,6 +120,7 @@ fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
         let hi = same.iter().map(|o| value(o).1[1]).fold(0.0, f64::max);
         points.push(Point {
             commit: r.commit.clone(),
+            measured: key.1.map(str::to_string),
             commit_date: r.commit_date.clone(),
             value: median(&values).unwrap_or(f64::NAN),
             ci95: [lo, hi],
@@ -122,6 +135,36 @@ fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
         points,
         dirty: records.len() - clean.len(),
     }
+}
+
+/// What makes records one point: their commit, and for records that name none, their
+/// measurement too.
+fn point_key(r: &Record) -> (&str, Option<&str>) {
+    (
+        r.commit.as_str(),
+        (!r.commit_known()).then_some(r.measured.as_str()),
+    )
+}
+
+/// `records` (in measurement order) in commit order. Each is keyed by (the instant of its
+/// commit date, else that of the nearest record before it that has one; its position): positions
+/// differ, so no two keys are equal and the order is total, and a record without a date keeps
+/// its place after its neighbour. (Comparing dates only when both records have one is not an
+/// order at all: the sort may then panic.)
+fn commit_order<'a>(records: &[&'a Record]) -> Vec<&'a Record> {
+    let mut before = None;
+    let mut keyed: Vec<(Option<Instant>, usize, &Record)> = records
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            if let Some(t) = r.commit_date.as_deref().and_then(instant::parse) {
+                before = Some(t);
+            }
+            (before, i, *r)
+        })
+        .collect();
+    keyed.sort_by_key(|&(t, i, _)| (t, i));
+    keyed.into_iter().map(|(_, _, r)| r).collect()
 }
 
 #[cfg(test)]
@@ -168,5 +211,83 @@ mod tests {
         // A series with a record lacking the reference timing is in seconds throughout.
         assert_eq!(s[1].metric, Metric::Seconds);
         assert_eq!(s[1].points[0].value, 5.0);
+    }
+
+    #[test]
+    fn commits_are_ordered_by_the_instant_of_their_dates() {
+        // git's %cI keeps the committer's offset: 23:00 at -05:00 is 04:00 UTC the next day,
+        // after 02:00 UTC although its text sorts first.
+        let records = vec![
+            record("a", "late", "2026-12-01T23:00:00-05:00", 2.0, false),
+            record("a", "early", "2026-12-02T02:00:00Z", 1.0, false),
+        ];
+        let s = series(&records);
+        let order: Vec<&str> = s[0].points.iter().map(|p| p.commit.as_str()).collect();
+        assert_eq!(order, ["early", "late"]);
+    }
+
+    #[test]
+    fn records_without_a_date_keep_their_place_and_the_order_is_total() {
+        // Dates out of file order, every third record without one: a comparator that compares
+        // dates only when both have one is no order, and sorting 30 such records panicked.
+        let records: Vec<Record> = (0..30)
+            .map(|i| {
+                let day = (i * 7) % 28 + 1;
+                let mut r = record(
+                    "a",
+                    &format!("c{i:02}"),
+                    &format!("2026-11-{day:02}"),
+                    1.0,
+                    false,
+                );
+                if i % 3 == 1 {
+                    r.commit_date = None;
+                }
+                r
+            })
+            .collect();
+        let s = series(&records);
+        let order: Vec<&str> = s[0].points.iter().map(|p| p.commit.as_str()).collect();
+        assert_eq!(order.len(), 30);
+        // Each undated record right after the record measured before it.
+        for i in (1..30).filter(|i| i % 3 == 1) {
+            let at = order.iter().position(|c| *c == format!("c{i:02}")).unwrap();
+            assert_eq!(order[at - 1], format!("c{:02}", i - 1), "{order:?}");
+        }
+        // The dated ones by date.
+        let days: Vec<u32> = order
+            .iter()
+            .filter_map(|c| {
+                let i: usize = c[1..].parse().unwrap();
+                (i % 3 != 1).then_some(((i * 7) % 28 + 1) as u32)
+            })
+            .collect();
+        assert!(days.is_sorted(), "{days:?}");
+    }
+
+    #[test]
+    fn records_outside_git_are_one_point_per_measurement() {
+        let mut a = record("a", "unknown", "2026-12-01", 1.0, false);
+        a.commit_date = None;
+        let mut b = a.clone();
+        b.measured = "2026-12-06T10:00:00Z".into();
+        b.median_s = 2.0;
+        let mut c = a.clone();
+        c.commit = String::new();
+        let records = vec![a.clone(), b, a, c];
+        let points = &series(&records)[0].points;
+        let got: Vec<(&str, Option<&str>, usize)> = points
+            .iter()
+            .map(|p| (p.commit.as_str(), p.measured.as_deref(), p.records))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("unknown", Some("2026-12-05T10:00:00Z"), 2),
+                ("unknown", Some("2026-12-06T10:00:00Z"), 1),
+                ("", Some("2026-12-05T10:00:00Z"), 1),
+            ]
+        );
+        assert!(points.iter().all(Point::outside_git));
     }
 }

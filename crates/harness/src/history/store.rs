@@ -4,6 +4,7 @@
 //! keep both (each writes its lines in one call under an exclusive lock of the file) and a
 //! damaged line costs that line only: a reader names it by its number and reads the rest.
 
+use super::lines::{Line, parse_lines, read_lines};
 use crate::gate::RunInfo;
 use crate::gate::baselines::class_name;
 use nbody_engine::kernels::WorkCounters;
@@ -84,14 +85,7 @@ pub struct Normalized {
     pub ci95: [f64; 2],
 }
 
-/// A line of a history file that is not a record.
-#[derive(Clone, Debug, PartialEq)]
-pub struct BadLine {
-    /// Line number in the file, from 1.
-    pub line: usize,
-    /// What is wrong with it: not JSON of a record, or another schema.
-    pub problem: String,
-}
+pub use super::lines::BadLine;
 
 /// A history file's records, and the lines that were not records.
 #[derive(Clone, Debug, Default)]
@@ -100,6 +94,9 @@ pub struct History {
     pub records: Vec<Record>,
     /// The lines that were not records, left out.
     pub bad: Vec<BadLine>,
+    /// Lines that carry the history's schema, read or left out: a file with one is a history
+    /// file, however damaged.
+    pub tagged: usize,
 }
 
 /// Why a history file cannot be read or appended to.
@@ -112,6 +109,17 @@ pub enum HistoryError {
         path: PathBuf,
         /// The underlying error.
         source: std::io::Error,
+    },
+    /// A record to append holds a value no measurement gives: nothing is appended.
+    #[error(
+        "not recording case {case}: {problem}; nothing was appended to the history (a record \
+         no reader could use would only be left out when read)"
+    )]
+    Invalid {
+        /// The case key.
+        case: String,
+        /// What is wrong with the record.
+        problem: String,
     },
     /// The history folder or a file in it cannot be created, locked or written.
     #[error("cannot append to {path}: {source}")]
@@ -231,6 +239,13 @@ pub fn file_of(dir: &Path, class: &str) -> PathBuf {
 /// each file's lines in one write under an exclusive lock, through no link. Returns the files
 /// written, with the number of records each.
 pub fn append(dir: &Path, records: &[Record]) -> Result<Vec<(PathBuf, usize)>, HistoryError> {
+    // Checked as every reader checks a line, before anything is written.
+    if let Some((r, problem)) = records.iter().find_map(|r| Some((r, r.problem()?))) {
+        return Err(HistoryError::Invalid {
+            case: r.case.clone(),
+            problem,
+        });
+    }
     let mut classes: Vec<&str> = records.iter().map(|r| r.class.as_str()).collect();
     classes.sort_unstable();
     classes.dedup();
@@ -244,7 +259,7 @@ pub fn append(dir: &Path, records: &[Record]) -> Result<Vec<(PathBuf, usize)>, H
         let mut text = String::new();
         let mut count = 0;
         for r in records.iter().filter(|r| r.class == class) {
-            // A record serialises: its numbers are vetted where they were measured.
+            // A record serialises: its numbers were checked above.
             let line = serde_json::to_string(r).map_err(|e| fail(std::io::Error::other(e)))?;
             text.push_str(&line);
             text.push('\n');
@@ -289,74 +304,73 @@ pub(crate) fn append_text(path: &Path, text: &str) -> std::io::Result<()> {
     file.unlock()
 }
 
-/// A line of a JSON Lines file of this project (a history record, a gate run's verdicts):
-/// the schema it carries, and what a line that is not one is called.
-pub(crate) trait Line: serde::de::DeserializeOwned {
-    const SCHEMA: &'static str;
-    /// "a history record", "a gate verdict line".
-    const WHAT: &'static str;
-    fn schema(&self) -> &str;
-}
-
 impl Line for Record {
     const SCHEMA: &'static str = HISTORY_SCHEMA;
     const WHAT: &'static str = "a history record";
-    fn schema(&self) -> &str {
-        &self.schema
+    const SUFFIX: &'static str = ".jsonl";
+    fn class(&self) -> &str {
+        &self.class
     }
-}
-
-/// Every line of the file at `path` that is a `T`, and every one that is not with its number
-/// (the rest stays readable). A missing file holds none.
-pub(crate) fn read_lines<T: Line>(path: &Path) -> Result<(Vec<T>, Vec<BadLine>), HistoryError> {
-    match nbody_engine::input::read_text(path) {
-        Ok(text) => Ok(parse_lines(&text)),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok((Vec::new(), Vec::new())),
-        Err(source) => Err(HistoryError::Read {
-            path: path.into(),
-            source,
-        }),
-    }
-}
-
-/// The lines of a text that are `T`s, and the numbered ones that are not (see [`read_lines`]).
-pub(crate) fn parse_lines<T: Line>(text: &str) -> (Vec<T>, Vec<BadLine>) {
-    let (mut good, mut bad) = (Vec::new(), Vec::new());
-    for (i, line) in text.lines().enumerate() {
-        if line.trim().is_empty() {
-            continue;
-        }
-        let problem = match serde_json::from_str::<T>(line) {
-            Ok(r) if r.schema() == T::SCHEMA => {
-                good.push(r);
-                continue;
-            }
-            Ok(r) => format!(
-                "schema `{}`, this version reads `{}`",
-                r.schema(),
-                T::SCHEMA
-            ),
-            Err(e) => format!("not {} ({e})", T::WHAT),
+    fn problem(&self) -> Option<String> {
+        let interval = |what: &str, [lo, hi]: [f64; 2]| {
+            (!(lo.is_finite() && hi.is_finite() && lo > 0.0 && lo <= hi))
+                .then(|| format!("{what} = [{lo}, {hi}] is not an interval of times > 0"))
         };
-        bad.push(BadLine {
-            line: i + 1,
-            problem,
+        let time = |what: &str, v: f64| {
+            (!(v.is_finite() && v > 0.0)).then(|| format!("{what} = {v} is not a time > 0"))
+        };
+        let normalized = self.normalized.and_then(|n| {
+            time("normalized.median", n.median).or_else(|| interval("normalized.ci95", n.ci95))
         });
+        time("median_s", self.median_s)
+            .or_else(|| interval("ci95_s", self.ci95_s))
+            .or(normalized)
+            .or_else(|| (self.samples == 0).then(|| "it is of 0 samples".to_string()))
+            .or_else(|| (self.n == 0).then(|| "it is of n = 0 particles".to_string()))
+            .or_else(|| {
+                self.case
+                    .is_empty()
+                    .then(|| "its case key is empty".to_string())
+            })
+            .or_else(|| {
+                self.class
+                    .is_empty()
+                    .then(|| "its machine class is empty".to_string())
+            })
     }
-    (good, bad)
+}
+
+impl Record {
+    /// Whether the record names the commit it measured: a sweep outside a git checkout names
+    /// `unknown`, a results file that names none gives an empty commit.
+    pub fn commit_known(&self) -> bool {
+        !(self.commit.is_empty() || self.commit == "unknown")
+    }
 }
 
 /// Reads a history file: every record, and every line that is not one with its number (the
-/// rest stays readable). A missing file is an empty history.
+/// rest stays readable). A record must name the class the file is named after
+/// (`<class>.jsonl`). A missing file is an empty history.
 pub fn read(path: &Path) -> Result<History, HistoryError> {
-    let (records, bad) = read_lines(path)?;
-    Ok(History { records, bad })
+    let lines = read_lines(path).map_err(|source| HistoryError::Read {
+        path: path.into(),
+        source,
+    })?;
+    Ok(History {
+        records: lines.good,
+        bad: lines.bad,
+        tagged: lines.tagged,
+    })
 }
 
-/// The records of a history's text (see [`read`]).
+/// The records of a history's text, whatever their class (see [`read`]).
 pub fn parse(text: &str) -> History {
-    let (records, bad) = parse_lines(text);
-    History { records, bad }
+    let lines = parse_lines(text.as_bytes(), None);
+    History {
+        records: lines.good,
+        bad: lines.bad,
+        tagged: lines.tagged,
+    }
 }
 
 #[cfg(test)]
@@ -458,6 +472,27 @@ pub(crate) mod tests {
         std::os::unix::fs::symlink(&victim, file_of(dir.path(), &r.class)).unwrap();
         assert!(append(dir.path(), &[r]).is_err());
         assert_eq!(std::fs::read_to_string(&victim).unwrap(), "mine\n");
+    }
+
+    #[test]
+    fn a_record_no_reader_could_use_is_never_appended() {
+        let dir = tempfile::tempdir().unwrap();
+        let good = record("a", "abc", 1e-3);
+        for median in [-1.0, 0.0, f64::NAN, f64::INFINITY] {
+            let bad = record("b", "abc", median);
+            let e = append(dir.path(), &[good.clone(), bad]).unwrap_err();
+            assert!(
+                e.to_string()
+                    .starts_with("not recording case b: median_s = "),
+                "{e}"
+            );
+            assert!(e.to_string().contains("is not a time > 0"), "{e}");
+        }
+        // Nothing of a refused batch was written, the good record included.
+        assert!(!file_of(dir.path(), &good.class).exists());
+        let mut no_samples = good.clone();
+        no_samples.samples = 0;
+        assert!(append(dir.path(), &[no_samples]).is_err());
     }
 
     #[test]

@@ -5,7 +5,8 @@
 //! the way the history is ([`super::store`]): appended whole lines under a lock, and read
 //! line by line, a bad line named by its number and the rest read.
 
-use super::store::{BadLine, HistoryError, Line, append_text, parse_lines, read_lines};
+use super::lines::{BadLine, Line, parse_lines, read_lines};
+use super::store::{HistoryError, append_text};
 use crate::gate::baselines::class_name;
 use crate::gate::guard::Regression;
 use crate::gate::{GateReport, Judged, RunInfo, Verdict};
@@ -279,12 +280,14 @@ pub struct Verdicts {
 }
 
 impl Verdicts {
-    /// The run measured last (of two at the same time, the one later in the file).
+    /// The run measured last, by the instant of its time (of two at the same time, or
+    /// without a time this version reads, the one later in the file).
     pub fn latest(&self) -> Option<&GateRun> {
         self.runs
             .iter()
-            .rev()
-            .max_by(|a, b| a.measured.cmp(&b.measured))
+            .enumerate()
+            .max_by_key(|(i, r)| (super::instant::parse(&r.measured), *i))
+            .map(|(_, r)| r)
     }
 }
 
@@ -329,21 +332,35 @@ pub fn append(dir: &Path, runs: &[GateRun]) -> Result<Vec<(PathBuf, usize)>, His
 impl Line for GateRun {
     const SCHEMA: &'static str = VERDICTS_SCHEMA;
     const WHAT: &'static str = "a gate verdict line";
-    fn schema(&self) -> &str {
-        &self.schema
+    const SUFFIX: &'static str = ".gate.jsonl";
+    fn class(&self) -> &str {
+        &self.class
+    }
+    fn problem(&self) -> Option<String> {
+        None
     }
 }
 
-/// Reads a verdict file (a missing file holds no run).
+/// Reads a verdict file, read as the history is ([`super::lines`]): a run must name the class
+/// the file is named after (`<class>.gate.jsonl`). A missing file holds no run.
 pub fn read(path: &Path) -> Result<Verdicts, HistoryError> {
-    let (runs, bad) = read_lines(path)?;
-    Ok(Verdicts { runs, bad })
+    let lines = read_lines(path).map_err(|source| HistoryError::Read {
+        path: path.into(),
+        source,
+    })?;
+    Ok(Verdicts {
+        runs: lines.good,
+        bad: lines.bad,
+    })
 }
 
-/// The runs of a verdict file's text (see [`read`]).
+/// The runs of a verdict file's text, whatever their class (see [`read`]).
 pub fn parse(text: &str) -> Verdicts {
-    let (runs, bad) = parse_lines(text);
-    Verdicts { runs, bad }
+    let lines = parse_lines(text.as_bytes(), None);
+    Verdicts {
+        runs: lines.good,
+        bad: lines.bad,
+    }
 }
 
 #[cfg(test)]

@@ -110,14 +110,7 @@ pub fn load(dir: &Path) -> Result<Loaded, PublishError> {
     names.sort();
     let mut warnings = Vec::new();
     let mut warn = |path: &Path, bad: &[store::BadLine]| {
-        for b in bad {
-            warnings.push(format!(
-                "{} line {}: {}; the line is left out",
-                path.display(),
-                b.line,
-                b.problem
-            ));
-        }
+        warnings.extend(bad.iter().map(|b| b.warning(path)));
     };
     let mut classes = Vec::new();
     for class in names {
@@ -196,7 +189,7 @@ impl Page {
         self.classes
             .iter()
             .filter_map(|c| c.newest.as_deref())
-            .max()
+            .max_by_key(|m| (super::instant::parse(m), *m))
     }
 
     /// Every chart with its steps, in page order.
@@ -212,9 +205,13 @@ pub fn page(loaded: &Loaded, figures: Vec<Figure>) -> Result<Page, PublishError>
     for c in &loaded.classes {
         let latest = c.verdicts.latest().cloned();
         let all = series(&c.records);
-        let mut commits: Vec<&str> = all
+        let mut commits: Vec<(&str, Option<&str>)> = all
             .iter()
-            .flat_map(|s| s.points.iter().map(|p| p.commit.as_str()))
+            .flat_map(|s| {
+                s.points
+                    .iter()
+                    .map(|p| (p.commit.as_str(), p.measured.as_deref()))
+            })
             .collect();
         commits.sort_unstable();
         commits.dedup();
@@ -222,7 +219,13 @@ pub fn page(loaded: &Loaded, figures: Vec<Figure>) -> Result<Page, PublishError>
             class: c.class.clone(),
             records: c.records.len(),
             commits: commits.len(),
-            newest: c.records.iter().map(|r| r.measured.clone()).max(),
+            // By instant, not by text: a hand-written time may carry an offset.
+            newest: c
+                .records
+                .iter()
+                .enumerate()
+                .max_by_key(|(i, r)| (super::instant::parse(&r.measured), *i))
+                .map(|(_, r)| r.measured.clone()),
             latest_gate: latest.clone(),
         });
         for s in all {
