@@ -33,12 +33,39 @@ pub fn is_pipe(path: &Path) -> bool {
 /// ends within [`MAX_INPUT_BYTES`] and never stays silent for longer than the pipe wait.
 /// Devices are refused.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
+    read(path, Pipes::Read)
+}
+
+/// The text of `path`, a regular file of at most [`MAX_INPUT_BYTES`]: for the files a
+/// command finds by name or next to others (a history file in its folder, REPORT.md beside
+/// its figures), which a pipe cannot stand for. Pipes and devices are refused without
+/// waiting.
+pub fn read_file_text(path: &Path) -> std::io::Result<String> {
+    read(path, Pipes::Refused)
+}
+
+/// Whether a reader takes a pipe.
+#[derive(Clone, Copy, PartialEq)]
+enum Pipes {
+    Read,
+    Refused,
+}
+
+fn read(path: &Path, pipes: Pipes) -> std::io::Result<String> {
     use std::os::unix::fs::FileTypeExt;
     let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
     let kind = std::fs::metadata(path)?.file_type();
     if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
         return Err(invalid(
             "is a device or socket, not a file: name a file".to_string(),
+        ));
+    }
+    if kind.is_dir() {
+        return Err(invalid("is a directory: name a file".to_string()));
+    }
+    if kind.is_fifo() && pipes == Pipes::Refused {
+        return Err(invalid(
+            "is a pipe, not a file: this input is read from a regular file".to_string(),
         ));
     }
     let mut bytes = Vec::new();
@@ -158,6 +185,18 @@ mod tests {
         assert_eq!(read_text(&p).unwrap(), "p,time\n");
         assert!(read_text(&dir.path().join("missing")).is_err());
         assert!(is_readable(&p) && !is_pipe(&p) && !is_readable(dir.path()));
+        assert_eq!(read_file_text(&p).unwrap(), "p,time\n");
+        let e = read_file_text(Path::new("/dev/zero")).unwrap_err();
+        assert!(e.to_string().contains("device"), "{e}");
+    }
+
+    #[test]
+    fn a_pipe_is_refused_where_a_file_is_read_without_waiting() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = fifo(dir.path());
+        let e = read_file_text(&p).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput);
+        assert!(e.to_string().contains("is a pipe"), "{e}");
     }
 
     fn fifo(dir: &Path) -> std::path::PathBuf {
