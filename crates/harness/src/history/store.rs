@@ -133,16 +133,14 @@ pub struct CommitFacts {
 }
 
 impl CommitFacts {
-    /// What `git` in `repo` knows of `commit` (nothing when git or the commit is missing).
+    /// What `git` in `repo` knows of `commit` (nothing when git or the commit is missing,
+    /// or when `commit` is not a commit hash: git is never asked about other text).
     pub fn of(repo: &Path, commit: &str) -> CommitFacts {
-        if commit.is_empty() {
+        let Some(commit) = crate::git::Rev::recorded(commit) else {
             return CommitFacts::default();
-        }
-        let git = |args: &[&str]| -> Option<String> {
-            let out = std::process::Command::new("git")
-                .arg("-C")
-                .arg(repo)
-                .args(args)
+        };
+        let git = |args: &[&str], rev: &crate::git::Rev| -> Option<String> {
+            let out = crate::git::command(repo, args, &[rev])
                 .stderr(std::process::Stdio::null())
                 .output()
                 .ok()?;
@@ -150,8 +148,8 @@ impl CommitFacts {
             (out.status.success() && !text.trim().is_empty()).then(|| text.trim().to_string())
         };
         CommitFacts {
-            parent: git(&["rev-parse", "--verify", "--quiet", &format!("{commit}^")]),
-            date: git(&["show", "-s", "--format=%cI", commit]),
+            parent: git(&["rev-parse", "--verify", "--quiet"], &commit.parent()),
+            date: git(&["show", "-s", "--format=%cI"], &commit),
         }
     }
 }
@@ -307,9 +305,10 @@ impl Line for Record {
 }
 
 /// Every line of the file at `path` that is a `T`, and every one that is not with its number
-/// (the rest stays readable). A missing file holds none.
+/// (the rest stays readable). A missing file holds none; a history file is a regular file
+/// (it is appended to), so a pipe or a device in its place is refused, not waited on.
 pub(crate) fn read_lines<T: Line>(path: &Path) -> Result<(Vec<T>, Vec<BadLine>), HistoryError> {
-    match nbody_engine::input::read_text(path) {
+    match nbody_engine::input::read_file_text(path) {
         Ok(text) => Ok(parse_lines(&text)),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok((Vec::new(), Vec::new())),
         Err(source) => Err(HistoryError::Read {
