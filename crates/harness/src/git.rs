@@ -86,11 +86,15 @@ pub fn given_range(text: &str) -> Result<(Rev, Rev), String> {
 }
 
 /// `git -C repo ARGS --end-of-options REVS`: `args` are the command and its options (the
-/// caller's own words), `revs` its revisions, which git then cannot read as options.
+/// caller's own words), `revs` its revisions, which git then cannot read as options. With no
+/// revision there is no `--end-of-options` (`rev-parse` would echo it as an argument).
 pub fn command(repo: &Path, args: &[&str], revs: &[&Rev]) -> Command {
     let mut c = Command::new("git");
-    c.arg("-C").arg(repo).args(args).arg("--end-of-options");
-    c.args(revs.iter().map(|r| r.as_str()));
+    c.arg("-C").arg(repo).args(args);
+    if !revs.is_empty() {
+        c.arg("--end-of-options");
+        c.args(revs.iter().map(|r| r.as_str()));
+    }
     c
 }
 
@@ -174,5 +178,7 @@ mod tests {
                 "abcd1234"
             ]
         );
+        let c = command(Path::new("/repo"), &["rev-parse", "--show-toplevel"], &[]);
+        assert_eq!(c.get_args().count(), 4);
     }
 }

@@ -8,7 +8,9 @@
 //!   (CommonMark closes a span only on a run of the same length), padded with a space where
 //!   the text starts or ends with a backtick or a space (CommonMark strips one from each side);
 //! - [`text`] writes `&`, `<` and `>` as HTML entities and backslash-escapes the punctuation
-//!   that starts emphasis, links, code or strikethrough;
+//!   that starts a link, a code span or a table cell (emphasis characters are left: they
+//!   change how a text looks, not what it is or where it leads, and `FAST_KER=ON` stays
+//!   readable in the Markdown source);
 //! - both keep the text on one line (a line break would end a table row, a blank line the
 //!   paragraph, and with it the span): control characters are shown escaped
 //!   ([`super::control`]), and [`cell_code`] / [`text`] escape `|`, which ends a table cell.
@@ -36,9 +38,9 @@ pub fn cell_code(text: &str) -> String {
     code(&text.replace("\\|", "\\u{5c}|")).replace('|', "\\|")
 }
 
-/// `text` as Markdown text on one line that renders as the same characters: no raw HTML, no
-/// entity, link, emphasis, code span or table cell border of its own. Line breaks and tabs
-/// become spaces; other control characters are shown escaped.
+/// `text` as Markdown text on one line: no raw HTML, no entity, link, image, code span or
+/// table cell border of its own. Line breaks and tabs become spaces; other control characters
+/// are shown escaped.
 pub fn text(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + 8);
     for c in text.chars() {
@@ -47,7 +49,7 @@ pub fn text(text: &str) -> String {
             '&' => out.push_str("&amp;"),
             '<' => out.push_str("&lt;"),
             '>' => out.push_str("&gt;"),
-            '\\' | '`' | '*' | '_' | '[' | ']' | '|' | '~' => {
+            '\\' | '`' | '[' | ']' | '|' => {
                 out.push('\\');
                 out.push(c);
             }
@@ -89,8 +91,8 @@ mod tests {
     fn text_carries_no_markup() {
         assert_eq!(text("plain words, 1.5x"), "plain words, 1.5x");
         assert_eq!(
-            text("<script>[x](javascript:y) *b* `c` a|b &amp;"),
-            "&lt;script&gt;\\[x\\](javascript:y) \\*b\\* \\`c\\` a\\|b &amp;amp;"
+            text("<script>[x](javascript:y) *b* `c` a|b &amp; FAST_KER"),
+            "&lt;script&gt;\\[x\\](javascript:y) *b* \\`c\\` a\\|b &amp;amp; FAST_KER"
         );
         assert_eq!(text("one\ntwo\u{1b}"), "one two\\u{1b}");
     }
