@@ -3,12 +3,14 @@
 
 use anyhow::{Context, bail};
 use clap::{Args, Subcommand};
+use nbody_engine::output::neutral::control::visible;
+use nbody_harness::gate::baselines::check_class_name;
 use nbody_harness::history::series::{Metric, Point, Series, series};
 use nbody_harness::history::steps::{Step, steps};
 use nbody_harness::history::store::{self, CommitFacts, History};
 use nbody_harness::history::verdicts::{self, GateRun};
 use nbody_harness::units::Duration;
-use nbody_records::results::ResultsFile;
+use nbody_records::results::{ResultsError, ResultsFile};
 use std::path::{Path, PathBuf};
 
 /// Where the committed history lives.
@@ -32,8 +34,8 @@ pub struct HistoryArgs {
     /// The folder of history files, one per machine class.
     #[arg(long, value_name = "DIR", default_value = DEFAULT_DIR, global = true)]
     pub dir: PathBuf,
-    /// The machine class to show (a file name under --dir without `.jsonl`); default: this
-    /// machine's.
+    /// The machine class to show (a file name under --dir without `.jsonl`: letters, digits
+    /// and `-`); default: this machine's.
     #[arg(long, value_name = "CLASS")]
     pub class: Option<String>,
     /// Only the cases whose key matches this pattern (`*` any text, `?` one character).
@@ -142,7 +144,13 @@ fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
         } else {
             path.clone()
         };
-        if let Some(run) = gate_report(&path)? {
+        // Read once, through the bounded reader: a pipe is read within the pipe wait, a device
+        // refused, and a gate report and a results file are told apart by their text.
+        let text = nbody_engine::input::read_text(&path).map_err(|source| ResultsError::Read {
+            path: path.clone(),
+            source,
+        })?;
+        if let Some(run) = gate_report(&path, &text)? {
             for (to, count) in verdicts::append(dir, &[run])? {
                 eprintln!(
                     "{}: the verdicts of {count} gate run(s) appended to {}",
@@ -152,9 +160,13 @@ fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
             }
             continue;
         }
-        let file = ResultsFile::load(&path)?;
+        let value = serde_json::from_str(&text).map_err(|e| ResultsError::Corrupt {
+            path: path.clone(),
+            detail: e.to_string(),
+        })?;
+        let file = ResultsFile::from_value(&path, value)?;
         for line in file.taken_out() {
-            eprintln!("warning: {}: {line}", path.display());
+            eprintln!("warning: {}: {}", path.display(), visible(&line));
         }
         let written = append_results(dir, &file, &args.source)?;
         for (to, count) in written {
@@ -168,23 +180,17 @@ fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
     Ok(0)
 }
 
-/// The verdicts of `path` when it is a gate report (schema `nbody-bench/gate/v1`, a kept gate
-/// run's `gate.json`); `None` for any other file.
-fn gate_report(path: &Path) -> anyhow::Result<Option<GateRun>> {
-    if path.extension().is_none_or(|e| e != "json") {
-        return Ok(None);
-    }
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return Ok(None);
-    };
-    let schema = serde_json::from_str::<serde_json::Value>(&text)
+/// The verdicts of `path` (its `text`) when it is a gate report (schema
+/// `nbody-bench/gate/v1`, a kept gate run's `gate.json`); `None` for any other file.
+fn gate_report(path: &Path, text: &str) -> anyhow::Result<Option<GateRun>> {
+    let schema = serde_json::from_str::<serde_json::Value>(text)
         .ok()
         .and_then(|v| v["schema"].as_str().map(str::to_string));
     if schema.as_deref() != Some(verdicts::GATE_REPORT_SCHEMA) {
         return Ok(None);
     }
     let machine = nbody_harness::gate::route::this_machine();
-    GateRun::from_report_json(&text, &machine)
+    GateRun::from_report_json(text, &machine)
         .map(Some)
         .map_err(|why| anyhow::anyhow!("{}: a gate report, but {why}", path.display()))
 }
@@ -196,7 +202,15 @@ pub fn append_results(
     file: &ResultsFile,
     source: &str,
 ) -> anyhow::Result<Vec<(PathBuf, usize)>> {
-    let facts = CommitFacts::of(Path::new("."), &file.metadata.git_commit);
+    let commit = &file.metadata.git_commit;
+    if nbody_harness::git::Rev::recorded(commit).is_none() && commit != "unknown" {
+        eprintln!(
+            "warning: the results' git_commit `{}` is not a commit hash: git is not asked \
+             about it, and its records are kept with no parent and no commit date",
+            visible(commit)
+        );
+    }
+    let facts = CommitFacts::of(Path::new("."), commit);
     let machine = nbody_harness::gate::route::this_machine();
     let records = store::records_of(file, source, &facts, &machine);
     if records.is_empty() {
@@ -207,7 +221,9 @@ pub fn append_results(
 
 fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
     let class = match &args.class {
-        Some(c) => c.clone(),
+        Some(c) => check_class_name(c)
+            .map_err(|why| anyhow::anyhow!("--class {why}"))?
+            .to_string(),
         None => {
             let m = nbody_harness::gate::route::this_machine();
             nbody_harness::gate::baselines::class_name(m.cpu_signature.as_deref(), m.logical_cpus)
@@ -223,7 +239,7 @@ fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
     }
     let History { records, bad, .. } = store::read(&path)?;
     for b in &bad {
-        eprintln!("warning: {}", b.warning(&path));
+        eprintln!("warning: {}", visible(&b.warning(&path)));
     }
     let pattern = args.case.as_deref().map(glob).transpose()?;
     let all: Vec<Series> = series(&records)
@@ -283,14 +299,15 @@ fn print_series(f: &Found) {
         Metric::Normalized => format!("{v:.4}"),
         Metric::Seconds => Duration(v).to_string(),
     };
+    // The case key and the config name come from the history file: no control character of
+    // theirs reaches the terminal.
+    let (case, config) = (visible(&s.case), visible(&s.config));
     let (Some(first), Some(last)) = (s.points.first(), s.points.last()) else {
-        println!("\n{} ({}): no commit measured", s.case, s.config);
+        println!("\n{case} ({config}): no commit measured");
         return;
     };
     println!(
-        "\n{} ({}): {} commits, {} → {} {unit}{}",
-        s.case,
-        s.config,
+        "\n{case} ({config}): {} commits, {} → {} {unit}{}",
         s.points.len(),
         value(first.value),
         value(last.value),
@@ -327,11 +344,12 @@ fn print_series(f: &Found) {
 }
 
 /// A point as the text names it: its commit as read from a history file, which may hold
-/// anything, cut by characters; a point of a sweep outside git by when it was measured.
+/// anything, cut by characters, its control characters shown escaped; a point of a sweep
+/// outside git by when it was measured.
 fn name(p: &Point) -> String {
     match &p.measured {
-        Some(measured) => format!("(no commit, measured {measured})"),
-        None => nbody_harness::gate::prefix(&p.commit, 10).to_string(),
+        Some(measured) => format!("(no commit, measured {})", visible(measured)),
+        None => visible(nbody_harness::gate::prefix(&p.commit, 10)).into_owned(),
     }
 }
 

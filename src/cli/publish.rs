@@ -31,7 +31,8 @@ pub struct PublishArgs {
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// The report whose figures the page links (those that exist, by paths relative to the
-    /// page's folder).
+    /// page's folder; a link that is not http, https, mailto or a relative path is shown as
+    /// text). A regular file: a pipe or a device is refused.
     #[arg(long, value_name = "FILE", default_value = "REPORT.md")]
     pub report: PathBuf,
     /// Print a Markdown summary for a pull-request comment instead of writing the page: per
@@ -78,8 +79,13 @@ pub fn publish(args: PublishArgs) -> anyhow::Result<i32> {
     Ok(0)
 }
 
+/// The lines left out of the history files; they quote those files, so their control
+/// characters are shown escaped.
 fn warn(warnings: &[String]) {
     for w in warnings {
-        eprintln!("warning: {w}");
+        eprintln!(
+            "warning: {}",
+            nbody_engine::output::neutral::control::visible(w)
+        );
     }
 }

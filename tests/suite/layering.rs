@@ -325,7 +325,7 @@ const MEMBERS: &[Member] = &[
         package: "nbody-harness",
         layer: 3,
         modules: &[
-            &["console", "children", "fit"],
+            &["console", "children", "git", "fit"],
             &["units"],
             // A figure names times and sizes in the units' words.
             &["plot"],

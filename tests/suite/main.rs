@@ -24,6 +24,7 @@ mod external;
 mod external_honesty;
 mod external_phases;
 mod fit_cli;
+mod foreign_input;
 mod gate;
 mod gate_baselines;
 mod gate_refusals;

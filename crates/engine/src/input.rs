@@ -33,7 +33,30 @@ pub fn is_pipe(path: &Path) -> bool {
 /// ends within [`MAX_INPUT_BYTES`] and never stays silent for longer than the pipe wait.
 /// Devices are refused.
 pub fn read_text(path: &Path) -> std::io::Result<String> {
-    String::from_utf8(read_bytes(path)?).map_err(|_| {
+    utf8(read(path, Pipes::Read)?)
+}
+
+/// The bytes of `path`, read as [`read_text`] reads them, for readers that take a file apart
+/// before decoding it (a JSON Lines file, where a line that is not UTF-8 costs that line).
+pub fn read_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+    read(path, Pipes::Read)
+}
+
+/// The text of `path`, a regular file of at most [`MAX_INPUT_BYTES`]: for the files a
+/// command finds by name or next to others (a history file in its folder, REPORT.md beside
+/// its figures), which a pipe cannot stand for. Pipes and devices are refused without
+/// waiting.
+pub fn read_file_text(path: &Path) -> std::io::Result<String> {
+    utf8(read(path, Pipes::Refused)?)
+}
+
+/// The bytes of `path`, read as [`read_file_text`] reads them (a regular file only).
+pub fn read_file_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+    read(path, Pipes::Refused)
+}
+
+fn utf8(bytes: Vec<u8>) -> std::io::Result<String> {
+    String::from_utf8(bytes).map_err(|_| {
         std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             "stream did not contain valid UTF-8",
@@ -41,15 +64,28 @@ pub fn read_text(path: &Path) -> std::io::Result<String> {
     })
 }
 
-/// The bytes of `path`, read as [`read_text`] reads them, for readers that take a file apart
-/// before decoding it (a JSON Lines file, where a line that is not UTF-8 costs that line).
-pub fn read_bytes(path: &Path) -> std::io::Result<Vec<u8>> {
+/// Whether a reader takes a pipe.
+#[derive(Clone, Copy, PartialEq)]
+enum Pipes {
+    Read,
+    Refused,
+}
+
+fn read(path: &Path, pipes: Pipes) -> std::io::Result<Vec<u8>> {
     use std::os::unix::fs::FileTypeExt;
     let invalid = |m: String| std::io::Error::new(std::io::ErrorKind::InvalidInput, m);
     let kind = std::fs::metadata(path)?.file_type();
     if kind.is_char_device() || kind.is_block_device() || kind.is_socket() {
         return Err(invalid(
             "is a device or socket, not a file: name a file".to_string(),
+        ));
+    }
+    if kind.is_dir() {
+        return Err(invalid("is a directory: name a file".to_string()));
+    }
+    if kind.is_fifo() && pipes == Pipes::Refused {
+        return Err(invalid(
+            "is a pipe, not a file: this input is read from a regular file".to_string(),
         ));
     }
     let mut bytes = Vec::new();
@@ -164,6 +200,18 @@ mod tests {
         assert_eq!(read_text(&p).unwrap(), "p,time\n");
         assert!(read_text(&dir.path().join("missing")).is_err());
         assert!(is_readable(&p) && !is_pipe(&p) && !is_readable(dir.path()));
+        assert_eq!(read_file_text(&p).unwrap(), "p,time\n");
+        let e = read_file_text(Path::new("/dev/zero")).unwrap_err();
+        assert!(e.to_string().contains("device"), "{e}");
+    }
+
+    #[test]
+    fn a_pipe_is_refused_where_a_file_is_read_without_waiting() {
+        let dir = tempfile::tempdir().unwrap();
+        let p = fifo(dir.path());
+        let e = read_file_text(&p).unwrap_err();
+        assert_eq!(e.kind(), std::io::ErrorKind::InvalidInput);
+        assert!(e.to_string().contains("is a pipe"), "{e}");
     }
 
     fn fifo(dir: &Path) -> std::path::PathBuf {

@@ -53,8 +53,14 @@ pub fn write_fmt(args: std::fmt::Arguments<'_>) {
 /// share one stream, and `eprintln!` writes a formatted line piece by piece, so two ranks'
 /// messages could come out interleaved mid-sentence; one write of a line shorter than the
 /// pipe's atomic size stays whole.
+///
+/// An error quotes what it refuses (a case key, a commit, a line of someone else's file):
+/// its control characters are shown escaped, so that none of them acts on the terminal; the
+/// message's own line breaks are kept.
 pub fn print_error(message: impl std::fmt::Display) {
-    let line = format!("error: {message}\n");
+    let message = message.to_string();
+    let shown = nbody_engine::output::neutral::control::visible_lines(&message);
+    let line = format!("error: {shown}\n");
     let _ = std::io::stderr().lock().write_all(line.as_bytes());
 }
 

@@ -4,9 +4,12 @@
 //!
 //! A [`TidyTable`] holds plain JSON values, so any record becomes rows the same way (a results
 //! file's samples here, [`samples`]; the performance history elsewhere) and is written by the
-//! same two writers. Null is "not measured": an empty CSV cell, JSON `null`, never 0.
+//! same two writers. Null is "not measured": an empty CSV cell, JSON `null`, never 0. Text
+//! that starts like a spreadsheet formula (`=`, `+`, `-`, `@`) is written with a `'` in front,
+//! in both formats.
 
 use super::results::ResultsFile;
+use nbody_engine::output::neutral::spreadsheet::text_cell;
 use serde_json::Value;
 use std::borrow::Cow;
 
@@ -71,7 +74,8 @@ impl TidyTable {
     }
 
     /// One object per row and line, its keys the columns in their order (a JSON map would sort
-    /// them).
+    /// them); a text value that a spreadsheet would run as a formula with a `'` in front
+    /// ([`text_cell`]), as in the CSV.
     pub fn to_jsonl(&self) -> String {
         let mut text = String::new();
         for row in &self.rows {
@@ -82,7 +86,13 @@ impl TidyTable {
                 }
                 text.push_str(&Value::String(column.clone()).to_string());
                 text.push(':');
-                text.push_str(&value.to_string());
+                match value {
+                    Value::String(s) => {
+                        let cell = text_cell(s).into_owned();
+                        text.push_str(&Value::String(cell).to_string());
+                    }
+                    other => text.push_str(&other.to_string()),
+                }
             }
             text.push_str("}\n");
         }
@@ -102,7 +112,8 @@ fn push_line<'a>(text: &mut String, cells: impl Iterator<Item = Cow<'a, str>>) {
 
 /// A value as a CSV cell: null empty; numbers as Rust prints them (`{}`: the shortest decimal
 /// that reads back to the same f64, never an exponent); an empty string quoted, so that it
-/// differs from null; an array or object as its compact JSON.
+/// differs from null; text that a spreadsheet would run as a formula with a `'` in front
+/// ([`text_cell`]); an array or object as its compact JSON.
 fn csv_cell(value: &Value) -> Cow<'_, str> {
     match value {
         Value::Null => Cow::Borrowed(""),
@@ -114,7 +125,10 @@ fn csv_cell(value: &Value) -> Cow<'_, str> {
             (None, None, None) => n.to_string(),
         }),
         Value::String(s) if s.is_empty() => Cow::Borrowed("\"\""),
-        Value::String(s) => quote(s),
+        Value::String(s) => match text_cell(s) {
+            Cow::Borrowed(s) => quote(s),
+            Cow::Owned(s) => Cow::Owned(quote(&s).into_owned()),
+        },
         Value::Array(_) | Value::Object(_) => Cow::Owned(quote(&value.to_string()).into_owned()),
     }
 }
@@ -294,6 +308,22 @@ mod tests {
             )
         );
         assert_eq!(tiny.parse::<f64>().unwrap(), 1e-300);
+    }
+
+    #[test]
+    fn text_that_starts_like_a_formula_is_written_as_text_and_numbers_as_numbers() {
+        let mut t = TidyTable::new(["key", "x"]);
+        t.push(vec![json!("=HYPERLINK(\"http://x\",\"y\")"), json!(-1.5)]);
+        t.push(vec![json!("@SUM(A1)"), json!("-1.5")]);
+        assert_eq!(
+            t.to_csv(),
+            "key,x\n\"'=HYPERLINK(\"\"http://x\"\",\"\"y\"\")\",-1.5\n'@SUM(A1),-1.5\n"
+        );
+        assert_eq!(
+            t.to_jsonl(),
+            "{\"key\":\"'=HYPERLINK(\\\"http://x\\\",\\\"y\\\")\",\"x\":-1.5}\n\
+             {\"key\":\"'@SUM(A1)\",\"x\":\"-1.5\"}\n"
+        );
     }
 
     #[test]

@@ -3,6 +3,7 @@
 
 pub mod dump;
 pub mod nbview;
+pub mod neutral;
 pub mod provenance;
 mod temporary_dir;
 

@@ -1,8 +1,11 @@
-//! Sweep progress: a bar with ETA on a terminal, one line per measured round otherwise.
+//! Sweep progress: a bar with ETA on a terminal, one line per measured round otherwise. Case
+//! keys and messages (which may quote an external program's output) are shown with their
+//! control characters escaped.
 
 use super::runner::Observer;
 use crate::units::Duration;
 use indicatif::{ProgressBar, ProgressStyle};
+use nbody_engine::output::neutral::control::{visible, visible_lines};
 use nbody_records::results::CaseRecord;
 
 /// Chooses the bar on a terminal and plain lines elsewhere (CI logs, pipes).
@@ -34,14 +37,14 @@ impl Observer for Bar {
     fn round_done(&mut self, record: &CaseRecord, _round: usize) {
         if let Some(bar) = &self.bar {
             bar.inc(1);
-            bar.set_message(record.key.clone());
+            bar.set_message(visible(&record.key).into_owned());
         }
     }
 
     fn message(&mut self, text: &str) {
         match &self.bar {
-            Some(bar) => bar.println(text),
-            None => eprintln!("{text}"),
+            Some(bar) => bar.println(visible_lines(text)),
+            None => eprintln!("{}", visible_lines(text)),
         }
     }
 
@@ -74,12 +77,12 @@ impl Observer for Lines {
             "[{}/{}] {} round {}: {result}",
             self.done,
             self.total,
-            record.key,
+            visible(&record.key),
             round + 1,
         );
     }
 
     fn message(&mut self, text: &str) {
-        eprintln!("{text}");
+        eprintln!("{}", visible_lines(text));
     }
 }

@@ -8,6 +8,7 @@
 //! changed); `worktree-<commit>/` exists only while that commit builds.
 
 use crate::children::supervised::{self as child, ChildError};
+use crate::git::{self, Rev};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::Duration;
@@ -42,6 +43,9 @@ pub enum BaseBuildError {
         /// Why git does not know it: the clone is shallow, or no such revision.
         detail: String,
     },
+    /// The base revision is not one git may be given (it would be read as an option).
+    #[error("the base revision {0}; pass --against a revision that is")]
+    NotARevision(String),
     /// Git could not add the worktree the base revision is built in.
     #[error("cannot prepare the base revision {commit}: {detail}")]
     Worktree {
@@ -85,16 +89,16 @@ pub struct BaseBinary {
     pub build_s: f64,
 }
 
-/// Runs git with `args` in `dir`; its trimmed standard output, or its error text.
-fn git(dir: &Path, args: &[&str]) -> Result<String, String> {
+/// Runs git with `args` and the revisions `revs` in `dir`; its trimmed standard output, or
+/// its error text.
+fn git(dir: &Path, args: &[&str], revs: &[&Rev]) -> Result<String, String> {
+    run_git(git::command(dir, args, revs), args)
+}
+
+/// Runs a git command (`args` name it in messages), bounded by [`GIT_LIMIT`].
+fn run_git(mut command: Command, args: &[&str]) -> Result<String, String> {
     let what = format!("`git {}`", args.join(" "));
-    let out = child::output(
-        Command::new("git").arg("-C").arg(dir).args(args),
-        GIT_LIMIT,
-        &what,
-        "",
-    )
-    .map_err(|e| e.to_string())?;
+    let out = child::output(&mut command, GIT_LIMIT, &what, "").map_err(|e| e.to_string())?;
     if out.status.success() {
         Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
     } else {
@@ -104,7 +108,7 @@ fn git(dir: &Path, args: &[&str]) -> Result<String, String> {
 
 /// The root of the git checkout that contains `dir`.
 pub fn repository_root(dir: &Path) -> Result<PathBuf, BaseBuildError> {
-    git(dir, &["rev-parse", "--show-toplevel"])
+    git(dir, &["rev-parse", "--show-toplevel"], &[])
         .map(PathBuf::from)
         .map_err(|e| {
             BaseBuildError::NoRepository(format!("{} is not in a git checkout: {e}", dir.display()))
@@ -113,14 +117,11 @@ pub fn repository_root(dir: &Path) -> Result<PathBuf, BaseBuildError> {
 
 /// The full hash of `rev` in `repo`.
 pub fn resolve(repo: &Path, rev: &str) -> Result<String, BaseBuildError> {
+    let given = Rev::given(rev).map_err(BaseBuildError::NotARevision)?;
     git(
         repo,
-        &[
-            "rev-parse",
-            "--verify",
-            "--quiet",
-            &format!("{rev}^{{commit}}"),
-        ],
+        &["rev-parse", "--verify", "--quiet"],
+        &[&given.commit()],
     )
     .ok()
     .filter(|hash| !hash.is_empty())
@@ -158,6 +159,9 @@ pub fn base_binary(
     commit: &str,
     progress: &mut dyn FnMut(&str),
 ) -> Result<BaseBinary, BaseBuildError> {
+    // The commit names the cache's folders and reaches git: a hash and nothing else.
+    let rev = Rev::recorded(commit)
+        .ok_or_else(|| BaseBuildError::NotARevision(format!("`{commit}` is not a commit hash")))?;
     let root = cache_root(repo);
     // One cached binary per commit and toolchain: a compiler upgrade between two gate runs
     // must not have the old compiler's base measured against the new one's build.
@@ -182,22 +186,19 @@ pub fn base_binary(
         detail,
     };
     // A worktree left by an interrupted build is stale: forget it and start again.
-    let _ = git(
-        repo,
-        &["worktree", "remove", "--force", &worktree.to_string_lossy()],
-    );
+    let remove = || {
+        let mut c = Command::new("git");
+        c.arg("-C").arg(repo);
+        c.args(["worktree", "remove", "--force", "--end-of-options"]);
+        c.arg(&worktree);
+        let _ = run_git(c, &["worktree", "remove"]);
+    };
+    remove();
     let _ = std::fs::remove_dir_all(&worktree);
-    let _ = git(repo, &["worktree", "prune"]);
-    git(
-        repo,
-        &[
-            "worktree",
-            "add",
-            "--detach",
-            "--force",
-            &worktree.to_string_lossy(),
-            commit,
-        ],
+    let _ = git(repo, &["worktree", "prune"], &[]);
+    run_git(
+        git::worktree_add(repo, &worktree, &rev),
+        &["worktree", "add"],
     )
     .map_err(worktree_error)?;
 
@@ -209,10 +210,7 @@ pub fn base_binary(
     let started = std::time::Instant::now();
     let log = root.join(&key).join("build.log");
     let result = build(&worktree, &root.join("target"), &log);
-    let _ = git(
-        repo,
-        &["worktree", "remove", "--force", &worktree.to_string_lossy()],
-    );
+    remove();
     let _ = std::fs::remove_dir_all(&worktree);
     let built = result.map_err(|tail| BaseBuildError::Build {
         commit: commit.to_string(),

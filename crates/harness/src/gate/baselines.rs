@@ -223,3 +223,18 @@ pub fn class_name(signature: Option<&str>, logical_cpus: Option<usize>) -> Strin
     let cpus = logical_cpus.map_or("unknown".into(), |n| n.to_string());
     format!("{slug}-{cpus}cpu")
 }
+
+/// `name` when it can be a machine class as [`class_name`] spells it: ASCII letters, digits
+/// and `-`, so one file name and nothing that leads out of the folder (`../x`, `sub/y`);
+/// `Err` says why not.
+pub fn check_class_name(name: &str) -> Result<&str, String> {
+    if !name.is_empty() && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '-') {
+        return Ok(name);
+    }
+    Err(format!(
+        "`{}` is not a machine class: a class is a file name made of letters, digits and `-` \
+         (such as GenuineIntel-6-167-1-2cpu, as `nbody-bench history` names this machine's); \
+         list the folder of the history to see the classes it holds",
+        nbody_engine::output::neutral::control::visible(name)
+    ))
+}

@@ -5,6 +5,8 @@ use super::checks::short;
 use super::{CaseComparison, GateReport, Normalization, Verdict};
 use crate::render::tables::{Align, Table};
 use crate::units::Duration;
+use nbody_engine::output::neutral::control;
+use nbody_engine::output::neutral::markdown::{self, cell_code, code};
 use std::fmt::Write;
 
 /// How a gate report is printed (`--format`).
@@ -21,7 +23,9 @@ pub enum Format {
 /// The report rendered in `format`.
 pub fn formatted(report: &GateReport, format: Format) -> String {
     match format {
-        Format::Text => text(report),
+        // Keys and machine names come from the results files: no control character of theirs
+        // reaches the terminal.
+        Format::Text => control::visible_lines(&text(report)).into_owned(),
         Format::Markdown => markdown(report),
         Format::Json => {
             serde_json::to_string_pretty(report).expect("gate report serializes") + "\n"
@@ -149,11 +153,11 @@ fn markdown(report: &GateReport) -> String {
     let _ = writeln!(s, "{}.\n", headline(report));
     let _ = writeln!(
         s,
-        "Baseline `{}`, current `{}`; times normalised by {}. A case regresses when its ratio \
+        "Baseline {}, current {}; times normalised by {}. A case regresses when its ratio \
          current / baseline lies above {:.2} ({}), at a family-wise error of {}% over the {} \
          cases (Holm's step-down on one-sided bootstrap p-values).\n",
-        origin(&report.baseline),
-        origin(&report.current),
+        code(&origin(&report.baseline)),
+        code(&origin(&report.current)),
         normalizations(report),
         1.0 + report.threshold,
         judged_on(report.judged_on),
@@ -179,7 +183,7 @@ fn markdown(report: &GateReport) -> String {
             _ => word.to_string(),
         };
         table.row([
-            format!("`{}`", c.key),
+            cell_code(&c.key),
             Duration(c.baseline_median_s).to_string(),
             Duration(c.current_median_s).to_string(),
             format!("{:.3}", c.ratio),
@@ -187,7 +191,9 @@ fn markdown(report: &GateReport) -> String {
             format!("{:.3}", c.raw_ratio),
             format!(
                 "{verdict}{}",
-                notes(c).map(|n| format!(" ({n})")).unwrap_or_default()
+                notes(c)
+                    .map(|n| format!(" ({})", markdown::text(&n)))
+                    .unwrap_or_default()
             ),
         ]);
     }
@@ -195,8 +201,9 @@ fn markdown(report: &GateReport) -> String {
     let lines = findings(report);
     if !lines.is_empty() {
         s += "\n";
+        // Keys, reasons and warnings quote the results files: text, never markup.
         for line in lines {
-            let _ = writeln!(s, "- {line}");
+            let _ = writeln!(s, "- {}", markdown::text(&line));
         }
     }
     s

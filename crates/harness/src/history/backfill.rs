@@ -57,15 +57,15 @@ pub enum Done {
 /// The commits of `range` to measure, oldest first: every `every`-th counted back from the
 /// range's end, which is always included.
 pub fn commits(repo: &Path, range: &str, every: usize) -> anyhow::Result<Vec<String>> {
-    if !range.contains("..") {
-        anyhow::bail!("`{range}` is not a range: give A..B (the commits after A up to B)");
-    }
-    let out = std::process::Command::new("git")
-        .arg("-C")
-        .arg(repo)
-        .args(["rev-list", "--first-parent", "--reverse", range])
-        .output()
-        .map_err(|e| anyhow::anyhow!("cannot run git: {e}"))?;
+    let (from, to) = crate::git::given_range(range).map_err(anyhow::Error::msg)?;
+    let range = crate::git::Rev::range(&from, &to);
+    let out = crate::git::command(
+        repo,
+        &["rev-list", "--first-parent", "--reverse"],
+        &[&range],
+    )
+    .output()
+    .map_err(|e| anyhow::anyhow!("cannot run git: {e}"))?;
     if !out.status.success() {
         anyhow::bail!(
             "git rev-list {range}: {}",

@@ -79,7 +79,7 @@ pub(crate) fn class_of_file<T: Line>(path: &Path) -> Option<String> {
 /// Every line of the file at `path` that is a sound `T` of the file's class, and every one that
 /// is not with its number. A missing file holds none.
 pub(crate) fn read_lines<T: Line>(path: &Path) -> std::io::Result<Lines<T>> {
-    match nbody_engine::input::read_bytes(path) {
+    match nbody_engine::input::read_file_bytes(path) {
         Ok(bytes) => Ok(parse_lines(&bytes, class_of_file::<T>(path).as_deref())),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(Lines {
             good: Vec::new(),

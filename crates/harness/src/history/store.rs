@@ -141,16 +141,14 @@ pub struct CommitFacts {
 }
 
 impl CommitFacts {
-    /// What `git` in `repo` knows of `commit` (nothing when git or the commit is missing).
+    /// What `git` in `repo` knows of `commit` (nothing when git or the commit is missing,
+    /// or when `commit` is not a commit hash: git is never asked about other text).
     pub fn of(repo: &Path, commit: &str) -> CommitFacts {
-        if commit.is_empty() {
+        let Some(commit) = crate::git::Rev::recorded(commit) else {
             return CommitFacts::default();
-        }
-        let git = |args: &[&str]| -> Option<String> {
-            let out = std::process::Command::new("git")
-                .arg("-C")
-                .arg(repo)
-                .args(args)
+        };
+        let git = |args: &[&str], rev: &crate::git::Rev| -> Option<String> {
+            let out = crate::git::command(repo, args, &[rev])
                 .stderr(std::process::Stdio::null())
                 .output()
                 .ok()?;
@@ -158,8 +156,8 @@ impl CommitFacts {
             (out.status.success() && !text.trim().is_empty()).then(|| text.trim().to_string())
         };
         CommitFacts {
-            parent: git(&["rev-parse", "--verify", "--quiet", &format!("{commit}^")]),
-            date: git(&["show", "-s", "--format=%cI", commit]),
+            parent: git(&["rev-parse", "--verify", "--quiet"], &commit.parent()),
+            date: git(&["show", "-s", "--format=%cI"], &commit),
         }
     }
 }

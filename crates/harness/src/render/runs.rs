@@ -6,6 +6,7 @@ use super::tables;
 use crate::analysis::Analysis;
 use crate::analysis::groups::Point;
 use crate::units::{Duration, Percent};
+use nbody_engine::output::neutral::markdown::{self, code};
 use nbody_records::external::config::TimeUnit;
 use nbody_records::external::{External, TimeSource};
 use std::fmt::Write;
@@ -29,11 +30,13 @@ pub fn external_runs(a: &Analysis) -> String {
             .externals
             .iter()
             .find(|v| v.name == e.name)
-            .map_or(String::new(), |v| format!(" ({})", v.version));
+            .map_or(String::new(), |v| {
+                format!(" ({})", markdown::text(&v.version))
+            });
         let _ = write!(
             md,
-            "- `{}`{version}: {}",
-            e.name,
+            "- {}{version}: {}",
+            code(&e.name),
             code(&command_line(
                 &[&a.external_launcher[..], &e.command[..]].concat()
             ))
@@ -111,15 +114,6 @@ pub(crate) fn command_line(tokens: &[String]) -> String {
         .join(" ")
 }
 
-/// Inline code that holds any text, backticks included.
-fn code(text: &str) -> String {
-    if text.contains('`') {
-        format!("`` {text} ``")
-    } else {
-        format!("`{text}`")
-    }
-}
-
 /// The phases external programs timed themselves, case by case: each phase per step with its
 /// share of the step, then the serial and the communication shares. Empty when no case has any.
 pub fn external_phases(a: &Analysis) -> String {
@@ -172,7 +166,7 @@ pub fn external_phases(a: &Analysis) -> String {
                 };
                 format!(
                     "{}{kind}: {} ({})",
-                    p.name,
+                    markdown::text(&p.name),
                     Duration(p.s_per_step),
                     Percent(p.s_per_step / step)
                 )
@@ -219,6 +213,6 @@ mod tests {
             command_line(&argv),
             "lmp -sf opt -var data {workdir}/state.data 'a b' 'it'\\''s' ''"
         );
-        assert_eq!(code("x`y"), "`` x`y ``");
+        assert_eq!(code("x`y"), "``x`y``");
     }
 }

@@ -4,6 +4,7 @@
 use super::analysis_figures::Figure;
 use super::tables;
 use crate::analysis::Analysis;
+use nbody_engine::output::neutral::markdown::code;
 use std::fmt::Write;
 
 /// The text of `summary.md` for `a`, linking `figures` as `<stem>.svg` beside it.
@@ -11,8 +12,9 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     let mut md = String::new();
     let _ = writeln!(
         md,
-        "# Analysis of sweep `{}` ({:?} study)\n",
-        a.name, a.study
+        "# Analysis of sweep {} ({:?} study)\n",
+        code(&a.name),
+        a.study
     );
     let _ = writeln!(md, "{}\n", super::analysis_figures::caption(a));
     if let Some(c) = &a.calibration {

@@ -8,6 +8,7 @@ use crate::analysis::forking;
 use crate::analysis::groups::Point;
 use crate::analysis::{Analysis, Fitted};
 use crate::units::{Duration, Percent, Plain, WithCi};
+use nbody_engine::output::neutral::control::visible;
 use nbody_engine::physics::LawKind;
 use std::fmt::Write;
 
@@ -84,16 +85,21 @@ impl Table {
 impl Table {
     /// The header and the rows as aligned text for a terminal: each column as wide as its
     /// widest cell (in characters), right-aligned columns padded on the left, one space between
-    /// columns, no trailing spaces.
+    /// columns, no trailing spaces. A cell's control characters (a case key from someone
+    /// else's file may hold ESC sequences) are shown escaped.
     pub fn text(&self) -> String {
+        let shown: Vec<Vec<String>> = std::iter::once(&self.header)
+            .chain(&self.rows)
+            .map(|r| r.iter().map(|c| visible(c).into_owned()).collect())
+            .collect();
         let mut widths = vec![0; self.header.len()];
-        for r in std::iter::once(&self.header).chain(&self.rows) {
+        for r in &shown {
             for (w, c) in widths.iter_mut().zip(r) {
                 *w = (*w).max(c.chars().count());
             }
         }
         let mut out = String::new();
-        for r in std::iter::once(&self.header).chain(&self.rows) {
+        for r in &shown {
             let mut line = String::new();
             for ((c, w), a) in r.iter().zip(&widths).zip(&self.align) {
                 let pad = " ".repeat(w - c.chars().count());

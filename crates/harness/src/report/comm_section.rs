@@ -10,6 +10,7 @@ use crate::render::analysis_figures::Figure;
 use crate::render::tables::{self, Table};
 use crate::units::{Duration, Plain, WithCi};
 use nbody_engine::decomp::Decomposition;
+use nbody_engine::output::neutral::markdown::{self, code};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -98,9 +99,9 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
     for s in &mpi {
         let _ = writeln!(
             md,
-            "From `{}`: per step, the mean over ranks of the time inside MPI calls (the Coulomb MPI tutorial's communication \
+            "From {}: per step, the mean over ranks of the time inside MPI calls (the Coulomb MPI tutorial's communication \
              time) and of the bytes sent, next to the step time. * = oversubscribed (more ranks than logical CPUs).\n",
-            s.analysis.source
+            code(&s.analysis.source)
         );
         let mut table = Table::new([
             "decomposition",
@@ -132,11 +133,11 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
             Some(f) => {
                 let _ = writeln!(
                     md,
-                    "α-β fit of the ping-pong in `{}` ({} ranks{}): latency α = {:.3} µs, inverse bandwidth β = {:.4} ns/byte \
+                    "α-β fit of the ping-pong in {} ({} ranks{}): latency α = {:.3} µs, inverse bandwidth β = {:.4} ns/byte \
                      (bootstrap 95% CIs). **Prediction** (not measured) for a weak-scaling series of lj-box with \
                      n = {}·p, f32: replicated data moves every position each step (⌈log2 p⌉ latencies + the gathered \
                      bytes), the spatial decomposition only ghosts within rc of the region borders.\n",
-                    m.source,
+                    code(&m.source),
                     m.bench_ranks,
                     if m.bench_oversubscribed {
                         ", oversubscribed"
@@ -171,9 +172,9 @@ pub fn section(md: &mut String, sweeps: &[Sweep], comm: Option<&Comm>, no_notes:
             None => {
                 let _ = writeln!(
                     md,
-                    "The α-β fit of `{}` failed: {}\n",
-                    m.source,
-                    m.alpha_beta.error.as_deref().unwrap_or("")
+                    "The α-β fit of {} failed: {}\n",
+                    code(&m.source),
+                    markdown::text(m.alpha_beta.error.as_deref().unwrap_or(""))
                 );
             }
         }

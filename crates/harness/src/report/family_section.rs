@@ -8,6 +8,7 @@ use super::keep::region;
 use crate::analysis::family::Family;
 use crate::render::family_tables;
 use nbody_engine::kernels::KernelKind;
+use nbody_engine::output::neutral::markdown::code;
 use std::fmt::Write;
 
 pub(crate) fn section(md: &mut String, sweeps: &[Sweep], no_notes: &str) {
@@ -39,7 +40,7 @@ pub(crate) fn section(md: &mut String, sweeps: &[Sweep], no_notes: &str) {
         );
     }
     for (s, families) in shown {
-        let _ = writeln!(md, "From `{}`.\n", s.analysis.source);
+        let _ = writeln!(md, "From {}.\n", code(&s.analysis.source));
         md.push_str(&family_tables::markdown(&families));
     }
     md.push_str(&region("family", no_notes));

@@ -4,6 +4,7 @@ use super::Sweep;
 use super::keep::region;
 use crate::render::tables::{self, Table};
 use nbody_calibrate::Calibration;
+use nbody_engine::output::neutral::markdown::{cell_code, code};
 use nbody_records::config::Study;
 use std::fmt::Write;
 use std::path::Path;
@@ -135,7 +136,7 @@ fn machine(md: &mut String, sweeps: &[Sweep]) {
         };
         let commit: String = a.metadata.git_commit.chars().take(7).collect();
         table.row([
-            format!("`{}`", a.source),
+            cell_code(&a.source),
             format!("{:?}", a.study),
             format!("{}{incomplete}", a.cases.len()),
             format!(
@@ -192,9 +193,9 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
         let a = &s.analysis;
         let _ = writeln!(
             md,
-            "From `{}`. Time per step at the largest n, the free power law `T = c·n^k` (bootstrap 95% CI) and the \
+            "From {}. Time per step at the largest n, the free power law `T = c·n^k` (bootstrap 95% CI) and the \
              complexity class chosen by leave-one-out cross-validation (SMAPE). {}\n",
-            a.source,
+            code(&a.source),
             tables::peak_note()
         );
         md.push_str(&tables::complexity(a));
@@ -224,10 +225,10 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
         let a = &s.analysis;
         let _ = writeln!(
             md,
-            "From `{}`. Speedup S = T(1)/T(p) with bootstrap 95% CI, and relative to the calibrated hardware \
+            "From {}. Speedup S = T(1)/T(p) with bootstrap 95% CI, and relative to the calibrated hardware \
              ceiling. Cases marked * ran more threads than logical CPUs (oversubscribed): they show the cost of \
              oversubscription, not parallel speedup.\n",
-            a.source
+            code(&a.source)
         );
         md.push_str(&tables::strong(a));
         md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
@@ -254,9 +255,9 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
         let rule = a.weak[0].rule.map(|r| format!("{r:?}")).unwrap_or_default();
         let _ = writeln!(
             md,
-            "From `{}` (rule: {rule}). Efficiency T(1)/T(p) of the scaled problem with 95% CI, and Gustafson's serial \
+            "From {} (rule: {rule}). Efficiency T(1)/T(p) of the scaled problem with 95% CI, and Gustafson's serial \
              fraction α from S(p) = p − α(p − 1). * = oversubscribed.\n",
-            a.source
+            code(&a.source)
         );
         md.push_str(&tables::weak(a));
         md.push_str(&tables::after_table(&tables::weak_one_thread_notes(a)));
@@ -279,8 +280,8 @@ fn octree(md: &mut String, sweeps: &[Sweep]) {
     for s in with {
         let _ = writeln!(
             md,
-            "From `{}`. Relative force error against an f64 direct sum on sampled particles.\n",
-            s.analysis.source
+            "From {}. Relative force error against an f64 direct sum on sampled particles.\n",
+            code(&s.analysis.source)
         );
         md.push_str(&tables::theta(&s.analysis));
         md.push('\n');
@@ -312,7 +313,7 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
     }
     for s in with {
         let a = &s.analysis;
-        let _ = writeln!(md, "From `{}`.\n", a.source);
+        let _ = writeln!(md, "From {}.\n", code(&a.source));
         md.push_str(&crate::render::runs::external_runs(a));
         md.push('\n');
         md.push_str(&tables::peers(a));

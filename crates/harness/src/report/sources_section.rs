@@ -10,6 +10,7 @@ use super::keep::region;
 use crate::analysis::Analysis;
 use crate::render::tables;
 use crate::units::Percent;
+use nbody_engine::output::neutral::markdown::code;
 use nbody_records::external::PhaseKind;
 use std::fmt::Write;
 
@@ -70,11 +71,11 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
             let _ = writeln!(
                 md,
                 "Strong scaling of the galaxy at 2000 bodies over MPI ranks, split by the report's \
-                 octants and by locally essential trees, from `{}`. Speedup T(1)/T(p) with 95% CI; \
+                 octants and by locally essential trees, from {}. Speedup T(1)/T(p) with 95% CI; \
                  * = more ranks than logical CPUs (left out of the fits). The report times its \
                  sequential phases to estimate the serial fraction; the harness does the same with its \
                  phase timers and sets the result beside the fraction fitted to the speedups:\n",
-                a.source
+                code(&a.source)
             );
             md.push_str(&tables::strong(a));
             md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
@@ -100,9 +101,9 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
                 let a = &s.analysis;
                 let _ = writeln!(
                     md,
-                    "Weak scaling, {what}, from `{}`: efficiency T(1)/T(p) with 95% CI and \
+                    "Weak scaling, {what}, from {}: efficiency T(1)/T(p) with 95% CI and \
                      Gustafson's serial fraction.\n",
-                    a.source
+                    code(&a.source)
                 );
                 md.push_str(&tables::weak(a));
                 md.push_str(&tables::after_table(&tables::weak_one_thread_notes(a)));
@@ -122,9 +123,9 @@ fn lj_box(md: &mut String, sweeps: &[Sweep]) {
         md,
         "The course's codes, written anew in C (`examples/course-codes/`: serial, OpenMP with \
          per-thread buffers, MPI with Allgatherv, and the Coulomb tutorial's MPI code), measured \
-         beside our kernels in the same rounds, from `{}`. Each C code times its own phases; the \
+         beside our kernels in the same rounds, from {}. Each C code times its own phases; the \
          table gives them per step.\n",
-        a.source
+        code(&a.source)
     );
     md.push_str(&crate::render::runs::external_phases(a));
     md.push_str(
@@ -198,8 +199,8 @@ fn coulomb(md: &mut String, sweeps: &[Sweep]) {
     let _ = writeln!(
         md,
         "The tutorial times communication and computation apart; its code, written anew \
-         (`coulomb_mpi`), does the same, from `{}`:\n",
-        s.analysis.source
+         (`coulomb_mpi`), does the same, from {}:\n",
+        code(&s.analysis.source)
     );
     md.push_str(&lines.join("\n"));
     md.push_str("\n\n");

@@ -7,6 +7,7 @@ use super::keep::region;
 use crate::analysis::tree_comm::{TREE_DECOMPS, Transport, TreeComm};
 use crate::render::tables::{self, Table};
 use crate::units::{Bytes, Duration, WithCi};
+use nbody_engine::output::neutral::markdown::{self, code};
 use std::fmt::Write;
 
 pub fn section(md: &mut String, tree: Option<&TreeComm>, no_notes: &str) {
@@ -82,8 +83,9 @@ fn counted_table(t: &TreeComm) -> Table {
 fn transport(md: &mut String, tr: &Transport) {
     let _ = write!(
         md,
-        "**{}**, α-β from the ping-pong of `{}`",
-        tr.name, tr.bench
+        "**{}**, α-β from the ping-pong of {}",
+        markdown::text(&tr.name),
+        code(&tr.bench)
     );
     match &tr.alpha_beta.fit {
         Some(f) => {

@@ -25,6 +25,7 @@
 pub mod probe;
 
 use crate::gate::{Verdict, judge_pair, prefix};
+use crate::git::Rev;
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
@@ -204,34 +205,28 @@ impl Bisection {
 /// The commits after `good` up to `bad` along the first parents, oldest first, with `good`
 /// in front: index 0 is GOOD, the last is BAD. `good` must be an ancestor of `bad`.
 pub fn first_parent_path(repo: &Path, good: &str, bad: &str) -> anyhow::Result<Vec<String>> {
-    let git = |args: &[&str]| {
-        std::process::Command::new("git")
-            .arg("-C")
-            .arg(repo)
-            .args(args)
+    let git = |args: &[&str], revs: &[&Rev]| {
+        crate::git::command(repo, args, revs)
             .output()
             .map_err(|e| anyhow::anyhow!("cannot run git: {e}"))
     };
-    let resolve = |rev: &str| -> anyhow::Result<String> {
-        let out = git(&[
-            "rev-parse",
-            "--verify",
-            "--quiet",
-            &format!("{rev}^{{commit}}"),
-        ])?;
-        if !out.status.success() {
-            anyhow::bail!("`{rev}` names no commit of {}", repo.display());
+    let resolve = |which: &str, rev: &str| -> anyhow::Result<Rev> {
+        let given = Rev::given(rev).map_err(|why| anyhow::anyhow!("{which} {why}"))?;
+        let out = git(&["rev-parse", "--verify", "--quiet"], &[&given.commit()])?;
+        let full = String::from_utf8_lossy(&out.stdout).trim().to_string();
+        match Rev::recorded(&full) {
+            Some(full) if out.status.success() => Ok(full),
+            _ => anyhow::bail!("`{rev}` names no commit of {}", repo.display()),
         }
-        Ok(String::from_utf8_lossy(&out.stdout).trim().to_string())
     };
-    let (g, b) = (resolve(good)?, resolve(bad)?);
+    let (g, b) = (resolve("GOOD", good)?, resolve("BAD", bad)?);
     if g == b {
         anyhow::bail!(
             "GOOD and BAD are the same commit ({}): nothing lies between them",
-            prefix(&g, 12)
+            prefix(g.as_str(), 12)
         );
     }
-    if !git(&["merge-base", "--is-ancestor", &g, &b])?
+    if !git(&["merge-base", "--is-ancestor"], &[&g, &b])?
         .status
         .success()
     {
@@ -240,12 +235,11 @@ pub fn first_parent_path(repo: &Path, good: &str, bad: &str) -> anyhow::Result<V
              the newer, slow one second (BAD)"
         );
     }
-    let out = git(&[
-        "rev-list",
-        "--first-parent",
-        "--reverse",
-        &format!("{g}..{b}"),
-    ])?;
+    let out = git(
+        &["rev-list", "--first-parent", "--reverse"],
+        &[&Rev::range(&g, &b)],
+    )?;
+    let (g, b) = (g.to_string(), b.to_string());
     let mut path = vec![g.clone()];
     path.extend(
         String::from_utf8_lossy(&out.stdout)

@@ -8,6 +8,7 @@ use super::{CaseView, Chart, ClassView, Page, esc, short};
 use crate::gate::Verdict;
 use crate::history::series::Metric;
 use crate::history::verdicts::GateRun;
+use nbody_engine::output::neutral::url;
 use std::fmt::Write;
 
 const STYLE: &str = r#"
@@ -284,13 +285,13 @@ fn figures(o: &mut String, page: &Page) {
     }
     o.push_str("<h2 id=\"figures\">Figures of REPORT.md</h2>\n<ul class=\"figures\">\n");
     for f in &page.figures {
-        let _ = writeln!(
-            o,
-            "<li><a href=\"{}\">{}</a> <code>{}</code></li>",
-            esc(&f.href),
-            esc(&f.title),
-            esc(&f.path)
-        );
+        // The link comes from REPORT.md's text: a link that is not to a document (a
+        // `javascript:` URL) is shown, not followed.
+        let title = match url::href(&f.href) {
+            Some(href) => format!("<a href=\"{}\">{}</a>", esc(href), esc(&f.title)),
+            None => esc(&f.title),
+        };
+        let _ = writeln!(o, "<li>{title} <code>{}</code></li>", esc(&f.path));
     }
     o.push_str("</ul>\n");
 }

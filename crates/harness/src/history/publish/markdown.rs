@@ -6,11 +6,13 @@ use super::chart::{percent, value};
 use super::html::gate_commits;
 use super::{Chart, ClassView, Page, short};
 use crate::gate::Verdict;
+use crate::git::Rev;
 use crate::history::steps::Step;
 use crate::render::tables::{Align, Table};
+use nbody_engine::output::neutral::markdown::{cell_code, code, text};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 /// The commit the summary counts from.
 #[derive(Clone, Debug)]
@@ -36,14 +38,11 @@ pub fn resolve(repo: &Path, given: Option<&str>, page: &Page) -> Result<Base, St
         none: None,
     };
     if let Some(given) = given {
+        let rev = Rev::given(given).map_err(|why| format!("--base {why}"))?;
         if let Some(full) = git(
             repo,
-            &[
-                "rev-parse",
-                "--verify",
-                "--quiet",
-                &format!("{given}^{{commit}}"),
-            ],
+            &["rev-parse", "--verify", "--quiet"],
+            &[&rev.commit()],
         ) {
             return Ok(base(short(&full).to_string(), Some(full)));
         }
@@ -58,10 +57,16 @@ pub fn resolve(repo: &Path, given: Option<&str>, page: &Page) -> Result<Base, St
              a commit of the history or a revision of this repository"
         ));
     }
-    if let Some(full) = git(repo, &["merge-base", "HEAD", "origin/main"]) {
+    let head = Rev::given("HEAD").expect("HEAD is a revision");
+    let main = Rev::given("origin/main").expect("origin/main is a revision");
+    if let Some(full) = git(repo, &["merge-base"], &[&head, &main]) {
         return Ok(base(short(&full).to_string(), Some(full)));
     }
-    if let Some(full) = git(repo, &["rev-parse", "--verify", "--quiet", "HEAD^"]) {
+    if let Some(full) = git(
+        repo,
+        &["rev-parse", "--verify", "--quiet"],
+        &[&head.parent()],
+    ) {
         return Ok(base(short(&full).to_string(), Some(full)));
     }
     Ok(Base {
@@ -76,11 +81,8 @@ pub fn resolve(repo: &Path, given: Option<&str>, page: &Page) -> Result<Base, St
     })
 }
 
-fn git(repo: &Path, args: &[&str]) -> Option<String> {
-    let out = Command::new("git")
-        .arg("-C")
-        .arg(repo)
-        .args(args)
+fn git(repo: &Path, args: &[&str], revs: &[&Rev]) -> Option<String> {
+    let out = crate::git::command(repo, args, revs)
         .stderr(Stdio::null())
         .output()
         .ok()?;
@@ -104,16 +106,21 @@ impl Base {
         if let Some(at) = chart.series.points.iter().position(|p| mine(&p.commit)) {
             return step.index > at;
         }
-        let Some(full) = &self.commit else {
+        let Some(full) = self.commit.as_deref().and_then(Rev::recorded) else {
             return true;
         };
-        let status = Command::new("git")
-            .arg("-C")
-            .arg(&self.repo)
-            .args(["merge-base", "--is-ancestor", &step.between[1], full])
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status();
+        // The step's commit comes from a history file: git hears of it only as a hash.
+        let Some(after) = Rev::recorded(&step.between[1]) else {
+            return true;
+        };
+        let status = crate::git::command(
+            &self.repo,
+            &["merge-base", "--is-ancestor"],
+            &[&after, &full],
+        )
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status();
         // 0: an ancestor of the base (before it); 1: not; anything else: git does not know it.
         !matches!(status.map(|s| s.code()), Ok(Some(0)))
     }
@@ -127,15 +134,15 @@ pub fn summary(page: &Page, base: &Base) -> String {
         .map(|c| (c, c.steps.iter().filter(|s| base.precedes(c, s)).collect()))
         .collect();
     let total: usize = found.iter().map(|(_, s)| s.len()).sum();
-    let _ = writeln!(o, "### Performance history since `{}`\n", base.name);
+    let _ = writeln!(o, "### Performance history since {}\n", code(&base.name));
     if let Some(why) = &base.none {
         let _ = writeln!(o, "_{why}._\n");
     }
     if total == 0 {
         let _ = writeln!(
             o,
-            "No change since `{}` in any of {} cases on {} machine class{}.\n",
-            base.name,
+            "No change since {} in any of {} cases on {} machine class{}.\n",
+            code(&base.name),
             page.cases.len(),
             page.classes.len(),
             if page.classes.len() == 1 { "" } else { "es" }
@@ -150,13 +157,13 @@ pub fn summary(page: &Page, base: &Base) -> String {
         let _ = writeln!(
             o,
             "**{}** ({} commits, newest measurement {})",
-            class.class,
+            text(&class.class),
             class.commits,
-            class.newest.as_deref().unwrap_or("unknown")
+            text(class.newest.as_deref().unwrap_or("unknown"))
         );
         o.push('\n');
         if count == 0 {
-            let _ = writeln!(o, "No change since `{}`.\n", base.name);
+            let _ = writeln!(o, "No change since {}.\n", code(&base.name));
         } else {
             o.push_str(&steps_table(&mine).markdown());
             o.push('\n');
@@ -187,8 +194,12 @@ fn steps_table(mine: &[&(&Chart, Vec<&Step>)]) -> Table {
         let s = &c.series;
         for st in steps {
             t.row([
-                format!("`{}`", s.case.replace('|', "\\|")),
-                format!("`{}..{}`", short(&st.between[0]), short(&st.between[1])),
+                cell_code(&s.case),
+                cell_code(&format!(
+                    "{}..{}",
+                    short(&st.between[0]),
+                    short(&st.between[1])
+                )),
                 format!(
                     "{} → {}",
                     value(s.metric, st.before),
@@ -220,9 +231,9 @@ fn latest_gate(o: &mut String, class: &ClassView) {
     let count = |v: Verdict| g.cases.iter().filter(|c| c.verdict == v).count();
     let _ = writeln!(
         o,
-        "Latest gate run ({}, `{}`, threshold ±{}%): {} regressed, {} improved, {} unchanged{}.\n",
-        g.measured,
-        gate_commits(g),
+        "Latest gate run ({}, {}, threshold ±{}%): {} regressed, {} improved, {} unchanged{}.\n",
+        text(&g.measured),
+        code(&gate_commits(g)),
         100.0 * g.threshold,
         count(Verdict::Regressed),
         count(Verdict::Improved),
@@ -234,19 +245,16 @@ fn latest_gate(o: &mut String, class: &ClassView) {
         }
     );
     if let Some(a) = &g.acceptance {
-        // A regression let into the baseline on purpose is shown as such, with why.
-        // The reason and keys come from a history file: one line, HTML escaped, no backtick
-        // that could close the code span, so that they stay text in the job summary.
-        let keys: Vec<String> = (a.cases.iter())
-            .map(|c| format!("`{}`", c.key.replace(['`', '|'], "'")))
-            .collect();
+        // A regression let into the baseline on purpose is shown as such, with why. The
+        // reason and keys come from a history file: they stay text in the summary.
+        let keys: Vec<String> = a.cases.iter().map(|c| code(&c.key)).collect();
         let reason = a.reason.split_whitespace().collect::<Vec<_>>().join(" ");
         let _ = writeln!(
             o,
             "Accepted into the baseline when it was saved ({}): {}, because: {}\n",
-            a.accepted,
+            text(&a.accepted),
             keys.join(", "),
-            super::esc(&reason)
+            text(&reason)
         );
     }
     let judged: Vec<_> = g
@@ -263,7 +271,7 @@ fn latest_gate(o: &mut String, class: &ClassView) {
         ]);
         for c in judged {
             t.row([
-                format!("`{}`", c.key.replace('|', "\\|")),
+                cell_code(&c.key),
                 c.verdict.name().to_string(),
                 format!("{:.3}", c.ratio),
                 format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),

@@ -61,6 +61,17 @@ pub enum PublishError {
         /// What is wrong with the series.
         source: ChangeError,
     },
+    /// The report whose figures the page links exists but cannot be read.
+    #[error(
+        "cannot read --report {path}: {source} (the page links the figures of REPORT.md, a \
+         file beside them)"
+    )]
+    Report {
+        /// The report.
+        path: PathBuf,
+        /// Why it cannot be read.
+        source: std::io::Error,
+    },
     /// The page, or its folder, cannot be written.
     #[error("cannot write the page: {0}; choose a folder you can write to with --out")]
     Write(#[from] nbody_engine::output::WriteError),
@@ -284,7 +295,11 @@ pub fn page(loaded: &Loaded, figures: Vec<Figure>) -> Result<Page, PublishError>
 /// and what the test of the committed page compares it with.
 pub fn build(dir: &Path, report: &Path, out: &Path) -> Result<(Page, Vec<String>), PublishError> {
     let loaded = load(dir)?;
-    let page = page(&loaded, report_figures::figures(report, out))?;
+    let figures = report_figures::figures(report, out).map_err(|source| PublishError::Report {
+        path: report.to_path_buf(),
+        source,
+    })?;
+    let page = page(&loaded, figures)?;
     Ok((page, loaded.warnings))
 }
 

@@ -16,12 +16,20 @@ pub struct Figure {
     pub href: String,
 }
 
-/// The figures `report` shows that exist, linked from the folder `out` (which must exist); an
-/// unreadable report has none.
-pub fn figures(report: &Path, out: &Path) -> Vec<Figure> {
-    let Ok(text) = std::fs::read_to_string(report) else {
-        return Vec::new();
+/// The figures `report` shows that exist, linked from the folder `out` (which must exist); a
+/// missing report has none. The report is read as a regular file only (its figures are found
+/// beside it): a pipe or a device is an error, not a wait.
+pub fn figures(report: &Path, out: &Path) -> std::io::Result<Vec<Figure>> {
+    let text = match nbody_engine::input::read_file_text(report) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => return Err(e),
     };
+    Ok(linked(report, &text, out))
+}
+
+/// The figures of the report at `report` (its `text`) that exist, linked from `out`.
+fn linked(report: &Path, text: &str, out: &Path) -> Vec<Figure> {
     let (Some(base), Ok(out)) = (
         report
             .parent()
@@ -38,7 +46,7 @@ pub fn figures(report: &Path, out: &Path) -> Vec<Figure> {
         return Vec::new();
     };
     let mut found: Vec<(PathBuf, Figure)> = Vec::new();
-    for (title, target) in image_links(&text) {
+    for (title, target) in image_links(text) {
         // Only files of the repository, never a URL or an absolute path.
         if target.contains("://") || target.starts_with('/') {
             continue;
@@ -111,7 +119,7 @@ mod tests {
              ![again](results/a/analysis/t.svg) ![web](https://example.org/x.png)\n",
         )
         .unwrap();
-        let found = figures(&root.join("REPORT.md"), &root.join("results/history/page"));
+        let found = figures(&root.join("REPORT.md"), &root.join("results/history/page")).unwrap();
         assert_eq!(
             found,
             [Figure {
@@ -120,6 +128,6 @@ mod tests {
                 href: "../../a/analysis/t.svg".into()
             }]
         );
-        assert!(figures(&root.join("missing.md"), root).is_empty());
+        assert!(figures(&root.join("missing.md"), root).unwrap().is_empty());
     }
 }
