@@ -3,6 +3,7 @@
 //! (`nbody_harness::history::tidy::records`).
 
 use crate::cli::args::ExportResultsArgs;
+use nbody_engine::output::neutral::control::visible;
 use nbody_harness::history::store::{self, HISTORY_SCHEMA, History};
 use nbody_records::locate;
 use nbody_records::results::ResultsFile;
@@ -146,7 +147,7 @@ fn history_table(input: &HistoryInput) -> (TidyTable, String) {
     let mut records = Vec::new();
     for (file, history) in &input.files {
         for bad in &history.bad {
-            eprintln!("warning: {}", bad.warning(file));
+            eprintln!("warning: {}", visible(&bad.warning(file)));
         }
         records.extend(history.records.iter().cloned());
     }
