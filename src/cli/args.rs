@@ -429,7 +429,7 @@ pub struct ValidateArgs {
     pub yes: bool,
 }
 
-fn parse_count(s: &str) -> Result<usize, String> {
+pub(crate) fn parse_count(s: &str) -> Result<usize, String> {
     match s.parse::<usize>() {
         Ok(0) => Err("must be at least 1".into()),
         Ok(v) => Ok(v),
@@ -509,7 +509,7 @@ fn parse_threshold(s: &str) -> Result<f64, String> {
 }
 
 /// A/B rounds per build: even, from 2 to `gate::ab::MAX_ROUNDS`.
-fn parse_ab_rounds(s: &str) -> Result<usize, String> {
+pub(crate) fn parse_ab_rounds(s: &str) -> Result<usize, String> {
     let v = s
         .parse::<usize>()
         .map_err(|_| format!("`{s}` is not a whole number"))?;

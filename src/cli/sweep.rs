@@ -27,6 +27,9 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         .filter(|p| !p.as_os_str().is_empty() && !from_pipe)
         .map(Path::to_path_buf);
     let target = where_to_write(&args, &config)?;
+    if let Some(history) = &args.record {
+        super::history::check_record_dir("--record", history)?;
+    }
     if let Some(code) = dry_run(&args, &config, &target, &config_dir)? {
         return Ok(code);
     }
@@ -125,15 +128,16 @@ fn analyze_and_record(args: &SweepArgs, results: &ResultsFile, path: &Path) -> a
         Err(e) => eprintln!(
             "warning: analysis failed ({}); the results are saved, retry with `nbody-bench analyze {}`",
             super::error_chain(&e),
-            path.display()
+            super::hint::arg(path)
         ),
     }
     if let Some(history) = &args.record {
         let appended = super::history::append_results(history, results, "sweep");
         let appended = anyhow::Context::with_context(appended, || {
             format!(
-                "the results are saved in {p}; record them with `nbody-bench history record {p}`",
-                p = path.display()
+                "the results are saved in {}; record them with `nbody-bench history record {}`",
+                path.display(),
+                super::hint::arg(path)
             )
         })?;
         for (to, count) in appended {

@@ -248,7 +248,8 @@ fn round_s(config: &SweepConfig, at_n: &Probe, step_s: f64, energy_s: f64, sampl
     ROUND_OVERHEAD_S
         + at_n.build_s
         + 3.0 * energy_s
-        + m.warmup_s.max(step_s)
+        // The warm-up takes at least the cold step and one more (`measure`).
+        + m.warmup_s.max(2.0 * step_s)
         + samples as f64 * (k * step_s + reference)
         + error
 }

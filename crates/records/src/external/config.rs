@@ -236,9 +236,11 @@ impl Steps {
     }
 }
 
-/// Letters, digits, '-', '_' and '.', not empty: what names a case or a family.
+/// Letters, digits, '-', '_' and '.', not empty and not starting with '-': what names a case
+/// or a family (a name starting with '-' would read as an option where a command names it).
 pub fn plain_name(name: &str) -> bool {
     !name.is_empty()
+        && !name.starts_with('-')
         && name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
@@ -409,7 +411,8 @@ impl External {
             return Err((
                 "external.name".into(),
                 format!(
-                    "is `{}`: it must be letters, digits, '-', '_' and '.' (it names the cases)",
+                    "is `{}`: it must be letters, digits, '-', '_' and '.', not starting with \
+                     '-' (it names the cases)",
                     self.name
                 ),
             ));
@@ -542,7 +545,10 @@ impl External {
             if !plain_name(name) {
                 return self.invalid(
                     "phases",
-                    format!("has a phase named `{name}`: use letters, digits, '-', '_' and '.'"),
+                    format!(
+                        "has a phase named `{name}`: use letters, digits, '-', '_' and '.', not \
+                         starting with '-'"
+                    ),
                 );
             }
             if let Err(e) = number_regex(&phase.regex, "phase comm ([0-9.eE+-]+)") {
@@ -581,7 +587,9 @@ impl External {
         if !plain_name(f) {
             return self.invalid(
                 "family",
-                format!("is `{f}`: it must be letters, digits, '-', '_' and '.'"),
+                format!(
+                    "is `{f}`: it must be letters, digits, '-', '_' and '.', not starting with '-'"
+                ),
             );
         }
         // A family names a series in tables and figures beside the built-in kernels' own.
