@@ -192,33 +192,25 @@ fn gate_report(path: &Path) -> anyhow::Result<Option<GateRun>> {
 /// files can be written. A sweep or a gate that measured for an hour must not fail at the end
 /// on a destination it could have refused at the start.
 pub fn check_record_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
-    let not_a_dir = |what: &Path| {
-        anyhow::anyhow!(
+    if let Some(part) = nbody_engine::output::not_a_directory(dir) {
+        bail!(
             "{flag} {}: {} is {}, where a directory is expected (the history is kept as \
              DIR/<machine class>.jsonl): pass a directory, new or existing",
             dir.display(),
-            what.display(),
-            if what.is_file() {
+            part.display(),
+            if part.is_file() {
                 "a file"
             } else {
                 "not a directory"
             }
-        )
-    };
+        );
+    }
     // The nearest part of the path that exists: the directory itself, or the one it would be
     // made in.
     let existing = dir
         .ancestors()
-        .find(|a| a.as_os_str().is_empty() || std::fs::symlink_metadata(a).is_ok())
+        .find(|a| !a.as_os_str().is_empty() && a.is_dir())
         .unwrap_or(Path::new("."));
-    let existing = if existing.as_os_str().is_empty() {
-        Path::new(".")
-    } else {
-        existing
-    };
-    if !existing.is_dir() {
-        return Err(not_a_dir(existing));
-    }
     let probe = if existing == dir {
         let m = nbody_harness::gate::route::this_machine();
         let class =
@@ -229,7 +221,7 @@ pub fn check_record_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
         // by writing (and removing) a file where it would go.
         let first_missing = dir
             .ancestors()
-            .take_while(|a| *a != existing)
+            .take_while(|a| *a != existing && !a.as_os_str().is_empty())
             .last()
             .unwrap_or(dir);
         first_missing.to_path_buf()

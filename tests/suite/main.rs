@@ -10,6 +10,7 @@ mod analyze;
 mod bad_input;
 mod bad_sizes;
 mod bisect;
+mod causes;
 mod checked_first;
 mod cli;
 mod config_corpus;

@@ -141,7 +141,7 @@ pub fn runs_dir(root: &Path, name: &str) -> PathBuf {
 /// of the same second exists), created empty.
 pub fn new_run_dir(root: &Path, name: &str, utc: &str) -> Result<PathBuf, LocateError> {
     let parent = runs_dir(root, name);
-    std::fs::create_dir_all(&parent).map_err(|source| LocateError::CreateRun {
+    nbody_engine::output::create_dir_all(&parent).map_err(|source| LocateError::CreateRun {
         path: parent.clone(),
         source,
     })?;
@@ -217,11 +217,17 @@ pub fn find_results(given: &Path, root: &Path) -> Result<PathBuf, LocateError> {
         return Ok(given.to_path_buf());
     }
     let mut looked = Vec::new();
-    let inside = given.join("results.json");
-    if inside.is_file() {
-        return Ok(inside);
+    if given.is_dir() {
+        let inside = given.join("results.json");
+        if inside.is_file() {
+            return Ok(inside);
+        }
+        looked.push(inside.display().to_string());
+    } else {
+        // A path that is no directory was looked for as the file itself (`results.json`, not
+        // `results.json/results.json`).
+        looked.push(given.display().to_string());
     }
-    looked.push(inside.display().to_string());
     if let Some(name) = config_name(given) {
         if let Some(latest) = runs(root, &name).pop() {
             return Ok(latest.join("results.json"));
@@ -308,7 +314,7 @@ mod tests {
             "{missing}"
         );
         let reference = root.path().join("quick");
-        std::fs::create_dir_all(&reference).unwrap();
+        nbody_engine::output::create_dir_all(&reference).unwrap();
         std::fs::write(reference.join("results.json"), "{}").unwrap();
         assert_eq!(
             find_results(Path::new("quick"), root.path()).unwrap(),

@@ -220,7 +220,7 @@ pub fn run_sweep<C: Clock>(
     }
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
+        nbody_engine::output::create_dir_all(dir).map_err(|source| SweepError::Dir {
             path: dir.into(),
             source,
         })?;
@@ -689,7 +689,7 @@ fn initial_bodies(
 /// results' fingerprint names.
 fn keep_initial(results: &Path, initial: &Initial) -> Result<PathBuf, SweepError> {
     let dir = results.parent().unwrap_or(Path::new(".")).join("initial");
-    std::fs::create_dir_all(&dir).map_err(|source| SweepError::Dir {
+    nbody_engine::output::create_dir_all(&dir).map_err(|source| SweepError::Dir {
         path: dir.clone(),
         source,
     })?;

@@ -90,7 +90,7 @@ pub(crate) fn measure_round(
     context: &Context,
 ) -> Result<RoundOutcome, ExternalError> {
     let dir = super::workdir(&context.work_root, &case.key());
-    std::fs::create_dir_all(&dir).map_err(|source| ExternalError::Workdir {
+    nbody_engine::output::create_dir_all(&dir).map_err(|source| ExternalError::Workdir {
         path: dir.clone(),
         source,
     })?;

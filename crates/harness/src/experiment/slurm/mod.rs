@@ -316,7 +316,7 @@ fn submit(
     resources: Resources,
     what: &str,
 ) -> Result<String, SlurmError> {
-    std::fs::create_dir_all(dir).map_err(|source| SlurmError::Dir {
+    nbody_engine::output::create_dir_all(dir).map_err(|source| SlurmError::Dir {
         path: dir.into(),
         source,
     })?;
