@@ -6,6 +6,7 @@
 //! runs the suite without them, then them with one test thread, so no other test loads the
 //! CPUs during their sweeps.
 
+mod after_failures;
 mod analyze;
 mod bad_input;
 mod bad_sizes;

@@ -42,6 +42,7 @@ pub fn plan(config: &SweepConfig, est: &Estimate) -> Table {
         ]);
     }
     for c in external_cases(config) {
+        let tried = est.external.iter().find(|e| e.case.key() == c.key());
         let steps = config
             .external
             .iter()
@@ -49,6 +50,20 @@ pub fn plan(config: &SweepConfig, est: &Estimate) -> Table {
             .map_or("-".to_string(), |e| {
                 format!("{} steps", crate::experiment::external::run::steps(e, &c))
             });
+        if let Some(e) = tried {
+            t.row([
+                c.key(),
+                c.n.to_string(),
+                c.threads.to_string(),
+                c.ranks.to_string(),
+                theta(c.theta),
+                e.rounds.to_string(),
+                e.samples.to_string(),
+                format!("{} ({steps})", Duration(e.step_s)),
+                WallTime(e.wall_s).to_string(),
+            ]);
+            continue;
+        }
         t.row([
             c.key(),
             c.n.to_string(),

@@ -206,7 +206,7 @@ impl Growth {
     }
 
     /// The cost of one step at `n`, in the rule's units.
-    fn cost(self, n: usize) -> f64 {
+    pub fn cost(self, n: usize) -> f64 {
         let n = n.max(1) as f64;
         match self {
             Growth::Linear => n,

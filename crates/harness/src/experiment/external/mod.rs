@@ -5,6 +5,7 @@
 
 pub mod process;
 pub mod run;
+pub mod trial;
 
 use nbody_records::external::{External, ExternalVersion, placeholders};
 use std::path::{Path, PathBuf};
