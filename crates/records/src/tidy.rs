@@ -259,7 +259,7 @@ pub fn samples(results: &ResultsFile) -> TidyTable {
                     Value::from(round.energy_drift.filter(|_| ours)),
                     Value::from(error_median),
                     Value::from(error_max),
-                    Value::from(ours.then_some(round.pairs_interacting)),
+                    Value::from(round.pairs_interacting.filter(|_| ours)),
                     Value::from(round.n),
                 ]);
                 row.extend(build.iter().cloned());
