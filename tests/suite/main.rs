@@ -24,6 +24,7 @@ mod export;
 mod export_history;
 mod export_results;
 mod external;
+mod external_energy;
 mod external_honesty;
 mod external_phases;
 mod fit_cli;

@@ -27,9 +27,10 @@ pub struct RoundOutcome {
     /// Interacting pairs in the final configuration; `None` (`null`) where nothing of ours
     /// counted them.
     pub pairs_interacting: Option<u64>,
-    /// Relative energy drift from the start of the warm-up to the end of the samples; `None`
-    /// (`null`) where nothing measured it: an external program, a job that ended without its
-    /// round, an MPI run of a system whose initial energy is zero.
+    /// Relative energy drift from the start of the warm-up to the end of the samples (an
+    /// external program with an `energy` pattern: the largest of its runs' drifts); `None`
+    /// (`null`) where nothing measured it: an external program without one, a job that ended
+    /// without its round, a system whose initial energy is zero.
     pub energy_drift: Option<f64>,
     /// Median and max relative force error against an f64 direct sum, when asked.
     pub force_error: Option<[f64; 2]>,

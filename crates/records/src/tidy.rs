@@ -256,7 +256,7 @@ pub fn samples(results: &ResultsFile) -> TidyTable {
                     Value::from(seconds),
                     Value::from(round.steps_per_sample),
                     Value::from(paired.then(|| round.reference_s[s])),
-                    Value::from(round.energy_drift.filter(|_| ours)),
+                    Value::from(round.energy_drift),
                     Value::from(error_median),
                     Value::from(error_max),
                     Value::from(round.pairs_interacting.filter(|_| ours)),

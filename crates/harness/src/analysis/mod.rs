@@ -413,7 +413,7 @@ fn engine_serial_fraction(
     kernel: KernelKind,
     dim: usize,
 ) -> Option<fit::TimedSerialFraction> {
-    let ph = &one.phases;
+    let ph = one.phases.as_ref()?;
     // Which phases ran on the pool's threads: the per-particle passes (kick, drift, walls)
     // and the cell and Verlet lists' binning fork from a size on; the interactions of
     // every kernel but `symmetric` do.

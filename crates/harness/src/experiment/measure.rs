@@ -147,9 +147,9 @@ fn measure<C: Clock>(
         step_ns,
         steps,
         warmup_steps: warm.len() as u64,
-        phases,
-        work,
-        pairs_interacting: sim.probe_work().pairs_interacting,
+        phases: Some(phases),
+        work: Some(work),
+        pairs_interacting: Some(sim.probe_work().pairs_interacting),
         // Relative to nothing when the initial energy is zero: not measured, as the MPI
         // drivers record it.
         energy_drift: (e0 != 0.0).then(|| (e1 - e0) / e0.abs()),

@@ -181,7 +181,7 @@ pub fn speedups(results: &ResultsFile) -> Vec<Speedup> {
                 one_thread: c.case.kernel.kernel().and_then(|k| {
                     // An external program counts no pairs: nothing to decide on.
                     s.pair_evals_per_s?;
-                    forking::one_thread(k, c.case.threads, c.case.ranks, s.pair_checks_per_step)
+                    forking::one_thread(k, c.case.threads, c.case.ranks, s.pair_checks_per_step?)
                 }),
             });
         }

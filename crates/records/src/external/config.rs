@@ -77,6 +77,17 @@ crate::config_keys::documented_keys! {
         /// Example: `force_error = 'error ([^ ]+) ([^ ]+)'`
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub force_error: Option<String>,
+        /// A regular expression whose group is the total energy the program prints: its first
+        /// match in a run is the energy at the start, its last the energy at the end, and their
+        /// relative change is the run's energy drift, checked against `measure.max_energy_drift`
+        /// as the built-in kernels' (a run whose output matches it fewer than twice is an error).
+        ///
+        /// Accepts a regular expression with one group around the number, such as energy =
+        /// 'total energy ([0-9.eE+-]+)'.
+        ///
+        /// Example: `energy = 'E = ([0-9.eE+-]+)'`
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub energy: Option<String>,
         /// Entries of one family are one code at several accuracy settings: their cases form one
         /// series of force error against cost, like a θ sweep.
         ///
@@ -554,6 +565,11 @@ impl External {
             if let Err(e) = number_regex(&phase.regex, "phase comm ([0-9.eE+-]+)") {
                 return self.invalid(&format!("phases.{name}.regex"), e);
             }
+        }
+        if let Some(e) = &self.energy
+            && let Err(e) = number_regex(e, "total energy ([0-9.eE+-]+)")
+        {
+            return self.invalid("energy", e);
         }
         if let Some(c) = &self.check
             && let Err(e) = regex::Regex::new(c)
