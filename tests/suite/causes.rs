@@ -84,23 +84,23 @@ fn a_file_where_a_directory_is_expected_is_named_as_such() {
     )
     .unwrap();
     let expected = "a-file is a file, where a directory is expected";
-    let o = bin()
+    let swept = bin()
         .current_dir(dir.path())
         .args(["sweep", "--config", "tiny.toml", "--out", "a-file"])
         .args(["--no-calibration", "--yes"])
         .output()
         .unwrap();
-    refused(&o, expected);
+    refused(&swept, expected);
     let quick = Path::new(env!("CARGO_MANIFEST_DIR")).join("results/quick/results.json");
-    let o = bin()
+    let analyzed = bin()
         .current_dir(dir.path())
         .arg("analyze")
         .arg(&quick)
         .args(["--out", "a-file/analysis"])
         .output()
         .unwrap();
-    refused(&o, expected);
-    for o in [&o] {
+    refused(&analyzed, expected);
+    for o in [&swept, &analyzed] {
         assert!(!text(&o.stderr).contains("os error"), "{}", text(&o.stderr));
     }
 }

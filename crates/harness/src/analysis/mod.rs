@@ -227,7 +227,7 @@ pub enum AnalysisError {
     #[error(
         "{path} has no successful sample to analyse: all {failed} measured case(s) failed \
          ({}); each one's errors are kept in the file",
-        crate::gate::listed(reasons)
+        first_of(reasons)
     )]
     AllFailed {
         /// The results file.
@@ -320,6 +320,16 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
         cases: groups.cases,
         failed,
     })
+}
+
+/// The first few of `items`, with how many more.
+fn first_of(items: &[String]) -> String {
+    const SHOWN: usize = 3;
+    let mut text = items[..items.len().min(SHOWN)].join("; ");
+    if items.len() > SHOWN {
+        text += &format!("; and {} more", items.len() - SHOWN);
+    }
+    text
 }
 
 /// The cases of `results` measured without one successful sample, with why.
