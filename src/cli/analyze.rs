@@ -8,8 +8,20 @@ use nbody_records::results::ResultsFile;
 use std::path::{Path, PathBuf};
 
 pub fn analyze(args: AnalyzeArgs) -> anyhow::Result<i32> {
-    let path = locate::find_results(&args.results, Path::new("results"))?;
-    if path != args.results {
+    let found = locate::find_results_noting(&args.results, Path::new("results"))?;
+    let path = found.path;
+    if !found.passed_over.is_empty() {
+        let newer: Vec<String> = found
+            .passed_over
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        eprintln!(
+            "analyzing {}, the newest run with a successful case; newer run(s) without one: {}",
+            path.display(),
+            newer.join(", ")
+        );
+    } else if path != args.results {
         eprintln!("analyzing {}", path.display());
     }
     if args.out.is_none() && nbody_engine::input::is_pipe(&path) {

@@ -154,7 +154,8 @@ pub struct ReportArgs {
 #[derive(Debug, Args)]
 pub struct AnalyzeArgs {
     /// The results of a sweep: a results.json, a run directory, or a config name (its latest
-    /// run under results/runs/, else its reference results results/<name>/).
+    /// run under results/runs/ with a successful case, else its reference results
+    /// results/<name>/; the run taken is named).
     #[arg(value_name = "RESULTS")]
     pub results: PathBuf,
     /// Directory for fits.json, summary.md and the figures [default: `analysis/` beside the results file].
@@ -429,7 +430,7 @@ pub struct ValidateArgs {
     pub yes: bool,
 }
 
-fn parse_count(s: &str) -> Result<usize, String> {
+pub(crate) fn parse_count(s: &str) -> Result<usize, String> {
     match s.parse::<usize>() {
         Ok(0) => Err("must be at least 1".into()),
         Ok(v) => Ok(v),
@@ -509,7 +510,7 @@ fn parse_threshold(s: &str) -> Result<f64, String> {
 }
 
 /// A/B rounds per build: even, from 2 to `gate::ab::MAX_ROUNDS`.
-fn parse_ab_rounds(s: &str) -> Result<usize, String> {
+pub(crate) fn parse_ab_rounds(s: &str) -> Result<usize, String> {
     let v = s
         .parse::<usize>()
         .map_err(|_| format!("`{s}` is not a whole number"))?;
@@ -689,7 +690,7 @@ pub struct GateArgs {
     #[arg(long, value_name = "TEXT", requires = "accept")]
     pub reason: Option<String>,
     /// Results of the run to check: a results.json, a run directory or a config name (its
-    /// latest run). Without it the gate measures this build itself.
+    /// latest run with a successful case). Without it the gate measures this build itself.
     #[arg(long, value_name = "RESULTS")]
     pub current: Option<PathBuf>,
     /// Measure this build and revision REV side by side (A/B), whatever machine the baseline
@@ -826,7 +827,8 @@ pub struct ExportArgs {
 )]
 pub struct ExportResultsArgs {
     /// The results of a sweep (a results.json, a run directory, or a config name: its latest
-    /// run under results/runs/, else its reference results results/<name>/), or a performance
+    /// run under results/runs/ with a successful case, else its reference results
+    /// results/<name>/), or a performance
     /// history (a history file, or the folder of them: every machine class).
     #[arg(value_name = "RESULTS|HISTORY")]
     pub results: PathBuf,

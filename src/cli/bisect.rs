@@ -36,8 +36,9 @@ pub struct BisectArgs {
     #[arg(long, value_name = "CONFIG", default_value = "configs/ci.toml")]
     pub config: PathBuf,
     /// Interleaved rounds of each side-by-side measurement (a midpoint that differs from
-    /// neither end is measured again with twice as many).
-    #[arg(long, default_value_t = AB_ROUNDS)]
+    /// neither end is measured again with twice as many): even, from 2 to 100, as the gate's
+    /// --rounds.
+    #[arg(long, default_value_t = AB_ROUNDS, value_parser = crate::cli::args::parse_ab_rounds)]
     pub rounds: usize,
     /// The smallest change taken for a step, as a fraction (the gate's A/B threshold).
     #[arg(long, default_value_t = AB_THRESHOLD)]

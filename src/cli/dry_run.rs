@@ -1,10 +1,12 @@
 //! What `sweep` does before it measures anything: `--dry-run` prints the planned cases and the
 //! estimated wall time and stops, and a real sweep estimated at more than an hour without a
 //! time budget asks first (or, without a terminal, refuses unless `--yes` is given). Nothing
-//! here writes a file or creates a directory.
+//! here keeps a file or a directory (the dry run tries each external program once, in a
+//! temporary directory it removes).
 
 use crate::cli::args::SweepArgs;
 use nbody_harness::experiment::estimate::{self, Done, Estimate, PROBE_MAX_N, Probed};
+use nbody_harness::experiment::external::trial::Trial;
 use nbody_harness::render::sweep_tables;
 use nbody_harness::units::WallTime;
 use nbody_records::config::SweepConfig;
@@ -22,6 +24,7 @@ pub fn before_sweep(
     args: &SweepArgs,
     config: &SweepConfig,
     path: Option<&Path>,
+    trials: &[Trial],
 ) -> anyhow::Result<Option<i32>> {
     if args.yes && !args.dry_run {
         // Nothing to ask, so nothing to estimate.
@@ -45,8 +48,9 @@ pub fn before_sweep(
     let calibrate = !args.no_calibration;
     let logical = nbody_engine::run::logical_cpus();
     let est = estimate::estimate(config, &probed.cases, &done, calibrate, logical);
+    let est = estimate::with_trials(est, config, &planned, trials, &done);
     if args.dry_run {
-        print_plan(args, config, &est, &probed, logical, path);
+        print_plan(args, config, &est, &probed, trials, logical, path);
         return Ok(Some(0));
     }
     eprintln!(
@@ -106,6 +110,7 @@ fn print_plan(
     config: &SweepConfig,
     est: &Estimate,
     probed: &Probed,
+    trials: &[Trial],
     logical: usize,
     path: Option<&Path>,
 ) {
@@ -114,7 +119,7 @@ fn print_plan(
     let all = est.cases.len() + external;
     outln!(
         "dry run of sweep `{}` ({}): {all} case{}{}, {} rounds of {} samples in all; nothing is \
-         measured or written",
+         measured or kept",
         config.name,
         args.config.display(),
         if all == 1 { "" } else { "s" },
@@ -130,11 +135,14 @@ fn print_plan(
         m.samples
     );
     outln!("{}", sweep_tables::plan(config, est).text().trim_end());
-    if external > 0 {
+    for t in trials {
         outln!(
-            "\n{external} external case{} not in the estimate: each sample runs the program once, \
-             for as long as it takes (up to its timeout_s)",
-            if external == 1 { " is" } else { "s are" }
+            "\nexternal `{}` tried once at {} (in a temporary directory, removed): {} a run; \
+             its cases are estimated from it, by their steps and a step's cost growing as its \
+             `steps` rule says (else as n²), no faster on more workers",
+            t.case.kernel.name(),
+            t.case.key(),
+            nbody_harness::units::Duration(t.run_s)
         );
     }
     print_estimate(est, probed, logical);

@@ -21,6 +21,9 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
         force: args.force,
         fail_on_work_change: args.fail_on_work_change,
     };
+    if let Some(history) = &args.record {
+        super::history::check_record_dir("--record", history)?;
+    }
     if let Some(results) = &args.save_baseline {
         return super::gate_save::save(&args, results, request);
     }

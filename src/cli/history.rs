@@ -64,15 +64,16 @@ pub struct BackfillArgs {
     /// The commits after A up to B (`A..B`, as git rev-list reads it).
     #[arg(value_name = "A..B")]
     pub range: String,
-    /// Measure every K-th commit, counted back from B (B always measured).
-    #[arg(long, value_name = "K", default_value_t = 1)]
+    /// Measure every K-th commit, counted back from B (B always measured); at least 1.
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = crate::cli::args::parse_count)]
     pub every: usize,
     /// The config both sides sweep: one every commit of the range reads (configs/backfill.toml
     /// holds kernels and keys the project has had since the CI config began).
     #[arg(long, value_name = "FILE|NAME", default_value = "backfill")]
     pub config: PathBuf,
-    /// Interleaved rounds per case and side.
-    #[arg(long, default_value_t = 4)]
+    /// Interleaved rounds per case and side: even (each side goes first as often), from 2 to
+    /// 100, as the gate's --rounds.
+    #[arg(long, default_value_t = 4, value_parser = crate::cli::args::parse_ab_rounds)]
     pub rounds: usize,
     /// Where each commit's A/B run is kept.
     #[arg(long, value_name = "DIR", default_value = "results/runs/backfill")]
@@ -105,6 +106,7 @@ pub fn history(args: HistoryArgs) -> anyhow::Result<i32> {
 fn backfill(dir: &Path, args: &BackfillArgs) -> anyhow::Result<i32> {
     use nbody_harness::history::backfill::{self, Backfill, Done};
     let config = nbody_records::locate::find_config(&args.config)?;
+    check_record_dir("--dir", dir)?;
     let job = Backfill {
         range: args.range.clone(),
         every: args.every,
@@ -138,6 +140,7 @@ fn backfill(dir: &Path, args: &BackfillArgs) -> anyhow::Result<i32> {
 }
 
 fn record(dir: &Path, args: &RecordArgs) -> anyhow::Result<i32> {
+    check_record_dir("--dir", dir)?;
     for path in &args.results {
         let path = if path.is_dir() {
             path.join("results.json")
@@ -193,6 +196,55 @@ fn gate_report(path: &Path, text: &str) -> anyhow::Result<Option<GateRun>> {
     GateRun::from_report_json(text, &machine)
         .map(Some)
         .map_err(|why| anyhow::anyhow!("{}: a gate report, but {why}", path.display()))
+}
+
+/// Checks, before anything is measured or read, that a history can be appended under `dir`
+/// (named by `flag`): a directory, or one that can be made, in which this machine class's
+/// files can be written. A sweep or a gate that measured for an hour must not fail at the end
+/// on a destination it could have refused at the start.
+pub fn check_record_dir(flag: &str, dir: &Path) -> anyhow::Result<()> {
+    if let Some(part) = nbody_engine::output::not_a_directory(dir) {
+        bail!(
+            "{flag} {}: {} is {}, where a directory is expected (the history is kept as \
+             DIR/<machine class>.jsonl): pass a directory, new or existing",
+            dir.display(),
+            part.display(),
+            if part.is_file() {
+                "a file"
+            } else {
+                "not a directory"
+            }
+        );
+    }
+    // The nearest part of the path that exists: the directory itself, or the one it would be
+    // made in.
+    let existing = dir
+        .ancestors()
+        .find(|a| !a.as_os_str().is_empty() && a.is_dir())
+        .unwrap_or(Path::new("."));
+    let probe = if existing == dir {
+        let m = nbody_harness::gate::route::this_machine();
+        let class =
+            nbody_harness::gate::baselines::class_name(m.cpu_signature.as_deref(), m.logical_cpus);
+        store::file_of(dir, &class)
+    } else {
+        // The directory is made when the first record is appended; that it can be is checked
+        // by writing (and removing) a file where it would go.
+        let first_missing = dir
+            .ancestors()
+            .take_while(|a| *a != existing && !a.as_os_str().is_empty())
+            .last()
+            .unwrap_or(dir);
+        first_missing.to_path_buf()
+    };
+    nbody_engine::output::check_writable(&probe).map_err(|e| {
+        anyhow::anyhow!(
+            "{flag} {}: the history cannot be written there ({}): pass a directory you can \
+             write to",
+            dir.display(),
+            crate::cli::error_chain(&e.into())
+        )
+    })
 }
 
 /// Appends the records of `file` (measured by `source`) to the history under `dir`; the files

@@ -36,8 +36,9 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
     let name = args.external.as_str();
     if !nbody_records::external::config::plain_name(name) {
         bail!(
-            "--external `{name}`: a program's name is letters, digits, '-', '_' and '.' (it names \
-             its cases and the config file)"
+            "--external `{name}`: a program's name is letters, digits, '-', '_' and '.', not \
+             starting with '-' (it names its cases and the config file, and the commands that \
+             name them would read it as an option)"
         );
     }
     if nbody_engine::kernels::KernelKind::ALL
@@ -100,7 +101,7 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
 
 /// What to do with the files just written.
 fn next_steps(out: &Path, name: &str, program: Option<&Path>) {
-    let out = out.display();
+    let out = super::hint::arg(out);
     match program {
         None => eprintln!(
             "wrote {out}: put your source beside it as {name}.c (or edit `setup` and `command`), \
@@ -112,7 +113,7 @@ fn next_steps(out: &Path, name: &str, program: Option<&Path>) {
              SECONDS`: try it with\n  python3 {program} --n 200 --steps 10\nput your code's \
              calls in its `evolve`, then\n  nbody-bench sweep --config {out} --dry-run\n  \
              nbody-bench sweep --config {out}",
-            program = program.display()
+            program = super::hint::arg(program)
         ),
     }
 }

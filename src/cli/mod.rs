@@ -13,6 +13,7 @@ mod fit;
 mod gate;
 mod gate_save;
 mod gate_study;
+mod hint;
 mod history;
 mod init;
 mod list;

@@ -59,7 +59,7 @@ pub fn publish(args: PublishArgs) -> anyhow::Result<i32> {
     let out = args.out.clone().unwrap_or_else(|| args.dir.join("page"));
     // The history first: a missing one is the error to report, not the folder for the page.
     publish::load(&args.dir)?;
-    std::fs::create_dir_all(&out).with_context(|| {
+    nbody_engine::output::create_dir_all(&out).with_context(|| {
         format!(
             "cannot create {}: choose a folder you can write to with --out",
             out.display()

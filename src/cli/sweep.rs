@@ -27,6 +27,9 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
         .filter(|p| !p.as_os_str().is_empty() && !from_pipe)
         .map(Path::to_path_buf);
     let target = where_to_write(&args, &config)?;
+    if let Some(history) = &args.record {
+        super::history::check_record_dir("--record", history)?;
+    }
     if let Some(code) = dry_run(&args, &config, &target, &config_dir)? {
         return Ok(code);
     }
@@ -61,7 +64,8 @@ pub fn sweep(args: SweepArgs) -> anyhow::Result<i32> {
 
 /// The checks a dry run makes before printing the plan (what the sweep checks before its
 /// first case: a program that cannot start, an `initial` file that cannot be read or lacks an
-/// n), and the plan itself; `Some(exit code)` when the command ends there.
+/// n; and each external program run once at its smallest case), and the plan itself;
+/// `Some(exit code)` when the command ends there.
 fn dry_run(
     args: &SweepArgs,
     config: &SweepConfig,
@@ -73,15 +77,17 @@ fn dry_run(
         Target::Existing(dir) => Some(dir.join("results.json")),
         Target::New => None,
     };
-    if args.dry_run {
+    let trials = if args.dry_run {
         let options = SweepOptions {
             out: args.out.clone(),
             config_dir: config_dir.clone(),
             ..Default::default()
         };
-        runner::check_before_running(config, &options)?;
-    }
-    super::dry_run::before_sweep(args, config, existing.as_deref())
+        runner::try_before_running(config, &options)?
+    } else {
+        Vec::new()
+    };
+    super::dry_run::before_sweep(args, config, existing.as_deref(), &trials)
 }
 
 /// The runner's options: where the results go (a new run directory is claimed here) and
@@ -122,18 +128,24 @@ fn analyze_and_record(args: &SweepArgs, results: &ResultsFile, path: &Path) -> a
     let dir = super::analyze::default_dir(path);
     match super::analyze::run(results, path, &dir) {
         Ok(written) => super::analyze::print_written(&written),
+        // Nothing to analyse yet: the failed and unfinished cases are reported next, with
+        // the command that finishes this run when one would.
+        Err(e)
+            if e.downcast_ref::<nbody_harness::analysis::AnalysisError>()
+                .is_some() => {}
         Err(e) => eprintln!(
             "warning: analysis failed ({}); the results are saved, retry with `nbody-bench analyze {}`",
             super::error_chain(&e),
-            path.display()
+            super::hint::arg(path)
         ),
     }
     if let Some(history) = &args.record {
         let appended = super::history::append_results(history, results, "sweep");
         let appended = anyhow::Context::with_context(appended, || {
             format!(
-                "the results are saved in {p}; record them with `nbody-bench history record {p}`",
-                p = path.display()
+                "the results are saved in {}; record them with `nbody-bench history record {}`",
+                path.display(),
+                super::hint::arg(path)
             )
         })?;
         for (to, count) in appended {
@@ -159,13 +171,9 @@ fn report_failures(args: &SweepArgs, results: &ResultsFile, report: &SweepReport
     }
     if report.incomplete > 0 {
         outln!(
-            "{} cases are not complete; run `nbody-bench sweep --config {} --resume{}` to finish them",
+            "{} cases are not complete; run `{}` to finish them",
             report.incomplete,
-            args.config.display(),
-            match &args.out {
-                Some(out) => format!(" --out {}", out.display()),
-                None => String::new(),
-            }
+            resume_command(args, &report.path)
         );
     }
     if failed.is_empty() {
@@ -178,6 +186,23 @@ fn report_failures(args: &SweepArgs, results: &ResultsFile, report: &SweepReport
         report.path.display()
     );
     FAILED_CASES
+}
+
+/// The command that resumes the run whose results are `results`, pasted as printed: the
+/// config as the user gave it, and the run itself (not "the latest unfinished one", which a
+/// newer run could change).
+fn resume_command(args: &SweepArgs, results: &Path) -> String {
+    let run = match &args.out {
+        Some(out) => format!("--out {} --resume", super::hint::arg(out)),
+        None => format!(
+            "--resume {}",
+            super::hint::arg(results.parent().unwrap_or(Path::new(".")))
+        ),
+    };
+    format!(
+        "nbody-bench sweep --config {} {run}",
+        super::hint::arg(&args.config)
+    )
 }
 
 /// The exit status of a sweep with a case whose every sample failed.
@@ -237,10 +262,14 @@ fn where_to_write(args: &SweepArgs, config: &SweepConfig) -> anyhow::Result<Targ
             }
             Ok(Target::Existing(dir))
         }
-        (Some(None), None) => Ok(Target::Existing(locate::latest_unfinished(
-            root,
-            &config.name,
-        )?)),
+        (Some(None), None) => match locate::latest_unfinished(root, &config.name) {
+            Ok(dir) => Ok(Target::Existing(dir)),
+            Err(e @ locate::LocateError::NothingToResume { .. }) => anyhow::bail!(
+                "{e}; a new run: `nbody-bench sweep --config {}`",
+                super::hint::arg(&args.config)
+            ),
+            Err(e) => Err(e.into()),
+        },
         (None, None) => {
             if let Ok(dir) = locate::latest_unfinished(root, &config.name) {
                 eprintln!(

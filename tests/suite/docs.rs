@@ -235,6 +235,7 @@ fn the_results_reference_lists_exactly_the_fields_written() {
             round.warnings.push("a warning".into());
             round.runs[0].error = Some(error);
             round.runs[0].phases.insert("comm".into(), 1e-3);
+            round.runs[0].energy_drift = Some(1e-4);
         }
         walk(&serde_json::to_value(&file).unwrap(), "", &mut found);
     }

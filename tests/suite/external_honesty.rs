@@ -245,3 +245,92 @@ time = {{ regex = 'elapsed ([0-9.]+) ms', unit = "ms" }}
             .all(|&s| (s - 1e-3 / 40.0).abs() < 1e-12)
     );
 }
+
+#[test]
+fn an_external_round_is_null_where_nothing_was_measured_from_the_round_up() {
+    let dir = program_dir();
+    let config = format!(
+        r#"{HEAD}
+kernels = ["naive"]
+[[external]]
+name = "printed"
+command = ["{{config_dir}}/prog", "ok", "0", "2"]
+steps = 4
+time = {{ regex = 'elapsed ([0-9.]+) ms', unit = "ms" }}
+{MEASURE}"#
+    );
+    let out = sweep_cli(dir.path(), &config);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let path = dir.path().join("out/ext/results.json");
+    let read = |p: &Path| -> serde_json::Value {
+        serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap()
+    };
+    let case = |v: &serde_json::Value, kernel: &str| {
+        v["cases"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["key"].as_str().unwrap().contains(kernel))
+            .unwrap()
+            .clone()
+    };
+    let results = read(&path);
+    let (ext, naive) = (case(&results, "printed"), case(&results, "naive"));
+    for round in ext["rounds"].as_array().unwrap() {
+        for field in ["phases", "work", "pairs_interacting"] {
+            assert!(round[field].is_null(), "{field}: {round}");
+        }
+    }
+    for field in ["phases", "pair_checks_per_step", "cells_visited_per_step"] {
+        assert!(
+            ext["summary"][field].is_null(),
+            "{field}: {}",
+            ext["summary"]
+        );
+    }
+    assert!(naive["rounds"][0]["work"]["pair_checks"].as_u64().unwrap() > 0);
+    assert!(
+        naive["summary"]["phases"]["force_interact"]
+            .as_f64()
+            .unwrap()
+            > 0.0
+    );
+    let analysis = dir.path().join("out/ext/analysis");
+    let fits = read(&analysis.join("fits.json"));
+    assert!(case(&fits, "printed")["phases"].is_null(), "{fits}");
+    assert!(case(&fits, "naive")["phases"].is_object());
+    let svg = std::fs::read_to_string(analysis.join("phases-lj-box.svg")).unwrap();
+    assert!(
+        svg.contains("(not measured)") && svg.contains("printed n=50"),
+        "the bar says it"
+    );
+
+    // A file of an older version holds zeros there: it still loads, and they read as null.
+    let mut old = results.clone();
+    for c in old["cases"].as_array_mut().unwrap() {
+        if !c["key"].as_str().unwrap().contains("printed") {
+            continue;
+        }
+        for round in c["rounds"].as_array_mut().unwrap() {
+            round["phases"] = serde_json::json!({
+                "force_build": 0.0, "force_interact": 0.0, "integrate": 0.0,
+                "boundary": 0.0, "output": 0.0
+            });
+            round["work"] = serde_json::json!({
+                "pair_checks": 0, "cells_visited": 0, "nodes_opened": 0, "nodes_accepted": 0,
+                "rebuilds": 0, "list_entries": 0, "pairs_interacting": 0
+            });
+            round["pairs_interacting"] = 0.into();
+        }
+    }
+    let old_path = dir.path().join("old.json");
+    std::fs::write(&old_path, serde_json::to_string(&old).unwrap()).unwrap();
+    let o = bin()
+        .current_dir(dir.path())
+        .args(["analyze", "old.json", "--out", "old-analysis"])
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", text(&o.stderr));
+    let fits = read(&dir.path().join("old-analysis/fits.json"));
+    assert!(case(&fits, "printed")["phases"].is_null(), "{fits}");
+}

@@ -6,10 +6,13 @@
 //! runs the suite without them, then them with one test thread, so no other test loads the
 //! CPUs during their sweeps.
 
+mod after_failures;
 mod analyze;
 mod bad_input;
 mod bad_sizes;
 mod bisect;
+mod causes;
+mod checked_first;
 mod cli;
 mod config_corpus;
 mod conservation;
@@ -21,6 +24,7 @@ mod export;
 mod export_history;
 mod export_results;
 mod external;
+mod external_energy;
 mod external_honesty;
 mod external_phases;
 mod fit_cli;

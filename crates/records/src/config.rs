@@ -313,11 +313,12 @@ crate::config_keys::documented_keys! {
         /// (left out: each kernel's default, 0.3 sigma of the LJ scenarios; `run --skin auto` finds
         /// the fastest).
         ///
-        /// Accepts a list of lengths above 0 in the scenario's unit, such as skin = [0.003, 0.012].
+        /// Accepts a non-empty list of lengths above 0 in the scenario's unit, such as
+        /// skin = [0.003, 0.012].
         ///
         /// Example: `skin = [0.004]`
-        #[serde(default, skip_serializing_if = "Vec::is_empty")]
-        pub skin: Vec<f64>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub skin: Option<Vec<f64>>,
         /// Overrides each scenario's precision (when left out: each scenario's own).
         ///
         /// Accepts "f32" or "f64".
@@ -669,10 +670,20 @@ impl SweepConfig {
                     .into(),
             ));
         }
-        if self.skin.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
+        // Left out, each kernel's default; given, the lengths to run, like every other list.
+        let skin = self.skin.as_deref().unwrap_or_default();
+        if self.skin.is_some() && skin.is_empty() {
+            return Err(bad(
+                "skin",
+                "is empty; list at least one length above 0, or leave skin out for each \
+                 kernel's default"
+                    .into(),
+            ));
+        }
+        if skin.iter().any(|s| !(s.is_finite() && *s > 0.0)) {
             return Err(bad("skin", "must list finite lengths above 0".into()));
         }
-        if !self.skin.is_empty()
+        if !skin.is_empty()
             && !self
                 .kernels
                 .iter()
@@ -816,7 +827,7 @@ impl SweepConfig {
             ("theta", twice(&self.theta)),
             ("multipole", twice(&self.multipole)),
             ("order", twice(&self.order)),
-            ("skin", twice(&self.skin)),
+            ("skin", twice(self.skin.as_deref().unwrap_or_default())),
             ("mpi.ranks", twice(&ranks)),
             ("mpi.decomp", decomp),
             ("external.name", twice(&names)),

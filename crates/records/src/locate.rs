@@ -50,8 +50,9 @@ pub enum LocateError {
     },
     /// `sweep --resume` without a directory, when every run of the config is complete.
     #[error(
-        "no unfinished run of `{name}` under {dir}; start a new one with `nbody-bench sweep \
-         --config {name}`, or pass the run to resume: --resume DIR"
+        "no unfinished run of `{name}` under {dir}: every run there is complete, so resuming \
+         would measure nothing; start a new run without --resume, or pass the run to resume: \
+         --resume DIR"
     )]
     NothingToResume {
         /// The config's name.
@@ -141,7 +142,7 @@ pub fn runs_dir(root: &Path, name: &str) -> PathBuf {
 /// of the same second exists), created empty.
 pub fn new_run_dir(root: &Path, name: &str, utc: &str) -> Result<PathBuf, LocateError> {
     let parent = runs_dir(root, name);
-    std::fs::create_dir_all(&parent).map_err(|source| LocateError::CreateRun {
+    nbody_engine::output::create_dir_all(&parent).map_err(|source| LocateError::CreateRun {
         path: parent.clone(),
         source,
     })?;
@@ -211,20 +212,60 @@ pub fn latest_unfinished(root: &Path, name: &str) -> Result<PathBuf, LocateError
 
 /// The results file `given` names: a file or a pipe; a directory holding `results.json`; or a config
 /// name (`quick`, `quick.toml`, `configs/quick.toml`), meaning its latest run under
-/// `<root>/runs/`, else its reference results `<root>/<name>/results.json`.
+/// `<root>/runs/` with a successful case, else its reference results
+/// `<root>/<name>/results.json`.
 pub fn find_results(given: &Path, root: &Path) -> Result<PathBuf, LocateError> {
+    find_results_noting(given, root).map(|found| found.path)
+}
+
+/// What [`find_results_noting`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Found {
+    /// The results file.
+    pub path: PathBuf,
+    /// For a config name: the runs newer than the one taken, passed over because none of their
+    /// cases has a successful sample (or their file cannot be read), newest first.
+    pub passed_over: Vec<PathBuf>,
+}
+
+/// [`find_results`], with the newer runs of a config name it passed over: a run whose every
+/// case failed, or that was stopped before any case finished, has nothing to analyse or
+/// compare, and taking it silently would hide the run that has.
+pub fn find_results_noting(given: &Path, root: &Path) -> Result<Found, LocateError> {
+    let found = |path: PathBuf| Found {
+        path,
+        passed_over: Vec::new(),
+    };
     if nbody_engine::input::is_readable(given) {
-        return Ok(given.to_path_buf());
+        return Ok(found(given.to_path_buf()));
     }
     let mut looked = Vec::new();
-    let inside = given.join("results.json");
-    if inside.is_file() {
-        return Ok(inside);
+    if given.is_dir() {
+        let inside = given.join("results.json");
+        if inside.is_file() {
+            return Ok(found(inside));
+        }
+        looked.push(inside.display().to_string());
+    } else {
+        // A path that is no directory was looked for as the file itself (`results.json`, not
+        // `results.json/results.json`).
+        looked.push(given.display().to_string());
     }
-    looked.push(inside.display().to_string());
     if let Some(name) = config_name(given) {
-        if let Some(latest) = runs(root, &name).pop() {
-            return Ok(latest.join("results.json"));
+        let all = runs(root, &name);
+        let mut passed_over = Vec::new();
+        for run in all.iter().rev() {
+            let path = run.join("results.json");
+            let measured =
+                ResultsFile::load(&path).is_ok_and(|f| f.cases.iter().any(|c| c.summary.is_some()));
+            if measured {
+                return Ok(Found { path, passed_over });
+            }
+            passed_over.push(run.clone());
+        }
+        // No run has a successful case: the newest, whose own errors then say why.
+        if let Some(latest) = all.last() {
+            return Ok(found(latest.join("results.json")));
         }
         looked.push(format!(
             "{}/*/results.json",
@@ -232,7 +273,7 @@ pub fn find_results(given: &Path, root: &Path) -> Result<PathBuf, LocateError> {
         ));
         let reference = root.join(&name).join("results.json");
         if reference.is_file() {
-            return Ok(reference);
+            return Ok(found(reference));
         }
         looked.push(reference.display().to_string());
     }
@@ -308,7 +349,7 @@ mod tests {
             "{missing}"
         );
         let reference = root.path().join("quick");
-        std::fs::create_dir_all(&reference).unwrap();
+        nbody_engine::output::create_dir_all(&reference).unwrap();
         std::fs::write(reference.join("results.json"), "{}").unwrap();
         assert_eq!(
             find_results(Path::new("quick"), root.path()).unwrap(),

@@ -145,8 +145,8 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
                 _ => vec![(Multipole::Monopole, None)],
             };
             let skins: Vec<Option<f64>> = match kernel {
-                KernelKind::Verlet | KernelKind::ClusterPair if !config.skin.is_empty() => {
-                    config.skin.iter().map(|&s| Some(s)).collect()
+                KernelKind::Verlet | KernelKind::ClusterPair if config.skin.is_some() => {
+                    config.skin.iter().flatten().map(|&s| Some(s)).collect()
                 }
                 _ => vec![None],
             };

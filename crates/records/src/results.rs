@@ -146,18 +146,20 @@ pub struct Summary {
     pub particle_steps_per_s: f64,
     /// `None` when the code counted no pair (an external program).
     pub pair_evals_per_s: Option<f64>,
-    /// Seconds per step in each phase, averaged over rounds.
-    pub phases: PhaseTimes,
-    /// Work per step.
-    pub pair_checks_per_step: f64,
-    pub(crate) cells_visited_per_step: f64,
-    pub(crate) nodes_opened_per_step: f64,
-    pub(crate) nodes_accepted_per_step: f64,
+    /// Seconds per step in each phase, averaged over the rounds that timed them; `None` when
+    /// none did (an external program).
+    pub phases: Option<PhaseTimes>,
+    /// Work per step, over the rounds that counted it; `None` when none did (an external
+    /// program).
+    pub pair_checks_per_step: Option<f64>,
+    pub(crate) cells_visited_per_step: Option<f64>,
+    pub(crate) nodes_opened_per_step: Option<f64>,
+    pub(crate) nodes_accepted_per_step: Option<f64>,
     /// Verlet list: rebuilds and list entries per step.
     #[serde(default)]
-    pub(crate) rebuilds_per_step: f64,
+    pub(crate) rebuilds_per_step: Option<f64>,
     #[serde(default)]
-    pub(crate) list_entries_per_step: f64,
+    pub(crate) list_entries_per_step: Option<f64>,
     /// `None` when the code counted no pair (an external program).
     pub pairs_interacting: Option<u64>,
     /// Largest |energy drift| of any round, and whether it stayed within the config's limit;
@@ -431,11 +433,30 @@ impl CaseRecord {
         let med = median(&samples)?;
         // Rounds that measured something (a batch job may end without measuring its round).
         let measured = || self.rounds.iter().filter(|r| !r.samples_s.is_empty());
-        let rounds = measured().count().max(1) as f64;
-        let steps: u64 = self.rounds.iter().map(|r| r.steps).sum();
-        let mean_of = |f: &dyn Fn(&RoundOutcome) -> f64| measured().map(f).sum::<f64>() / rounds;
+        // The rounds that timed phases, and those that counted work: none of an external
+        // program's, and then the figure is "not measured", never zero.
+        let timed: Vec<&PhaseTimes> = measured().filter_map(|r| r.phases.as_ref()).collect();
+        let phase_mean = |f: &dyn Fn(&PhaseTimes) -> f64| {
+            timed.iter().map(|p| f(p)).sum::<f64>() / timed.len() as f64
+        };
+        let phases = (!timed.is_empty()).then(|| PhaseTimes {
+            force_build: phase_mean(&|p| p.force_build),
+            force_interact: phase_mean(&|p| p.force_interact),
+            integrate: phase_mean(&|p| p.integrate),
+            boundary: phase_mean(&|p| p.boundary),
+            output: 0.0,
+        });
+        let counted_rounds = || self.rounds.iter().filter(|r| r.work.is_some());
+        let steps: u64 = counted_rounds().map(|r| r.steps).sum();
+        let counted = counted_rounds().next().is_some();
         let per_step = |f: &dyn Fn(&WorkCounters) -> u64| {
-            self.rounds.iter().map(|r| f(&r.work) as f64).sum::<f64>() / steps.max(1) as f64
+            counted.then(|| {
+                counted_rounds()
+                    .filter_map(|r| r.work.as_ref())
+                    .map(|w| f(w) as f64)
+                    .sum::<f64>()
+                    / steps.max(1) as f64
+            })
         };
         let pair_checks = per_step(&|w| w.pair_checks);
         let drift = self
@@ -444,8 +465,6 @@ impl CaseRecord {
             .filter_map(|r| r.energy_drift)
             .map(f64::abs)
             .reduce(f64::max);
-        // An external program's rounds count no work: zeros there are "not counted".
-        let counted = measured().any(|r| r.external.is_none());
         let n = self.n.max(1) as f64;
         Some(Summary {
             median_s: med,
@@ -459,14 +478,8 @@ impl CaseRecord {
             ns_per_particle_step: med * 1e9 / n,
             // Vetted samples take more than zero time.
             particle_steps_per_s: n / med,
-            pair_evals_per_s: (counted && pair_checks > 0.0).then(|| pair_checks / med),
-            phases: PhaseTimes {
-                force_build: mean_of(&|r| r.phases.force_build),
-                force_interact: mean_of(&|r| r.phases.force_interact),
-                integrate: mean_of(&|r| r.phases.integrate),
-                boundary: mean_of(&|r| r.phases.boundary),
-                output: 0.0,
-            },
+            pair_evals_per_s: pair_checks.filter(|&p| p > 0.0).map(|p| p / med),
+            phases,
             pair_checks_per_step: pair_checks,
             cells_visited_per_step: per_step(&|w| w.cells_visited),
             nodes_opened_per_step: per_step(&|w| w.nodes_opened),
@@ -476,8 +489,8 @@ impl CaseRecord {
             pairs_interacting: self
                 .rounds
                 .iter()
-                .rfind(|r| r.external.is_none() && !r.samples_s.is_empty())
-                .map(|r| r.pairs_interacting),
+                .rfind(|r| !r.samples_s.is_empty())
+                .and_then(|r| r.pairs_interacting),
             max_energy_drift: drift,
             sanity_ok: drift.map(|d| d <= max_drift),
             force_error: self.rounds.iter().filter_map(|r| r.force_error).next_back(),

@@ -19,15 +19,18 @@ pub struct RoundOutcome {
     pub steps: u64,
     /// Untimed warm-up steps before the samples.
     pub warmup_steps: u64,
-    /// Seconds per step in each phase (means over the timed steps).
-    pub phases: PhaseTimes,
-    /// Work over the timed steps.
-    pub work: WorkCounters,
-    /// Interacting pairs in the final configuration.
-    pub pairs_interacting: u64,
-    /// Relative energy drift from the start of the warm-up to the end of the samples; `None`
-    /// (`null`) where nothing measured it: an external program, a job that ended without its
-    /// round, an MPI run of a system whose initial energy is zero.
+    /// Seconds per step in each phase (means over the timed steps); `None` (`null`) where no
+    /// timer of ours ran: an external program, a job that ended without its round.
+    pub phases: Option<PhaseTimes>,
+    /// Work over the timed steps; `None` (`null`) where nothing of ours counted it.
+    pub work: Option<WorkCounters>,
+    /// Interacting pairs in the final configuration; `None` (`null`) where nothing of ours
+    /// counted them.
+    pub pairs_interacting: Option<u64>,
+    /// Relative energy drift from the start of the warm-up to the end of the samples (an
+    /// external program with an `energy` pattern: the largest of its runs' drifts); `None`
+    /// (`null`) where nothing measured it: an external program without one, a job that ended
+    /// without its round, a system whose initial energy is zero.
     pub energy_drift: Option<f64>,
     /// Median and max relative force error against an f64 direct sum, when asked.
     pub force_error: Option<[f64; 2]>,
@@ -54,4 +57,17 @@ pub struct RoundOutcome {
     /// then the round has no samples.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub job: Option<super::scheduler::JobRecord>,
+}
+
+impl RoundOutcome {
+    /// Forgets the phases, work and pair counts of an external program's round: none of our
+    /// timers or counters ran in it, and a file written before they were `null` holds zeros
+    /// there, which would read as measured.
+    pub fn forget_unmeasured(&mut self) {
+        if self.external.is_some() {
+            self.phases = None;
+            self.work = None;
+            self.pairs_interacting = None;
+        }
+    }
 }

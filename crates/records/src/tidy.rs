@@ -270,10 +270,10 @@ pub fn samples(results: &ResultsFile) -> TidyTable {
                     Value::from(seconds),
                     Value::from(round.steps_per_sample),
                     Value::from(paired.then(|| round.reference_s[s])),
-                    Value::from(round.energy_drift.filter(|_| ours)),
+                    Value::from(round.energy_drift),
                     Value::from(error_median),
                     Value::from(error_max),
-                    Value::from(ours.then_some(round.pairs_interacting)),
+                    Value::from(round.pairs_interacting.filter(|_| ours)),
                     Value::from(round.n),
                 ]);
                 row.extend(build.iter().cloned());

@@ -74,6 +74,8 @@ fn finite_or_zero(x: &mut f64) {
 /// becomes the largest finite number, so the sanity check flags the case instead of the file
 /// losing it.
 pub fn round(index: usize, round: &mut RoundOutcome) -> Vec<Rejected> {
+    // An external program's round measured none of ours, whatever an older file wrote there.
+    round.forget_unmeasured();
     let mut rejected = Vec::new();
     let paired = round.reference_s.len() == round.samples_s.len();
     let mut keep = Vec::with_capacity(round.samples_s.len());
@@ -127,17 +129,18 @@ pub fn round(index: usize, round: &mut RoundOutcome) -> Vec<Rejected> {
     if let Some(external) = &mut round.external {
         rejected.extend(external_phases(index, external));
     }
-    let p = &mut round.phases;
-    for x in [
-        &mut p.force_build,
-        &mut p.force_interact,
-        &mut p.integrate,
-        &mut p.boundary,
-        &mut p.output,
-        &mut round.clock_overhead,
-    ] {
-        finite_or_zero(x);
+    if let Some(p) = &mut round.phases {
+        for x in [
+            &mut p.force_build,
+            &mut p.force_interact,
+            &mut p.integrate,
+            &mut p.boundary,
+            &mut p.output,
+        ] {
+            finite_or_zero(x);
+        }
     }
+    finite_or_zero(&mut round.clock_overhead);
     rejected
 }
 

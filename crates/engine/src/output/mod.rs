@@ -1,12 +1,14 @@
 //! Files the engine writes: trajectories (NBView), state dumps, and the atomic-write helper
 //! every output goes through so that a failed run never leaves a partial file behind.
 
+mod dir;
 pub mod dump;
 pub mod nbview;
 pub mod neutral;
 pub mod provenance;
 mod temporary_dir;
 
+pub use dir::{create_dir_all, not_a_directory};
 pub use temporary_dir::TemporaryDir;
 
 use std::fs::{self, File};
@@ -56,6 +58,18 @@ pub enum OutputError {
         path: PathBuf,
         /// The missing directory.
         dir: PathBuf,
+    },
+    /// A part of the path's directory is a file (or another thing that is no directory).
+    #[error("{flag} {path}: {part} is {what}, where a directory is expected")]
+    NotADirectory {
+        /// The option that named the path, as typed.
+        flag: String,
+        /// The path as given.
+        path: PathBuf,
+        /// The part of its directory that exists and is no directory.
+        part: PathBuf,
+        /// "a file", or "not a directory" for anything else.
+        what: &'static str,
     },
     /// The path is one of the command's inputs (or the same file by another path).
     #[error("{flag} {path}: is also an input of this command ({input}); it would be overwritten")]
@@ -153,6 +167,19 @@ pub fn check_outputs(
                 return Err(OutputError::Special { flag, path });
             }
         } else if let Some(dir) = target.parent().filter(|d| !d.is_dir()) {
+            if let Some(part) = not_a_directory(dir) {
+                let (flag, path) = bad(path);
+                return Err(OutputError::NotADirectory {
+                    flag,
+                    path,
+                    what: if part.is_file() {
+                        "a file"
+                    } else {
+                        "not a directory"
+                    },
+                    part: part.to_path_buf(),
+                });
+            }
             let (flag, path) = bad(path);
             return Err(OutputError::NoDirectory {
                 flag,

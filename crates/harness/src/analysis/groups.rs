@@ -63,8 +63,9 @@ pub struct Point {
     /// was worth a fork is decided on it); `None` when the code counted no pair.
     #[serde(skip)]
     pub pair_checks_per_step: Option<f64>,
-    /// Seconds per step in each of the engine's phases, averaged over rounds.
-    pub phases: PhaseTimes,
+    /// Seconds per step in each of the engine's phases, averaged over rounds; `None` (`null`)
+    /// where no timer of ours ran (an external program, which may time its own: `named_phases`).
+    pub phases: Option<PhaseTimes>,
     /// The phases an external program timed itself (`phases`), by name.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub named_phases: Vec<NamedPhase>,
@@ -426,7 +427,7 @@ fn point(r: &CaseRecord, ext: Option<&External>) -> Option<Point> {
         oversubscribed: r.oversubscribed,
         ns_per_particle_step: s.ns_per_particle_step,
         pair_evals_per_s: s.pair_evals_per_s,
-        pair_checks_per_step: s.pair_evals_per_s.map(|_| s.pair_checks_per_step),
+        pair_checks_per_step: s.pair_evals_per_s.and(s.pair_checks_per_step),
         phases: s.phases,
         named_phases,
         step_ns: s.step_ns,

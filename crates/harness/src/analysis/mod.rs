@@ -173,6 +173,20 @@ pub struct Analysis {
     pub cases: Vec<Point>,
     /// Cases of the file still unmeasured or partly measured (left out of the analysis).
     pub incomplete: Vec<String>,
+    /// Cases measured without one successful sample, each with why (left out of the analysis,
+    /// but never out of its summary).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failed: Vec<FailedCase>,
+}
+
+/// A case every sample of which failed.
+#[derive(Clone, Debug, Serialize)]
+pub struct FailedCase {
+    /// The case's key.
+    pub key: String,
+    /// Why its samples failed: the first reasons the results file records (empty when it
+    /// records none).
+    pub reasons: Vec<String>,
 }
 
 impl Analysis {
@@ -200,17 +214,50 @@ impl Analysis {
 #[derive(Debug, Error)]
 pub enum AnalysisError {
     /// The results file has no complete case yet (a sweep interrupted before any finished).
-    #[error("{path} has no complete case to analyse; finish it with `nbody-bench sweep --resume`")]
+    #[error(
+        "{path} has no complete case to analyse yet: finish its run with `nbody-bench sweep \
+         --config <its config> --resume {}`",
+        path.parent().unwrap_or(Path::new(".")).display()
+    )]
     Empty {
         /// The results file.
         path: PathBuf,
+    },
+    /// Every case the results file measured failed: resuming would measure nothing more.
+    #[error(
+        "{path} has no successful sample to analyse: all {failed} measured case(s) failed \
+         ({}); each one's errors are kept in the file",
+        first_of(reasons)
+    )]
+    AllFailed {
+        /// The results file.
+        path: PathBuf,
+        /// How many cases failed.
+        failed: usize,
+        /// Each failed case with its first reason.
+        reasons: Vec<String>,
     },
 }
 
 /// Fits every series of `results` (read from `source`, for the record).
 pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, AnalysisError> {
     let groups: Groups = groups::group(results);
+    let failed = failed_cases(results);
     if groups.cases.is_empty() {
+        // A run with nothing left to measure is not asked to be finished.
+        if !failed.is_empty() && results.cases.iter().all(|c| c.is_complete()) {
+            return Err(AnalysisError::AllFailed {
+                path: source.into(),
+                failed: failed.len(),
+                reasons: failed
+                    .iter()
+                    .map(|f| match f.reasons.first() {
+                        Some(r) => format!("{}: {r}", f.key),
+                        None => f.key.clone(),
+                    })
+                    .collect(),
+            });
+        }
         return Err(AnalysisError::Empty {
             path: source.into(),
         });
@@ -271,7 +318,31 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
             .map(|c| c.key.clone())
             .collect(),
         cases: groups.cases,
+        failed,
     })
+}
+
+/// The first few of `items`, with how many more.
+fn first_of(items: &[String]) -> String {
+    const SHOWN: usize = 3;
+    let mut text = items[..items.len().min(SHOWN)].join("; ");
+    if items.len() > SHOWN {
+        text += &format!("; and {} more", items.len() - SHOWN);
+    }
+    text
+}
+
+/// The cases of `results` measured without one successful sample, with why.
+fn failed_cases(results: &ResultsFile) -> Vec<FailedCase> {
+    results
+        .cases
+        .iter()
+        .filter(|c| c.failed())
+        .map(|c| FailedCase {
+            key: c.key.clone(),
+            reasons: c.failures(),
+        })
+        .collect()
 }
 
 fn samples_by(
@@ -352,7 +423,7 @@ fn engine_serial_fraction(
     kernel: KernelKind,
     dim: usize,
 ) -> Option<fit::TimedSerialFraction> {
-    let ph = &one.phases;
+    let ph = one.phases.as_ref()?;
     // Which phases ran on the pool's threads: the per-particle passes (kick, drift, walls)
     // and the cell and Verlet lists' binning fork from a size on; the interactions of
     // every kernel but `symmetric` do.

@@ -132,8 +132,11 @@ pub struct CaseEstimate {
 /// The estimate of a whole sweep.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Estimate {
-    /// Each built-in kernel's case (external programs are not estimated), in plan order.
+    /// Each built-in kernel's case, in plan order.
     pub cases: Vec<CaseEstimate>,
+    /// Each case of an external program tried once ([`with_trials`]), in plan order; empty
+    /// when none was.
+    pub external: Vec<CaseEstimate>,
     /// The calibrations still to run (start and end).
     pub calibration_s: f64,
     /// Expected wall time of the whole sweep, seconds: the calibrations plus every case.
@@ -176,9 +179,46 @@ pub fn estimate(
     let total_s = calibration_s + cases.iter().map(|c| c.wall_s).sum::<f64>();
     Estimate {
         cases,
+        external: Vec::new(),
         calibration_s,
         total_s,
     }
+}
+
+/// `est` with the cases of every external program that was tried once (the dry run's
+/// [`trial`](super::external::trial)), each carried from its trial run to the case.
+pub fn with_trials(
+    mut est: Estimate,
+    config: &SweepConfig,
+    planned: &[Case],
+    trials: &[super::external::trial::Trial],
+    done: &Done,
+) -> Estimate {
+    let m = &config.measure;
+    for case in planned.iter().filter(|c| c.kernel.is_external()) {
+        let name = case.kernel.name();
+        let (Some(ext), Some(trial)) = (
+            config.external.iter().find(|e| e.name == name),
+            trials.iter().find(|t| t.case.kernel.name() == name),
+        ) else {
+            continue;
+        };
+        let first = done.rounds.get(&case.key()).copied().unwrap_or(0);
+        let wall_s = super::external::trial::case_s(config, ext, trial, case, first);
+        let steps = super::external::run::steps(ext, case).max(1) as f64;
+        let rounds = m.rounds - first.min(m.rounds);
+        est.external.push(CaseEstimate {
+            case: case.clone(),
+            rounds,
+            samples: (first.min(m.rounds)..m.rounds)
+                .map(|r| samples_in_round(m.samples, m.rounds, r))
+                .sum(),
+            step_s: super::external::trial::run_s(ext, trial, case) / steps,
+            wall_s,
+        });
+        est.total_s += wall_s;
+    }
+    est
 }
 
 /// Wall time of one calibration with this many thread counts (`calibrate::calibrate`).
@@ -248,7 +288,8 @@ fn round_s(config: &SweepConfig, at_n: &Probe, step_s: f64, energy_s: f64, sampl
     ROUND_OVERHEAD_S
         + at_n.build_s
         + 3.0 * energy_s
-        + m.warmup_s.max(step_s)
+        // The warm-up takes at least the cold step and one more (`measure`).
+        + m.warmup_s.max(2.0 * step_s)
         + samples as f64 * (k * step_s + reference)
         + error
 }

@@ -148,15 +148,15 @@ pub(crate) fn round_from_json(
         step_ns: used,
         steps: run.steps,
         warmup_steps: warmup,
-        phases: PhaseTimes {
+        phases: Some(PhaseTimes {
             force_build: per_step(p.force_build),
             force_interact: per_step(p.force_interact),
             integrate: per_step(p.integrate),
             boundary: per_step(p.boundary),
             output: 0.0,
-        },
-        work: run.counters.total,
-        pairs_interacting: run.counters.pairs_interacting_final,
+        }),
+        work: Some(run.counters.total),
+        pairs_interacting: Some(run.counters.pairs_interacting_final),
         // A null drift (zero initial energy) is not measured: null in the results, "–" in the
         // tables, as for an external program's round.
         energy_drift: run.energy.rel_drift,

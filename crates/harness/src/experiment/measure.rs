@@ -80,20 +80,35 @@ fn measure<C: Clock>(
     let n = sim.len();
     let e0 = sim.probe().total();
     let initial_work = sim.probe_work();
-    // Warm-up: untimed for the results, but its step times choose the sample length.
+    // Warm-up: untimed for the results, but its step times choose the sample length. The
+    // first step is cold (lists and trees built, caches empty) and can take many times a
+    // usual one: when the round chooses the sample length, at least one step after it is
+    // taken, and the cold one is left out of the choice, even with `warmup_s = 0`.
+    let least = if spec.steps_per_sample.is_none() {
+        2
+    } else {
+        1
+    };
     let warm_start = clock.now();
     let mut warm = Vec::new();
     loop {
         let t = clock.now();
         sim.step()?;
         warm.push((clock.now() - t).as_secs_f64());
-        if (clock.now() - warm_start).as_secs_f64() >= spec.warmup_s
+        if ((clock.now() - warm_start).as_secs_f64() >= spec.warmup_s && warm.len() >= least)
             || warm.len() as u64 >= MAX_WARMUP_STEPS
         {
             break;
         }
     }
-    let typical = nbody_engine::stats::median(&warm).unwrap_or(0.0).max(1e-9);
+    let after_cold = if warm.len() > 1 {
+        &warm[1..]
+    } else {
+        &warm[..]
+    };
+    let typical = nbody_engine::stats::median(after_cold)
+        .unwrap_or(0.0)
+        .max(1e-9);
     let k = spec.steps_per_sample.unwrap_or_else(|| {
         ((spec.min_sample_s / typical).ceil() as u64).clamp(1, MAX_STEPS_PER_SAMPLE)
     });
@@ -132,9 +147,9 @@ fn measure<C: Clock>(
         step_ns,
         steps,
         warmup_steps: warm.len() as u64,
-        phases,
-        work,
-        pairs_interacting: sim.probe_work().pairs_interacting,
+        phases: Some(phases),
+        work: Some(work),
+        pairs_interacting: Some(sim.probe_work().pairs_interacting),
         // Relative to nothing when the initial energy is zero: not measured, as the MPI
         // drivers record it.
         energy_drift: (e0 != 0.0).then(|| (e1 - e0) / e0.abs()),

@@ -2,7 +2,8 @@
 //! round (`runner`; one round of any case in `case_round`, of a kernel in `measure`, with the
 //! `reference` workload and `progress` lines) into its results file, held by one writer
 //! (`lock`); external programs run (`external`) and rounds under an MPI launcher (`launcher`)
-//! or as batch jobs (`slurm`); the length estimate of a sweep (`estimate`).
+//! or as batch jobs (`slurm`), a program that keeps failing the same way stopped
+//! (`repeated_failure`); the length estimate of a sweep (`estimate`).
 
 mod case_round;
 pub mod estimate;
@@ -12,6 +13,7 @@ pub mod lock;
 pub mod measure;
 pub mod progress;
 pub mod reference;
+mod repeated_failure;
 pub mod runner;
 pub mod skin;
 pub mod slowdown;

@@ -83,6 +83,9 @@ pub enum SweepError {
         /// How it differs, e.g. the file's commit and the current one.
         detail: String,
     },
+    /// The dry run's trial of an external program failed.
+    #[error(transparent)]
+    Trial(#[from] super::external::trial::TrialError),
     /// Loading or saving the results file failed.
     #[error(transparent)]
     Results(#[from] ResultsError),
@@ -220,7 +223,7 @@ pub fn run_sweep<C: Clock>(
     }
     let slowdown = TestSlowdown::from_env().map_err(SweepError::Slowdown)?;
     if let Some(dir) = path.parent() {
-        std::fs::create_dir_all(dir).map_err(|source| SweepError::Dir {
+        nbody_engine::output::create_dir_all(dir).map_err(|source| SweepError::Dir {
             path: dir.into(),
             source,
         })?;
@@ -398,6 +401,7 @@ impl<C: Clock> Sweep<'_, C> {
         observer.start(total, done);
         let started = self.clock.now();
         let mut measured = 0;
+        let mut watch = super::repeated_failure::FailureWatch::default();
         for round in 0..rounds {
             // Alternate the direction of each round so no case always runs first or last.
             let mut order: Vec<usize> = (0..results.cases.len()).collect();
@@ -419,13 +423,22 @@ impl<C: Clock> Sweep<'_, C> {
                     return Ok((measured, true));
                 }
                 let record = &results.cases[i];
+                let program = (record.case.kernel.is_external())
+                    .then(|| record.case.kernel.name().to_string());
+                if program.as_deref().is_some_and(|p| watch.stopped(p)) {
+                    continue;
+                }
                 let outcome = self.measure_round(record, round, observer)?;
                 report_external(&record.key, &outcome, observer);
+                let stopped = program.and_then(|p| Some((watch.note(&p, &outcome)?, p)));
                 let record = &mut results.cases[i];
                 record.add_round(outcome, self.config.measure.max_energy_drift);
                 results.save(self.path)?;
                 measured += 1;
                 observer.round_done(&results.cases[i], round);
+                if let Some((why, program)) = stopped {
+                    say_stopped(&program, &why, results, rounds, observer);
+                }
             }
         }
         Ok((measured, false))
@@ -477,7 +490,7 @@ impl<C: Clock> Sweep<'_, C> {
 }
 
 /// The share of `samples` taken in `round`: equal parts, the remainder in the first rounds.
-pub(super) fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
+pub(crate) fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
     samples / rounds + usize::from(round < samples % rounds)
 }
 
@@ -599,6 +612,21 @@ pub fn check_before_running(
     preflight(config, options, &path).map(|_| ())
 }
 
+/// [`check_before_running`], then every external program tried once at its smallest case
+/// (in a temporary work directory): the dry run's checks. The trials, for the estimate.
+pub fn try_before_running(
+    config: &SweepConfig,
+    options: &SweepOptions,
+) -> Result<Vec<super::external::trial::Trial>, SweepError> {
+    let path = match &options.run_dir {
+        Some(dir) => dir.join("results.json"),
+        None => results_path(config, options.out.as_deref()),
+    };
+    let (_, context) = preflight(config, options, &path)?;
+    let planned = nbody_records::plan::unique_cases(config).map_err(SweepError::Plan)?;
+    Ok(super::external::trial::try_all(config, &planned, &context)?)
+}
+
 /// [`check_before_running`], keeping the bodies it read and the externals' context.
 fn preflight(
     config: &SweepConfig,
@@ -689,7 +717,7 @@ fn initial_bodies(
 /// results' fingerprint names.
 fn keep_initial(results: &Path, initial: &Initial) -> Result<PathBuf, SweepError> {
     let dir = results.parent().unwrap_or(Path::new(".")).join("initial");
-    std::fs::create_dir_all(&dir).map_err(|source| SweepError::Dir {
+    nbody_engine::output::create_dir_all(&dir).map_err(|source| SweepError::Dir {
         path: dir.clone(),
         source,
     })?;
@@ -725,6 +753,31 @@ fn external_context(
         initial: None,
         bodies: None,
     })
+}
+
+/// Says that `program` is no longer run, why, and what is left for `--resume`.
+fn say_stopped(
+    program: &str,
+    why: &str,
+    results: &ResultsFile,
+    rounds: usize,
+    observer: &mut dyn Observer,
+) {
+    let left: usize = results
+        .cases
+        .iter()
+        .filter(|c| c.case.kernel.is_external() && c.case.kernel.name() == program)
+        .map(|c| rounds.saturating_sub(c.rounds_done))
+        .sum();
+    if left == 0 {
+        // Its last round: nothing is left out, and its failures are reported case by case.
+        return;
+    }
+    observer.message(&format!(
+        "error: external `{program}` failed the same way in its first {} rounds ({why}); its \
+         other {left} round(s) are not run: fix the program, then resume the run to measure them",
+        super::repeated_failure::SAME_FAILURES
+    ));
 }
 
 /// Tells the observer about an external round's failed samples and warnings.

@@ -484,7 +484,7 @@ fn run_side(
         let path = path.to_path_buf();
         move |source| AbError::Io { path, source }
     };
-    std::fs::create_dir_all(dir).map_err(io(dir))?;
+    nbody_engine::output::create_dir_all(dir).map_err(io(dir))?;
     let config = dir.join("ab.toml");
     std::fs::write(&config, config_text).map_err(io(&config))?;
     let binary = match side {

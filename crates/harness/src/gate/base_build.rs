@@ -179,7 +179,7 @@ pub fn base_binary(
         let path = path.to_path_buf();
         move |source| BaseBuildError::Io { path, source }
     };
-    std::fs::create_dir_all(root.join(&key)).map_err(io(&root.join(&key)))?;
+    nbody_engine::output::create_dir_all(root.join(&key)).map_err(io(&root.join(&key)))?;
     let worktree = root.join(format!("worktree-{commit}"));
     let worktree_error = |detail: String| BaseBuildError::Worktree {
         commit: commit.to_string(),

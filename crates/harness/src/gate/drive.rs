@@ -99,9 +99,29 @@ pub fn run(request: &Request, say: &mut dyn FnMut(&str)) -> anyhow::Result<Outco
         None => measure_and_judge(request, say)?,
     };
     if outcome.report.cases.is_empty() {
-        anyhow::bail!("the gate compared no case: nothing was judged, which is not a pass");
+        anyhow::bail!("the gate {}", nothing_judged(&outcome.report));
     }
     Ok(outcome)
+}
+
+/// Why a run judged no case, which is not a pass: the reasons its cases could not be compared
+/// (too few samples, none measured, ...), not only that nothing was judged.
+fn nothing_judged(report: &GateReport) -> String {
+    if report.missing.is_empty() {
+        return "compared no case: the baseline has none, so nothing was judged, which is not a \
+                pass"
+            .to_string();
+    }
+    let why: Vec<String> = report
+        .missing
+        .iter()
+        .map(|m| format!("{} ({})", m.key, m.reason))
+        .collect();
+    format!(
+        "could judge none of its {} case(s), which is not a pass: {}",
+        why.len(),
+        super::listed(&why)
+    )
 }
 
 fn options(request: &Request, default_threshold: f64, default_judge: Judged) -> GateOptions {
@@ -178,7 +198,7 @@ pub fn a_b_run(
     let judged = a_b(request, &prepared, config, text, &out, say);
     let outcome = kept(judged, out)?;
     if outcome.report.cases.is_empty() {
-        anyhow::bail!("the A/B run compared no case: nothing was judged, which is not a pass");
+        anyhow::bail!("the A/B run {}", nothing_judged(&outcome.report));
     }
     Ok(outcome)
 }
@@ -187,7 +207,7 @@ pub fn a_b_run(
 fn created_out_dir(out: Option<PathBuf>) -> anyhow::Result<PathBuf> {
     match out {
         Some(dir) => {
-            std::fs::create_dir_all(&dir)
+            nbody_engine::output::create_dir_all(&dir)
                 .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", dir.display()))?;
             Ok(dir)
         }

@@ -213,7 +213,7 @@ pub fn check(folder: &Path, results: &Path) -> anyhow::Result<Candidate> {
             folder.display()
         );
     }
-    std::fs::create_dir_all(folder)
+    nbody_engine::output::create_dir_all(folder)
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", folder.display()))?;
     let info = RunInfo::of(&file);
     let target = folder.join(baselines::file_name(&info));

@@ -57,6 +57,9 @@ pub enum Done {
 /// The commits of `range` to measure, oldest first: every `every`-th counted back from the
 /// range's end, which is always included.
 pub fn commits(repo: &Path, range: &str, every: usize) -> anyhow::Result<Vec<String>> {
+    if every == 0 {
+        anyhow::bail!("every 0th commit is none: measure every K-th commit with K at least 1");
+    }
     let (from, to) = crate::git::given_range(range).map_err(anyhow::Error::msg)?;
     let range = crate::git::Rev::range(&from, &to);
     let out = crate::git::command(
@@ -79,7 +82,6 @@ pub fn commits(repo: &Path, range: &str, every: usize) -> anyhow::Result<Vec<Str
     if all.is_empty() {
         anyhow::bail!("{range} holds no commit");
     }
-    let every = every.max(1);
     let last = all.len() - 1;
     Ok(all
         .into_iter()
@@ -92,6 +94,8 @@ pub fn commits(repo: &Path, range: &str, every: usize) -> anyhow::Result<Vec<Str
 /// Measures each commit of the backfill against this build and appends both sides to the
 /// history; `say` hears the progress. A commit that fails is skipped with its reason.
 pub fn backfill(job: &Backfill, say: &mut dyn FnMut(&str)) -> anyhow::Result<Vec<Done>> {
+    // Refused before the builds, which take minutes each, as the gate refuses them.
+    crate::gate::ab::check_rounds(job.rounds)?;
     let repo = base_build::repository_root(&std::env::current_dir()?)?;
     let commits = commits(&repo, &job.range, job.every)?;
     say(&format!(

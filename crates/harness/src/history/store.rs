@@ -263,7 +263,7 @@ pub fn append(dir: &Path, records: &[Record]) -> Result<Vec<(PathBuf, usize)>, H
             text.push('\n');
             count += 1;
         }
-        std::fs::create_dir_all(dir).map_err(fail)?;
+        nbody_engine::output::create_dir_all(dir).map_err(fail)?;
         append_text(&path, &text).map_err(fail)?;
         written.push((path.clone(), count));
     }

@@ -321,7 +321,7 @@ pub fn append(dir: &Path, runs: &[GateRun]) -> Result<Vec<(PathBuf, usize)>, His
             count += 1;
         }
         if count > 0 {
-            std::fs::create_dir_all(dir).map_err(fail)?;
+            nbody_engine::output::create_dir_all(dir).map_err(fail)?;
             append_text(&path, &text).map_err(fail)?;
         }
         written.push((path.clone(), count));

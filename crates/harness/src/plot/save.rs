@@ -4,7 +4,6 @@
 
 use plotters::prelude::*;
 use resvg::{tiny_skia, usvg};
-use std::fs;
 use std::path::Path;
 
 use super::spec::Rendered;
@@ -31,7 +30,7 @@ pub(crate) fn save_figure(
 ) -> Result<Rendered, PlotError> {
     super::check_stem(stem)?;
     font::register();
-    fs::create_dir_all(dir).map_err(|source| PlotError::Dir {
+    nbody_engine::output::create_dir_all(dir).map_err(|source| PlotError::Dir {
         path: dir.to_path_buf(),
         source,
     })?;

@@ -293,11 +293,19 @@ fn scenario_figures(a: &Analysis, cap: &str) -> Vec<(String, Drawing)> {
         if cases.is_empty() {
             continue;
         }
+        // A case no timer covered keeps its row, named "not measured": an empty bar alone
+        // would read as a step that took no time.
         let phases: Vec<PhaseTimes> = cases
             .iter()
-            .map(|c| PhaseTimes {
-                case: case_label(c),
-                phases: phase_list(c),
+            .map(|c| match phase_list(c) {
+                Some(phases) => PhaseTimes {
+                    case: case_label(c),
+                    phases,
+                },
+                None => PhaseTimes {
+                    case: format!("{} (not measured)", case_label(c)),
+                    phases: Vec::new(),
+                },
             })
             .collect();
         let mut bars = fig::phase_breakdown(&phases, cap);
@@ -498,17 +506,19 @@ fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
 }
 
 /// A case's phases for the bars: an external program's own, else the engine's timers and the
-/// MPI drivers' communication.
-fn phase_list(c: &Point) -> Vec<(String, f64)> {
+/// MPI drivers' communication; `None` when nothing timed any (an external program that prints
+/// no phase), which the bar says instead of standing empty.
+fn phase_list(c: &Point) -> Option<Vec<(String, f64)>> {
     if !c.named_phases.is_empty() {
-        return c
-            .named_phases
-            .iter()
-            .map(|p| (p.name.clone(), p.s_per_step))
-            .collect();
+        return Some(
+            c.named_phases
+                .iter()
+                .map(|p| (p.name.clone(), p.s_per_step))
+                .collect(),
+        );
     }
-    let ph = &c.phases;
-    [
+    let ph = c.phases.as_ref()?;
+    let list = [
         ("force: build", ph.force_build),
         ("force: interact", ph.force_interact),
         ("integrate", ph.integrate),
@@ -517,5 +527,6 @@ fn phase_list(c: &Point) -> Vec<(String, f64)> {
     ]
     .into_iter()
     .map(|(name, s)| (name.to_string(), s))
-    .collect()
+    .collect();
+    Some(list)
 }

@@ -31,9 +31,14 @@ pub fn write(analysis: &Analysis, dir: &Path) -> Result<Written, nbody_engine::o
     let fits = dir.join("fits.json");
     let summary = dir.join("summary.md");
     // Checked before any figure is drawn, so that a refusal writes nothing.
-    if dir.is_dir()
-        && let Err(e) =
-            nbody_engine::output::check_outputs(&[("analysis", &fits), ("analysis", &summary)], &[])
+    nbody_engine::output::create_dir_all(dir).map_err(|source| {
+        nbody_engine::output::WriteError {
+            path: dir.to_path_buf(),
+            source,
+        }
+    })?;
+    if let Err(e) =
+        nbody_engine::output::check_outputs(&[("analysis", &fits), ("analysis", &summary)], &[])
     {
         return Err(nbody_engine::output::WriteError {
             path: dir.to_path_buf(),

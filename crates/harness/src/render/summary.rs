@@ -27,6 +27,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             a.incomplete.len()
         );
     }
+    md.push_str(&failed_cases(a));
     if !a.complexity.is_empty() {
         let _ = writeln!(
             md,
@@ -113,5 +114,28 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             let _ = writeln!(md, "![{}]({}.svg)\n", f.title, f.stem);
         }
     }
+    md
+}
+
+/// The cases that failed, each with why: a summary that left them out silently would read as
+/// if they had never been planned.
+fn failed_cases(a: &Analysis) -> String {
+    if a.failed.is_empty() {
+        return String::new();
+    }
+    let mut md = format!(
+        "## Failed cases\n\n{} case(s) have no successful sample and are left out of the \
+         tables and figures:\n\n",
+        a.failed.len()
+    );
+    for f in &a.failed {
+        let why = match f.reasons.as_slice() {
+            [] => "no reason recorded".to_string(),
+            [one] => one.clone(),
+            [first, rest @ ..] => format!("{first}; and {} more", rest.len()),
+        };
+        let _ = writeln!(md, "- `{}`: {}", f.key, why.replace('\n', " "));
+    }
+    md.push('\n');
     md
 }

@@ -42,6 +42,7 @@ pub fn plan(config: &SweepConfig, est: &Estimate) -> Table {
         ]);
     }
     for c in external_cases(config) {
+        let tried = est.external.iter().find(|e| e.case.key() == c.key());
         let steps = config
             .external
             .iter()
@@ -49,6 +50,20 @@ pub fn plan(config: &SweepConfig, est: &Estimate) -> Table {
             .map_or("-".to_string(), |e| {
                 format!("{} steps", crate::experiment::external::run::steps(e, &c))
             });
+        if let Some(e) = tried {
+            t.row([
+                c.key(),
+                c.n.to_string(),
+                c.threads.to_string(),
+                c.ranks.to_string(),
+                theta(c.theta),
+                e.rounds.to_string(),
+                e.samples.to_string(),
+                format!("{} ({steps})", Duration(e.step_s)),
+                WallTime(e.wall_s).to_string(),
+            ]);
+            continue;
+        }
         t.row([
             c.key(),
             c.n.to_string(),
@@ -166,7 +181,7 @@ pub fn speedups(results: &ResultsFile) -> Vec<Speedup> {
                 one_thread: c.case.kernel.kernel().and_then(|k| {
                     // An external program counts no pairs: nothing to decide on.
                     s.pair_evals_per_s?;
-                    forking::one_thread(k, c.case.threads, c.case.ranks, s.pair_checks_per_step)
+                    forking::one_thread(k, c.case.threads, c.case.ranks, s.pair_checks_per_step?)
                 }),
             });
         }

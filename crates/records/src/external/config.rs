@@ -77,6 +77,17 @@ crate::config_keys::documented_keys! {
         /// Example: `force_error = 'error ([^ ]+) ([^ ]+)'`
         #[serde(default, skip_serializing_if = "Option::is_none")]
         pub force_error: Option<String>,
+        /// A regular expression whose group is the total energy the program prints: its first
+        /// match in a run is the energy at the start, its last the energy at the end, and their
+        /// relative change is the run's energy drift, checked against `measure.max_energy_drift`
+        /// as the built-in kernels' (a run whose output matches it fewer than twice is an error).
+        ///
+        /// Accepts a regular expression with one group around the number, such as energy =
+        /// 'total energy ([0-9.eE+-]+)'.
+        ///
+        /// Example: `energy = 'E = ([0-9.eE+-]+)'`
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        pub energy: Option<String>,
         /// Entries of one family are one code at several accuracy settings: their cases form one
         /// series of force error against cost, like a θ sweep.
         ///
@@ -206,7 +217,7 @@ impl Growth {
     }
 
     /// The cost of one step at `n`, in the rule's units.
-    fn cost(self, n: usize) -> f64 {
+    pub fn cost(self, n: usize) -> f64 {
         let n = n.max(1) as f64;
         match self {
             Growth::Linear => n,
@@ -236,9 +247,11 @@ impl Steps {
     }
 }
 
-/// Letters, digits, '-', '_' and '.', not empty: what names a case or a family.
+/// Letters, digits, '-', '_' and '.', not empty and not starting with '-': what names a case
+/// or a family (a name starting with '-' would read as an option where a command names it).
 pub fn plain_name(name: &str) -> bool {
     !name.is_empty()
+        && !name.starts_with('-')
         && name
             .chars()
             .all(|c| c.is_ascii_alphanumeric() || "-_.".contains(c))
@@ -409,7 +422,8 @@ impl External {
             return Err((
                 "external.name".into(),
                 format!(
-                    "is `{}`: it must be letters, digits, '-', '_' and '.' (it names the cases)",
+                    "is `{}`: it must be letters, digits, '-', '_' and '.', not starting with \
+                     '-' (it names the cases)",
                     self.name
                 ),
             ));
@@ -542,12 +556,20 @@ impl External {
             if !plain_name(name) {
                 return self.invalid(
                     "phases",
-                    format!("has a phase named `{name}`: use letters, digits, '-', '_' and '.'"),
+                    format!(
+                        "has a phase named `{name}`: use letters, digits, '-', '_' and '.', not \
+                         starting with '-'"
+                    ),
                 );
             }
             if let Err(e) = number_regex(&phase.regex, "phase comm ([0-9.eE+-]+)") {
                 return self.invalid(&format!("phases.{name}.regex"), e);
             }
+        }
+        if let Some(e) = &self.energy
+            && let Err(e) = number_regex(e, "total energy ([0-9.eE+-]+)")
+        {
+            return self.invalid("energy", e);
         }
         if let Some(c) = &self.check
             && let Err(e) = regex::Regex::new(c)
@@ -581,7 +603,9 @@ impl External {
         if !plain_name(f) {
             return self.invalid(
                 "family",
-                format!("is `{f}`: it must be letters, digits, '-', '_' and '.'"),
+                format!(
+                    "is `{f}`: it must be letters, digits, '-', '_' and '.', not starting with '-'"
+                ),
             );
         }
         // A family names a series in tables and figures beside the built-in kernels' own.

@@ -48,6 +48,10 @@ pub struct ExternalRun {
     /// The phases it printed (`phases`): each its time over the whole run, seconds.
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub phases: BTreeMap<String, f64>,
+    /// The relative change of the total energy it printed between its first and last match
+    /// of `energy` (`None`: no `energy` pattern, or a start energy of zero).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy_drift: Option<f64>,
     /// Why the run is not a sample.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<SampleError>,

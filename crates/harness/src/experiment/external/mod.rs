@@ -5,6 +5,7 @@
 
 pub mod process;
 pub mod run;
+pub mod trial;
 
 use nbody_records::external::{External, ExternalVersion, placeholders};
 use std::path::{Path, PathBuf};
@@ -154,7 +155,7 @@ pub(crate) fn version_line(ext: &External, context: &Context) -> ExternalVersion
             Ok(argv) => {
                 let dir = context.work_root.join(format!("version-{}", ext.name));
                 let launch = process::Launch { argv, env: vec![] };
-                match std::fs::create_dir_all(&dir)
+                match nbody_engine::output::create_dir_all(&dir)
                     .and_then(|()| process::run(&launch, &dir, VERSION_TIMEOUT_S))
                 {
                     Err(e) => format!("(`{}` failed: {e})", launch.display()),

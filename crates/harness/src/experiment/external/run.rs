@@ -90,7 +90,7 @@ pub(crate) fn measure_round(
     context: &Context,
 ) -> Result<RoundOutcome, ExternalError> {
     let dir = super::workdir(&context.work_root, &case.key());
-    std::fs::create_dir_all(&dir).map_err(|source| ExternalError::Workdir {
+    nbody_engine::output::create_dir_all(&dir).map_err(|source| ExternalError::Workdir {
         path: dir.clone(),
         source,
     })?;
@@ -144,12 +144,17 @@ pub(crate) fn measure_round(
         TimeSource::Wall(_) => None,
     };
     let error = ext.force_error.as_deref().map(compile).transpose()?;
+    let energy = ext.energy.as_deref().map(compile).transpose()?;
     let phases = ext
         .phases
         .iter()
         .map(|(name, p)| Ok((name.as_str(), compile(&p.regex)?, p.unit.seconds())))
         .collect::<Result<Vec<_>, ExternalError>>()?;
-    let reads_output = check.is_some() || time.is_some() || error.is_some() || !phases.is_empty();
+    let reads_output = check.is_some()
+        || time.is_some()
+        || error.is_some()
+        || energy.is_some()
+        || !phases.is_empty();
     for _ in 0..spec.samples {
         let run = match checked_run(&main, &dir, ext.timeout_s, check.as_ref(), reads_output) {
             Err(e) => ExternalRun {
@@ -157,9 +162,18 @@ pub(crate) fn measure_round(
                 reported_s: None,
                 force_error: None,
                 phases: BTreeMap::new(),
+                energy_drift: None,
                 error: Some(e.error),
             },
-            Ok(done) => sample(&main, &done, time.as_ref(), error.as_ref(), &phases),
+            Ok(done) => {
+                let patterns = Patterns {
+                    time: time.as_ref(),
+                    error: error.as_ref(),
+                    energy: energy.as_ref(),
+                    phases: &phases,
+                };
+                sample(&main, &done, &patterns)
+            }
         };
         round.runs.push(run);
     }
@@ -237,18 +251,28 @@ fn checked_run(
 
 /// The sample of a successful run: its time (wall, or the last match of the time regex), the
 /// force error and the phase times it printed.
-fn sample(
-    launch: &Launch,
-    done: &Finished,
-    time: Option<&(Regex, f64)>,
-    error: Option<&Regex>,
-    phases: &[(&str, Regex, f64)],
-) -> ExternalRun {
+/// What a run's output is read for: its time (unit in seconds), force error, total energy and
+/// phases (name, pattern, unit), each when the entry gives it.
+struct Patterns<'a> {
+    time: Option<&'a (Regex, f64)>,
+    error: Option<&'a Regex>,
+    energy: Option<&'a Regex>,
+    phases: &'a [(&'a str, Regex, f64)],
+}
+
+fn sample(launch: &Launch, done: &Finished, patterns: &Patterns) -> ExternalRun {
+    let Patterns {
+        time,
+        error,
+        energy,
+        phases,
+    } = *patterns;
     let fail = |what: String| ExternalRun {
         wall_s: done.wall_s,
         reported_s: None,
         force_error: None,
         phases: BTreeMap::new(),
+        energy_drift: None,
         error: Some(SampleError {
             what,
             command: launch.display(),
@@ -339,13 +363,54 @@ fn sample(
         };
         phase_s.insert(name.to_string(), t);
     }
+    let energy_drift = match energy.map(|re| energy_drift(re, done)) {
+        None => None,
+        Some(Ok(drift)) => drift,
+        Some(Err(why)) => return fail(why),
+    };
     ExternalRun {
         wall_s: done.wall_s,
         reported_s,
         force_error,
         phases: phase_s,
+        energy_drift,
         error: None,
     }
+}
+
+/// The relative energy drift of a run, as the engine's runs compute theirs: from the total
+/// energy at its start (the first match of `re` in its standard output, else standard error)
+/// to its end (the last match); `None` when the start energy is zero (relative to nothing).
+fn energy_drift(re: &Regex, done: &Finished) -> Result<Option<f64>, String> {
+    let text = [&done.stdout.text, &done.stderr.text]
+        .into_iter()
+        .find(|t| re.is_match(t))
+        .ok_or_else(|| {
+            format!(
+                "its output does not match the energy regex `{}`",
+                re.as_str()
+            )
+        })?;
+    let values: Vec<&str> = re
+        .captures_iter(text)
+        .filter_map(|c| Some(c.get(1)?.as_str().trim()))
+        .collect();
+    let number = |m: &str| match m.parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        _ => Err(format!(
+            "the energy regex `{}` matched `{m}`, which is not a finite number",
+            re.as_str()
+        )),
+    };
+    let [first, .., last] = values.as_slice() else {
+        return Err(format!(
+            "its output matches the energy regex `{}` once: the drift needs the energy at the \
+             start and at the end of the run",
+            re.as_str()
+        ));
+    };
+    let (e0, e1) = (number(first)?, number(last)?);
+    Ok((e0 != 0.0).then(|| (e1 - e0) / e0.abs()))
 }
 
 /// The first group of the last match in standard output (else standard error), parsed.
@@ -364,6 +429,11 @@ fn outcome(ext: &External, case: &Case, round: ExternalRound, steps: u64) -> Rou
     let ok: Vec<&ExternalRun> = round.runs.iter().filter(|r| r.error.is_none()).collect();
     let samples_s: Vec<f64> = ok.iter().map(|r| per_step(r)).collect();
     let errors: Vec<[f64; 2]> = ok.iter().filter_map(|r| r.force_error).collect();
+    // The round's drift is its worst run's, as the check of the case is against its worst.
+    let energy_drift = ok
+        .iter()
+        .filter_map(|r| r.energy_drift)
+        .max_by(|a, b| a.abs().total_cmp(&b.abs()));
     let force_error = (!errors.is_empty()).then(|| {
         let med: Vec<f64> = errors.iter().map(|e| e[0]).collect();
         [
@@ -377,10 +447,11 @@ fn outcome(ext: &External, case: &Case, round: ExternalRound, steps: u64) -> Rou
         samples_s,
         step_ns: Vec::new(),
         warmup_steps: steps * ext.warmup_runs as u64,
-        phases: Default::default(),
-        work: Default::default(),
-        pairs_interacting: 0,
-        energy_drift: None,
+        // None of our timers or counters ran: not measured, never zero.
+        phases: None,
+        work: None,
+        pairs_interacting: None,
+        energy_drift,
         force_error,
         n: case.n,
         clock_overhead: round.overhead_share.unwrap_or(0.0),

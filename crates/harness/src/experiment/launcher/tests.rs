@@ -108,9 +108,9 @@ fn a_round_groups_the_slowest_rank_step_times_into_samples() {
     assert_eq!(round.step_ns.len(), 9);
     assert_eq!(round.steps, 10);
     assert_eq!(round.warmup_steps, 5);
-    assert!((round.phases.force_interact - 0.02).abs() < 1e-15);
-    assert_eq!(round.work.pair_checks, 500);
-    assert_eq!(round.pairs_interacting, 77);
+    assert!((round.phases.unwrap().force_interact - 0.02).abs() < 1e-15);
+    assert_eq!(round.work.unwrap().pair_checks, 500);
+    assert_eq!(round.pairs_interacting, Some(77));
     assert_eq!(round.n, 2000);
     let mpi = round.mpi.unwrap();
     assert!(mpi.step_ns.is_empty(), "kept out of the results file");

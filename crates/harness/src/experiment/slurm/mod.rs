@@ -316,7 +316,7 @@ fn submit(
     resources: Resources,
     what: &str,
 ) -> Result<String, SlurmError> {
-    std::fs::create_dir_all(dir).map_err(|source| SlurmError::Dir {
+    nbody_engine::output::create_dir_all(dir).map_err(|source| SlurmError::Dir {
         path: dir.into(),
         source,
     })?;
@@ -399,9 +399,9 @@ pub(crate) fn unmeasured_round(case: &Case, spec: &RoundSpec, job: JobRecord) ->
         step_ns: Vec::new(),
         steps: 0,
         warmup_steps: 0,
-        phases: Default::default(),
-        work: Default::default(),
-        pairs_interacting: 0,
+        phases: None,
+        work: None,
+        pairs_interacting: None,
         energy_drift: None,
         force_error: None,
         n: case.n,

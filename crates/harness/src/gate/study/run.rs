@@ -223,7 +223,7 @@ pub fn summarise(
         }
     }
     file.put(StudyRun::of(raw, baseline));
-    std::fs::create_dir_all(out)
+    nbody_engine::output::create_dir_all(out)
         .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", out.display()))?;
     save_json(&path, &file)?;
     Ok(path)

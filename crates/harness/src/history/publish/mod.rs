@@ -306,9 +306,11 @@ pub fn build(dir: &Path, report: &Path, out: &Path) -> Result<(Page, Vec<String>
 /// Writes the page's HTML to `out/index.html` (the folder created as needed), atomically.
 pub fn write(page: &Page, out: &Path) -> Result<PathBuf, PublishError> {
     let path = out.join(PAGE_FILE);
-    std::fs::create_dir_all(out).map_err(|source| nbody_engine::output::WriteError {
-        path: out.to_path_buf(),
-        source,
+    nbody_engine::output::create_dir_all(out).map_err(|source| {
+        nbody_engine::output::WriteError {
+            path: out.to_path_buf(),
+            source,
+        }
     })?;
     nbody_engine::output::write_atomic(&path, html(page).as_bytes())?;
     Ok(path)
