@@ -47,6 +47,7 @@ mod mpi_launch;
 mod parsers;
 mod peers;
 mod publish;
+mod readings;
 mod report;
 mod runs;
 mod skin_auto;

@@ -178,7 +178,7 @@ pub fn calibrate_with(opts: &CalibrationOptions, threads: &[usize]) -> Calibrati
     let background_cpus = ticks_before
         .zip(cpu_ticks())
         .and_then(|(before, after)| before.background_cpus(&after));
-    if let Some(b) = background_cpus.filter(|&b| b >= BACKGROUND_WARNING_CPUS) {
+    if let Some(b) = background_cpus.filter(|&b| b >= SHARED_MACHINE_CPUS) {
         calibration.warnings.push(format!(
             "other processes used {b:.2} CPUs during calibration: throughputs and the parallel \
              ceiling are likely understated"
@@ -353,6 +353,7 @@ mod team;
 
 use compute::*;
 use fork_join::*;
+pub use load::SHARED_MACHINE_CPUS;
 use load::*;
 use memory::*;
 use team::*;

@@ -6,10 +6,12 @@ use super::*;
 // ---------------------------------------------------------------------------------------------
 // Background load
 
-/// Background load (in CPUs) from which a calibration is flagged. Calibrating on a machine
-/// where another process keeps a CPU busy is the commonest way to get a wrong ceiling: with
-/// 2 vCPUs and one busy, 2 threads measure ~1.0x even when the vCPUs are independent cores.
-pub(super) const BACKGROUND_WARNING_CPUS: f64 = 0.25;
+/// Background load (in CPUs) from which the machine counts as shared: a calibration is
+/// flagged, a gate baseline refused, and a scaling study's loss of speedup is not attributed to
+/// the code. Calibrating on a machine where another process keeps a CPU busy is the commonest
+/// way to get a wrong ceiling: with 2 vCPUs and one busy, 2 threads measure ~1.0x even when
+/// the vCPUs are independent cores.
+pub const SHARED_MACHINE_CPUS: f64 = 0.25;
 
 /// CPU time counters, in clock ticks (Linux `/proc`).
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -5,6 +5,7 @@
 //! file always gives the same analysis.
 
 pub mod comm_model;
+pub mod crossover;
 pub mod family;
 pub mod forking;
 pub mod groups;
@@ -13,9 +14,10 @@ pub mod tree_comm;
 mod views;
 
 use crate::fit::{
-    self, ComplexityClass, PowerFit, Samples, SerialFractionComparison, StrongFit,
+    self, ComplexityClass, PowerFit, Samples, SerialFractionComparison, SharedMachine, StrongFit,
     TimedSerialFraction, WeakFit, WeakSamples,
 };
+use crossover::Crossover;
 use groups::{Groups, Point, Series, SeriesKey};
 use nbody_calibrate::Calibration;
 use nbody_engine::kernels::KernelKind;
@@ -65,20 +67,6 @@ pub struct ComplexityAnalysis {
     pub fit: Fitted<PowerFit>,
 }
 
-/// Where two kernels' fitted cost curves cross.
-#[derive(Clone, Debug, Serialize)]
-pub(crate) struct Crossover {
-    pub scenario: String,
-    pub precision: String,
-    pub threads: usize,
-    /// The kernel that is faster above `n` and the one that is faster below it.
-    pub(crate) faster_above: String,
-    pub(crate) faster_below: String,
-    /// Where the fitted curves cross; `None` when `faster_above` is faster over the whole
-    /// measured range.
-    pub n: Option<f64>,
-}
-
 /// A series over p at fixed n (from p = 1) and the strong-scaling models fitted to it.
 #[derive(Clone, Debug, Serialize)]
 pub struct StrongAnalysis {
@@ -96,6 +84,11 @@ pub struct StrongAnalysis {
     /// and how it compares with the fitted one.
     pub timed_serial: Option<TimedSerialFraction>,
     pub(crate) serial_comparison: Option<SerialFractionComparison>,
+    /// Other processes' load when the machine was shared while the sweep ran (its
+    /// calibrations measured it): every reading of this series then says so, and none puts the
+    /// loss of speedup on the code. Absent on a quiet machine.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shared_machine: Option<SharedMachine>,
 }
 
 /// A weak-scaling series over p (from p = 1) and Gustafson's model fitted to it.
@@ -112,6 +105,10 @@ pub struct WeakAnalysis {
     pub measured: Vec<fit::EfficiencyPoint>,
     /// Gustafson's model, fitted to the cases that had a logical CPU per worker only.
     pub fit: Fitted<WeakFit>,
+    /// Other processes' load when the machine was shared while the sweep ran, as for
+    /// [`StrongAnalysis::shared_machine`]. Absent on a quiet machine.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub shared_machine: Option<SharedMachine>,
 }
 
 /// A tree code over θ (or an external family over its accuracy settings) at fixed n and p.
@@ -263,15 +260,23 @@ pub fn analyze(results: &ResultsFile, source: &Path) -> Result<Analysis, Analysi
         });
     }
     let calibration = results.calibration.for_analysis();
+    // The most load either calibration measured: the sweep ran between them.
+    let shared = SharedMachine::of(
+        [&results.calibration.start, &results.calibration.end]
+            .into_iter()
+            .flatten()
+            .filter_map(|c| c.background_cpus)
+            .reduce(f64::max),
+    );
     let complexity: Vec<ComplexityAnalysis> = groups.complexity.iter().map(complexity).collect();
-    let crossovers = crossovers(&complexity);
+    let crossovers = crossover::crossovers(&complexity);
     let strong = groups
         .strong
         .iter()
-        .map(|s| strong(s, calibration.as_ref()))
+        .map(|s| strong(s, calibration.as_ref(), shared))
         .collect();
     let rule = results.config.weak.as_ref().map(|w| w.rule);
-    let weak = groups.weak.iter().map(|s| weak(s, rule)).collect();
+    let weak = groups.weak.iter().map(|s| weak(s, rule, shared)).collect();
     let theta = groups
         .theta
         .iter()
@@ -371,41 +376,6 @@ fn complexity(s: &Series) -> ComplexityAnalysis {
     }
 }
 
-fn crossovers(all: &[ComplexityAnalysis]) -> Vec<Crossover> {
-    let mut out = Vec::new();
-    for (i, a) in all.iter().enumerate() {
-        for b in &all[i + 1..] {
-            let same = a.series.scenario == b.series.scenario
-                && a.series.precision == b.series.precision
-                && a.series.threads == b.series.threads
-                && a.series.ranks == b.series.ranks;
-            let (Some(fa), Some(fb)) = (&a.fit.fit, &b.fit.fit) else {
-                continue;
-            };
-            // Kernels of the same class differ by a constant factor: a crossing of their
-            // curves is noise, not an algorithmic crossover.
-            if !same || fa.class == fb.class {
-                continue;
-            }
-            let ns = a.points.iter().chain(&b.points).map(|p| p.n as f64);
-            let lo = ns.clone().fold(f64::INFINITY, f64::min);
-            let hi = ns.fold(0.0, f64::max);
-            let n = fit::crossover(fa, fb, lo, hi);
-            let a_faster_above = fa.predict(hi) < fb.predict(hi);
-            let (above, below) = if a_faster_above { (a, b) } else { (b, a) };
-            out.push(Crossover {
-                scenario: a.series.scenario.name().into(),
-                precision: a.series.precision.name().into(),
-                threads: a.series.threads.unwrap_or(1),
-                faster_above: above.label.clone(),
-                faster_below: below.label.clone(),
-                n,
-            });
-        }
-    }
-    out
-}
-
 /// Kernels whose force interaction runs on the rayon pool; their build, integration and
 /// boundary phases stay serial. (The Verlet list also splits its list builds over the pool,
 /// which the timed serial fraction counts as serial: for it, that fraction is an upper bound.)
@@ -461,7 +431,11 @@ fn external_serial_fraction(one: &Point) -> Option<fit::TimedSerialFraction> {
     fit::timed_serial_fraction(&serial, &[rest]).ok()
 }
 
-fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
+fn strong(
+    s: &Series,
+    calibration: Option<&Calibration>,
+    shared: Option<SharedMachine>,
+) -> StrongAnalysis {
     let real: Vec<Point> = s
         .points
         .iter()
@@ -489,8 +463,13 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
     };
     let mut ceiling = ceiling;
     ceiling.dedup_by(|a, b| a.0 == b.0);
-    let fit = Fitted::of(fit::fit_strong(&data, &ceiling, fit::DEFAULT_SEED));
-    let measured = match fit::fit_strong(&all, &ceiling, fit::DEFAULT_SEED) {
+    let fit = Fitted::of(fit::fit_strong_on(
+        &data,
+        &ceiling,
+        fit::DEFAULT_SEED,
+        shared,
+    ));
+    let measured = match fit::fit_strong_on(&all, &ceiling, fit::DEFAULT_SEED, shared) {
         Ok(f) => f.points,
         Err(_) => fit
             .fit
@@ -513,7 +492,12 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
                 .filter(|m| m.p > 1.0 && kernel_of(s).is_none())
                 .map(|m| m.speedup.estimate)
                 .reduce(f64::max);
-            Some(fit::compare_serial_fractions(t, &f.serial_fraction, best))
+            Some(fit::compare_serial_fractions(
+                t,
+                &f.serial_fraction,
+                best,
+                shared.as_ref(),
+            ))
         }
         _ => None,
     };
@@ -525,6 +509,7 @@ fn strong(s: &Series, calibration: Option<&Calibration>) -> StrongAnalysis {
         fit,
         timed_serial,
         serial_comparison,
+        shared_machine: shared,
     }
 }
 
@@ -550,7 +535,7 @@ fn cost_class(kernel: &KernelOrProgram, rule: Option<WeakRule>) -> ComplexityCla
     }
 }
 
-fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
+fn weak(s: &Series, rule: Option<WeakRule>, shared: Option<SharedMachine>) -> WeakAnalysis {
     let real: Vec<Point> = s
         .points
         .iter()
@@ -573,6 +558,7 @@ fn weak(s: &Series, rule: Option<WeakRule>) -> WeakAnalysis {
         points: s.points.clone(),
         measured,
         fit,
+        shared_machine: shared,
     }
 }
 
@@ -599,26 +585,5 @@ fn fit_weak_points(
             }
         }
         fit::fit_weak_with_n(&data, cost_class(kernel, rule), fit::DEFAULT_SEED)
-    }
-}
-
-/// "galaxy (f64, 1 thread): octree θ=0.5 is faster above n ≈ 574, naive below."
-pub(crate) fn crossover_sentence(x: &Crossover) -> String {
-    let head = format!(
-        "{} ({}, {} thread{})",
-        x.scenario,
-        x.precision,
-        x.threads,
-        if x.threads == 1 { "" } else { "s" }
-    );
-    match x.n {
-        Some(n) => format!(
-            "{head}: {} is faster above n ≈ {n:.0}, {} below.",
-            x.faster_above, x.faster_below
-        ),
-        None => format!(
-            "{head}: {} is faster than {} over the whole measured range.",
-            x.faster_above, x.faster_below
-        ),
     }
 }

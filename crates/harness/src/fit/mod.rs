@@ -8,19 +8,23 @@
 //! resampling the fit's residuals across x.
 //!
 //! - [`power`]: `T = c·n^k` and the complexity class chosen by leave-one-out cross-validation;
+//! - [`growth`]: what may be said of the growth: a class only where k agrees with it;
 //! - [`strong`]: speedup, efficiency, Amdahl's serial fraction, Karp-Flatt and overhead terms;
 //! - [`weak`]: weak-scaling efficiency and Gustafson's serial fraction;
 //! - [`timed`]: the serial fraction from timed serial phases, compared with the fitted one;
+//! - [`shared`]: a study measured on a shared machine, whose loss of speedup is not the code's;
 //! - [`alpha_beta`]: the α-β (latency-bandwidth) model of message time;
 //! - [`csv`]: reading `(p or n, time)` tables written by other codes.
 
 pub mod alpha_beta;
 mod bootstrap;
 pub mod csv;
+pub mod growth;
 mod karp_flatt;
 mod linear;
 mod overhead;
 pub mod power;
+pub mod shared;
 pub mod strong;
 #[cfg(test)]
 pub(crate) mod synthetic;
@@ -29,11 +33,13 @@ pub mod weak;
 
 pub(crate) use alpha_beta::{AlphaBetaFit, fit_alpha_beta};
 pub use bootstrap::CiMethod;
+pub use growth::GrowthReading;
+pub use karp_flatt::Trend;
 use nbody_engine::stats::BOOTSTRAP_RESAMPLES as RESAMPLES;
-pub(crate) use power::crossover;
 pub use power::{ComplexityClass, PowerFit, fit_power};
+pub use shared::SharedMachine;
 pub(crate) use strong::StrongPoint;
-pub use strong::{StrongFit, fit_strong};
+pub use strong::{StrongFit, fit_strong, fit_strong_on};
 pub use timed::TimedSerialFraction;
 pub(crate) use timed::{SerialFractionComparison, compare_serial_fractions, timed_serial_fraction};
 pub(crate) use weak::{EfficiencyPoint, WeakSamples};

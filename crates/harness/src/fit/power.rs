@@ -1,73 +1,16 @@
 //! Complexity in n: the free power law `T = c·n^k` (log-log least squares on the medians) and
 //! the complexity class chosen among n, n log n, n^1.5, n², n² log n and n³ by leave-one-out
-//! cross-validation on SMAPE, as Extra-P selects its hypotheses.
+//! cross-validation on SMAPE, as Extra-P selects its hypotheses; what a reader is told of the
+//! growth is [`GrowthReading`], which names that class only where k agrees with it.
 
 use super::bootstrap::{bootstrap, estimate};
+pub use super::growth::ComplexityClass;
+use super::growth::{self, GrowthReading};
 use super::linear::{self, Basis, Goodness};
 use super::{CiMethod, Data, Estimate, FitError, Input, RESAMPLES, Samples, XRule, prepare};
-use serde::{Serialize, Serializer};
+use serde::Serialize;
 
 const MODEL: &str = "power law";
-
-/// A candidate growth class `g(n)`; models are `c·g(n)` or `a + c·g(n)`. Logarithms are base 2
-/// (any base is absorbed by `c`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ComplexityClass {
-    /// Linear, `g(n) = n`.
-    N,
-    /// `g(n) = n·log2 n` (tree codes such as Barnes-Hut).
-    NLogN,
-    /// `g(n) = n^1.5`.
-    NSqrtN,
-    /// Quadratic, `g(n) = n²` (direct all-pairs summation).
-    N2,
-    /// `g(n) = n²·log2 n`.
-    N2LogN,
-    /// Cubic, `g(n) = n³`.
-    N3,
-}
-
-impl ComplexityClass {
-    /// Every class, in increasing order of growth: the hypotheses the selection tries.
-    pub const ALL: [ComplexityClass; 6] = [
-        ComplexityClass::N,
-        ComplexityClass::NLogN,
-        ComplexityClass::NSqrtN,
-        ComplexityClass::N2,
-        ComplexityClass::N2LogN,
-        ComplexityClass::N3,
-    ];
-
-    /// How the class is written in tables, messages and JSON, e.g. `n log n` or `n^2`.
-    pub fn name(self) -> &'static str {
-        match self {
-            ComplexityClass::N => "n",
-            ComplexityClass::NLogN => "n log n",
-            ComplexityClass::NSqrtN => "n^1.5",
-            ComplexityClass::N2 => "n^2",
-            ComplexityClass::N2LogN => "n^2 log n",
-            ComplexityClass::N3 => "n^3",
-        }
-    }
-
-    /// The growth function, `g(n)`.
-    pub fn g(self, n: f64) -> f64 {
-        match self {
-            ComplexityClass::N => n,
-            ComplexityClass::NLogN => n * n.log2(),
-            ComplexityClass::NSqrtN => n * n.sqrt(),
-            ComplexityClass::N2 => n * n,
-            ComplexityClass::N2LogN => n * n * n.log2(),
-            ComplexityClass::N3 => n * n * n,
-        }
-    }
-}
-
-impl Serialize for ComplexityClass {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.name())
-    }
-}
 
 /// One hypothesis of the class selection, fitted to all the medians.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -119,8 +62,12 @@ pub struct PowerFit {
     pub coefficient: Estimate,
     /// Fit of the free power law in log-log space.
     pub power_law_goodness: Goodness,
-    /// The selected complexity class (also in `selected`).
+    /// The class cross-validation selected (also in `selected`); what tables and figures say
+    /// of the growth is `reading`, which names it only where k agrees.
     pub class: ComplexityClass,
+    /// What may be said of the growth: the class, classes the data do not tell apart, or the
+    /// exponent alone.
+    pub reading: GrowthReading,
     /// The selected hypothesis with its parameters' intervals and how firmly it was selected.
     pub selected: SelectedClass,
     /// Every hypothesis with its leave-one-out SMAPE.
@@ -129,15 +76,32 @@ pub struct PowerFit {
     pub ci_method: CiMethod,
     /// The number of bootstrap replicates drawn (before degenerate ones were dropped).
     pub resamples: usize,
-    /// Warnings for a reader, one sentence each: weak class support, wide exponent interval,
-    /// a runner-up class too close over the measured range of n.
+    /// Warnings for a reader, one sentence each: why no class is named, weak class support,
+    /// wide exponent interval, a runner-up class too close over the measured range of n.
     pub notes: Vec<String>,
 }
 
 impl PowerFit {
     /// Time predicted at `n` by the selected class model (the one to extrapolate with).
+    #[cfg(test)]
     pub(crate) fn predict(&self, n: f64) -> f64 {
         self.selected.constant.estimate + self.selected.coefficient.estimate * self.class.g(n)
+    }
+
+    /// The curve the reading stands for at `n`: the named class's model, else the free power
+    /// law `c·n^k` (a figure draws what its legend says).
+    pub(crate) fn curve(&self, n: f64) -> f64 {
+        match self.reading.class() {
+            Some(class) => {
+                self.selected.constant.estimate + self.selected.coefficient.estimate * class.g(n)
+            }
+            None => self.coefficient.estimate * n.powf(self.exponent.estimate),
+        }
+    }
+
+    /// The reading as a table or legend says it (see [`GrowthReading::text`]).
+    pub fn growth(&self) -> String {
+        self.reading.text(self.exponent.estimate)
     }
 }
 
@@ -206,14 +170,19 @@ pub fn fit_power(samples: &[Samples], seed: u64) -> Result<PowerFit, FitError> {
         ),
         support,
     };
-    let mut notes = notes(&exponent, &selected);
-    notes.extend(range_note(&hypotheses, chosen.class, &data.xs));
+    let (lo, hi) = (data.xs[0], data.xs[data.len() - 1]);
+    let reading = growth::read(&exponent, chosen.class, support, lo, hi);
+    let mut notes = notes(&exponent, &selected, &reading, lo, hi);
+    if reading.class().is_some() {
+        notes.extend(range_note(&hypotheses, chosen.class, &data.xs));
+    }
     Ok(PowerFit {
         inputs: data.inputs(),
         exponent,
         coefficient: estimate(ln_c.exp(), reps.fits.iter().map(|r| r.ln_c.exp())),
         power_law_goodness: log_log_goodness(&data, ln_c, k),
         class: chosen.class,
+        reading,
         selected,
         candidates: hypotheses,
         ci_method: reps.method,
@@ -247,42 +216,6 @@ fn refuse_unsupported(k: f64, chosen: &ClassCandidate) -> Result<(), FitError> {
         return Ok(());
     };
     Err(FitError::Unsupported { model: MODEL, why })
-}
-
-/// The n in `[lo, hi]` where the fitted curves ([`PowerFit::predict`]) of two kernels cross,
-/// the first crossing when there are several; `None` when they do not cross in the range (or
-/// the range is not `0 < lo < hi`).
-pub(crate) fn crossover(a: &PowerFit, b: &PowerFit, lo: f64, hi: f64) -> Option<f64> {
-    if !(lo > 0.0 && hi > lo && hi.is_finite()) {
-        return None;
-    }
-    let diff = |ln_n: f64| a.predict(ln_n.exp()) - b.predict(ln_n.exp());
-    let (ln_lo, ln_hi) = (lo.ln(), hi.ln());
-    const STEPS: usize = 512;
-    let mut left = ln_lo;
-    let mut d_left = diff(left);
-    for i in 1..=STEPS {
-        if d_left == 0.0 {
-            return Some(left.exp());
-        }
-        let right = ln_lo + (ln_hi - ln_lo) * i as f64 / STEPS as f64;
-        let d_right = diff(right);
-        if d_left.signum() != d_right.signum() {
-            // Bisection in log n down to f64 resolution.
-            let (mut l, mut r) = (left, right);
-            for _ in 0..100 {
-                let mid = 0.5 * (l + r);
-                if diff(mid).signum() == d_left.signum() {
-                    l = mid;
-                } else {
-                    r = mid;
-                }
-            }
-            return Some((0.5 * (l + r)).exp());
-        }
-        (left, d_left) = (right, d_right);
-    }
-    (d_left == 0.0).then(|| left.exp())
 }
 
 /// `(ln c, k)` of the least-squares line through `(ln n, ln T)`.
@@ -399,9 +332,16 @@ fn range_note(
     })
 }
 
-fn notes(exponent: &Estimate, selected: &SelectedClass) -> Vec<String> {
+fn notes(
+    exponent: &Estimate,
+    selected: &SelectedClass,
+    reading: &GrowthReading,
+    lo: f64,
+    hi: f64,
+) -> Vec<String> {
     let mut notes = Vec::new();
-    if selected.support < 0.7 {
+    notes.extend(growth::note(reading, exponent, lo, hi));
+    if reading.class().is_some() && selected.support < 0.7 {
         notes.push(format!(
             "only {:.0}% of bootstrap replicates select {}: the class is not firmly determined by \
              these points; widen the range of n or take more samples",

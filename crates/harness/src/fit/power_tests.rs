@@ -67,19 +67,6 @@ fn every_candidate_reports_its_loo_smape() {
 }
 
 #[test]
-fn crossover_of_quadratic_and_linear_kernels() {
-    let s = sizes();
-    let quadratic = fit_power(&noisy(&s, 5, 0.01, 1, |n| 1e-9 * n * n), 1).unwrap();
-    let linear = fit_power(&noisy(&s, 5, 0.01, 2, |n| 2e-6 * n), 1).unwrap();
-    let n = crossover(&quadratic, &linear, 10.0, 1e6).unwrap();
-    // 1e-9 n² = 2e-6 n at n = 2000.
-    assert!((n / 2000.0 - 1.0).abs() < 0.1, "{n}");
-    assert!((quadratic.predict(n) / linear.predict(n) - 1.0).abs() < 1e-9);
-    assert_eq!(crossover(&quadratic, &linear, 1e4, 1e6), None);
-    assert_eq!(crossover(&quadratic, &linear, 1e6, 1e4), None);
-}
-
-#[test]
 fn degenerate_input_is_refused() {
     let one = [Samples::new(100.0, vec![1.0, 1.1])];
     assert!(matches!(fit_power(&one, 1), Err(FitError::OneX { .. })));
@@ -129,4 +116,112 @@ fn a_range_too_short_to_tell_two_classes_apart_is_said() {
         "{:?}",
         fit.notes
     );
+}
+
+/// Whether every class `fit`'s reading names grows with an exponent inside k's interval over
+/// the measured n: a class is never printed beside an exponent that contradicts it.
+fn named_classes_fit_k(fit: &PowerFit) -> bool {
+    let (lo, hi) = (fit.inputs[0].x, fit.inputs[fit.inputs.len() - 1].x);
+    let named = match &fit.reading {
+        GrowthReading::Class { class } => vec![*class],
+        GrowthReading::NotDistinguished { classes } => classes.clone(),
+        GrowthReading::ExponentOnly => vec![],
+    };
+    named.iter().all(|&c| {
+        let [a, b] = crate::fit::growth::nominal_exponents(c, lo, hi);
+        a <= fit.exponent.ci95[1] && fit.exponent.ci95[0] <= b
+    })
+}
+
+#[test]
+fn data_growing_as_n_log_n_read_n_log_n_whatever_the_noise() {
+    // The sizes of the report that read "n" in one run and "n log n" in the next.
+    let ns = [1000.0, 2000.0, 4000.0, 8000.0, 16000.0];
+    let readings: Vec<GrowthReading> = (1..=20)
+        .map(|seed| {
+            let s = noisy(&ns, 5, 0.05, seed, |n| 4e-8 * n * n.log2());
+            let fit = fit_power(&s, seed).unwrap();
+            assert!(
+                named_classes_fit_k(&fit),
+                "{:?} beside {:?}",
+                fit.reading,
+                fit.exponent
+            );
+            assert_ne!(fit.reading.class(), Some(ComplexityClass::N));
+            fit.reading
+        })
+        .collect();
+    assert!(
+        readings.iter().all(|r| *r == readings[0]),
+        "readings differ between noise seeds: {readings:?}"
+    );
+    assert_eq!(readings[0].class(), Some(ComplexityClass::NLogN));
+}
+
+#[test]
+fn identical_runs_of_one_kernel_give_one_reading() {
+    for model in [
+        (|n: f64| 3e-9 * n * n) as fn(f64) -> f64,
+        |n| 1e-7 * n * n.sqrt(),
+        |n| 2e-5 + 2e-8 * n,
+    ] {
+        // The reading, not its text: an exponent alone is quoted as measured in each run.
+        let readings: Vec<GrowthReading> = (1..=10)
+            .map(|seed| fit_power(&noisy(&sizes(), 5, 0.05, seed, model), seed).unwrap())
+            .map(|fit| fit.reading)
+            .collect();
+        assert!(
+            readings.iter().all(|r| *r == readings[0]),
+            "readings differ between noise seeds: {readings:?}"
+        );
+    }
+}
+
+#[test]
+fn a_class_is_never_named_beside_an_exponent_that_contradicts_it() {
+    // A setup cost that dominates at small n: cross-validation picks a + c·n log n while the
+    // free exponent is about 0.8 ("n log n (n^0.79)" in a legend).
+    let ns = [1000.0, 2000.0, 4000.0, 8000.0, 16000.0];
+    let mut named_n_log_n = 0;
+    for seed in 1..=20 {
+        let s = noisy(&ns, 5, 0.03, seed, |n| 5e-4 + 4e-8 * n * n.log2());
+        let fit = fit_power(&s, seed).unwrap();
+        assert!(fit.exponent.ci95[1] < 1.0, "{:?}", fit.exponent);
+        assert!(
+            named_classes_fit_k(&fit),
+            "{:?} beside {:?}",
+            fit.reading,
+            fit.exponent
+        );
+        assert_eq!(
+            fit.reading,
+            GrowthReading::ExponentOnly,
+            "{:?}",
+            fit.exponent
+        );
+        let text = fit.growth();
+        assert!(text.starts_with("n^0.") && !text.contains("log"), "{text}");
+        assert!(
+            fit.notes
+                .iter()
+                .any(|n| n.contains("measured exponent alone"))
+        );
+        named_n_log_n += usize::from(fit.class == ComplexityClass::NLogN);
+    }
+    // The case the reading guards against did arise: cross-validation picked n log n.
+    assert!(named_n_log_n > 0);
+    // And whatever the data, the reading keeps to k's interval.
+    for (seed, model) in [
+        (1, (|n: f64| 1e-9 * n.powf(1.04)) as fn(f64) -> f64),
+        (2, |n| 1e-9 * n.powf(1.9)),
+        (3, |n| 1e-4 + 1e-9 * n * n),
+    ] {
+        let fit = fit_power(&noisy(&sizes(), 5, 0.05, seed, model), seed).unwrap();
+        assert!(
+            named_classes_fit_k(&fit),
+            "{:?} beside {:?}",
+            fit.reading,
+            fit.exponent
+        );
+    }
 }

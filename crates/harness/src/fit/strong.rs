@@ -10,7 +10,8 @@ use super::karp_flatt::{self, KarpFlattPoint, KarpFlattTrend};
 use super::linear::{self, Goodness};
 use super::overhead::{self, OverheadCandidate, OverheadSelection, OverheadTerm, OverheadTermFit};
 use super::{
-    CiMethod, Data, Estimate, FitError, Input, RESAMPLES, Samples, XRule, clamp_unit, prepare,
+    CiMethod, Data, Estimate, FitError, Input, RESAMPLES, Samples, SharedMachine, XRule,
+    clamp_unit, prepare,
 };
 use serde::Serialize;
 
@@ -66,7 +67,7 @@ pub struct StrongFit {
     /// The number of bootstrap replicates drawn (before degenerate ones were dropped).
     pub resamples: usize,
     /// Warnings for a reader, one sentence each: clamping, too few thread counts, a kept
-    /// overhead term, ceilings at unmeasured p.
+    /// overhead term, ceilings at unmeasured p, a machine shared with other processes.
     pub notes: Vec<String>,
     /// `(T1, clamped f)` of every bootstrap replicate, for curve bands.
     #[serde(skip)]
@@ -115,6 +116,17 @@ pub fn fit_strong(
     ceiling: &[(f64, f64)],
     seed: u64,
 ) -> Result<StrongFit, FitError> {
+    fit_strong_on(samples, ceiling, seed, None)
+}
+
+/// [`fit_strong`] of times measured on a machine that was `shared` with other processes when
+/// it was: then no reading of the fit attributes the loss of speedup to the code.
+pub fn fit_strong_on(
+    samples: &[Samples],
+    ceiling: &[(f64, f64)],
+    seed: u64,
+    shared: Option<SharedMachine>,
+) -> Result<StrongFit, FitError> {
     let data = prepare(MODEL, samples, XRule::AtLeastOne, 2)?;
     check_inputs(&data.xs, ceiling)?;
     let ps = &data.xs;
@@ -133,8 +145,10 @@ pub fn fit_strong(
     let kf_point = karp_flatt_values(ps, &speedups);
     let karp_flatt = karp_flatt_points(ps, &kf_point, fits);
     let karp_flatt_trend = karp_flatt::trend(
+        &karp_flatt,
         karp_flatt::slope(&above_one, &kf_point),
         fits.iter().filter_map(|r| r.kf_slope),
+        shared.as_ref(),
     );
 
     let unclamped = estimate(f_raw, fits.iter().map(|r| r.f));
@@ -146,7 +160,8 @@ pub fn fit_strong(
         .map(|p| t1 * (f_raw + (1.0 - f_raw) / p))
         .collect();
     let overhead = overhead_selection(candidates, kept, kept_abc, fits);
-    let notes = notes(ps, ceiling, &unclamped, clamped, &overhead);
+    let mut notes = notes(ps, ceiling, &unclamped, clamped, &overhead);
+    notes.extend(shared.map(|s| s.sentence()));
     Ok(StrongFit {
         inputs: data.inputs(),
         points,

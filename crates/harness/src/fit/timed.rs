@@ -2,9 +2,10 @@
 //! that stay serial, divide by the total, and compare with the serial fraction fitted to the
 //! speedups. The fitted one is usually larger: the gap is the cost of running in parallel
 //! (synchronisation, communication, memory contention) that a one-worker run does not have and
-//! so cannot time.
+//! so cannot time, unless the machine was shared: then time-sharing with other processes is in
+//! the gap too, and the comparison says so instead of naming any cost of the code.
 
-use super::{Estimate, FitError};
+use super::{Estimate, FitError, SharedMachine};
 use serde::Serialize;
 
 /// `f_timed = Σ serial / (Σ serial + Σ parallelisable)` of a one-worker run.
@@ -66,11 +67,13 @@ pub(crate) fn timed_serial_fraction(
 const UNUSED_WORKERS_SERIAL: f64 = 0.25;
 
 /// Compares the timed serial fraction with the one fitted to the speedups; `best_speedup` is
-/// the largest measured speedup of the series' parallel runs, when it has any.
+/// the largest measured speedup of the series' parallel runs, when it has any, and `shared`
+/// the load of other processes when the machine was shared.
 pub(crate) fn compare_serial_fractions(
     timed: &TimedSerialFraction,
     fitted: &Estimate,
     best_speedup: Option<f64>,
+    shared: Option<&SharedMachine>,
 ) -> SerialFractionComparison {
     let t = timed.fraction;
     let gap = fitted.estimate - t;
@@ -82,7 +85,17 @@ pub(crate) fn compare_serial_fractions(
         percent(fitted.ci95[1])
     );
     let unused = best_speedup.filter(|&s| s <= 1.0 && t <= UNUSED_WORKERS_SERIAL);
-    let explanation = if let Some(best) = unused {
+    let explanation = if let Some(shared) = shared {
+        // Time-sharing slows the parallel runs as much as any cost of the code would, and
+        // can leave a program that uses its workers with no speedup at all.
+        format!(
+            "The fitted serial fraction {fitted_text} {} the {} of the one-worker time spent in \
+             serial phases, but {}.",
+            if agree { "agrees with" } else { "differs from" },
+            percent(t),
+            shared.sentence()
+        )
+    } else if let Some(best) = unused {
         format!(
             "No run on more workers is faster than the one-worker run (best speedup {best:.2}×), \
              though only {} of the one-worker time is in serial phases: the program most \
@@ -156,7 +169,7 @@ mod tests {
             estimate: 0.12,
             ci95: [0.1, 0.14],
         };
-        let c = compare_serial_fractions(&timed, &larger, Some(1.6));
+        let c = compare_serial_fractions(&timed, &larger, Some(1.6), None);
         assert!(!c.agree && (c.gap - 0.07).abs() < 1e-12);
         assert!(
             c.explanation.contains("7.0% of the one-worker time"),
@@ -168,13 +181,13 @@ mod tests {
             estimate: 0.051,
             ci95: [0.04, 0.06],
         };
-        assert!(compare_serial_fractions(&timed, &same, Some(1.9)).agree);
+        assert!(compare_serial_fractions(&timed, &same, Some(1.9), None).agree);
         let smaller = Estimate {
             estimate: 0.01,
             ci95: [0.0, 0.02],
         };
         assert!(
-            compare_serial_fractions(&timed, &smaller, None)
+            compare_serial_fractions(&timed, &smaller, None, None)
                 .explanation
                 .contains("below")
         );
@@ -188,7 +201,7 @@ mod tests {
             estimate: 1.0,
             ci95: [0.95, 1.0],
         };
-        let c = compare_serial_fractions(&timed, &all, Some(0.91));
+        let c = compare_serial_fractions(&timed, &all, Some(0.91), None);
         assert!(
             c.explanation.contains("does not use its workers"),
             "{}",
@@ -197,11 +210,40 @@ mod tests {
         assert!(c.explanation.contains("0.91×"));
         assert!(!c.explanation.contains("contention"));
         // A speedup above 1 keeps the overhead reading; so does a mostly serial program.
-        let c = compare_serial_fractions(&timed, &all, Some(1.2));
+        let c = compare_serial_fractions(&timed, &all, Some(1.2), None);
         assert!(c.explanation.contains("contention"), "{}", c.explanation);
         let serial = timed_serial_fraction(&[0.9], &[0.1]).unwrap();
-        let c = compare_serial_fractions(&serial, &all, Some(0.99));
+        let c = compare_serial_fractions(&serial, &all, Some(0.99), None);
         assert!(!c.explanation.contains("does not use its workers"));
+    }
+
+    #[test]
+    fn on_a_shared_machine_the_gap_is_not_put_on_the_code() {
+        // f fitted to 100% on two CPUs with one busy: the runs time-shared, nothing more.
+        let timed = timed_serial_fraction(&[0.0009], &[0.9991]).unwrap();
+        let all = Estimate {
+            estimate: 1.0,
+            ci95: [0.95, 1.0],
+        };
+        let shared = SharedMachine {
+            background_cpus: 1.0,
+        };
+        for best in [Some(0.91), Some(1.2), None] {
+            let c = compare_serial_fractions(&timed, &all, best, Some(&shared));
+            for blame in [
+                "synchronisation",
+                "communication",
+                "contention",
+                "does not use",
+            ] {
+                assert!(!c.explanation.contains(blame), "{}", c.explanation);
+            }
+            assert!(
+                c.explanation.contains("other processes used 1.00 CPUs"),
+                "{}",
+                c.explanation
+            );
+        }
     }
 
     #[test]

@@ -142,8 +142,9 @@ pub fn rates_differ(baseline: f64, current: f64) -> Option<String> {
     ))
 }
 
-/// Other processes' CPU use, from the calibrations, above which a baseline is called busy.
-pub const BUSY_BASELINE_CPUS: f64 = 0.25;
+/// Other processes' CPU use, from the calibrations, above which a baseline is called busy:
+/// the one threshold of a shared machine, the calibration's own.
+pub const BUSY_BASELINE_CPUS: f64 = nbody_calibrate::SHARED_MACHINE_CPUS;
 
 /// The most CPUs other processes used during the file's calibrations, if measured.
 pub fn background_cpus(file: &ResultsFile) -> Option<f64> {

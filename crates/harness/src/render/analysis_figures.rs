@@ -6,6 +6,7 @@
 use crate::analysis::forking;
 use crate::analysis::groups::{Point, workers_noun};
 use crate::analysis::{Analysis, ComplexityAnalysis, StrongAnalysis, ThetaAnalysis, WeakAnalysis};
+use crate::fit::{GrowthReading, SharedMachine, Trend};
 use crate::plot::figures::{
     self as fig, Curve, KernelSeries, Measured, Percentiles, PhaseTimes, ThetaPoint, ThetaSweep,
 };
@@ -235,10 +236,19 @@ fn karp_flatt_series(s: &StrongAnalysis) -> Option<KernelSeries> {
                 .oversubscribed(oversubscribed_at(&s.points, k.p))
         })
         .collect();
+    let verdict = match f.karp_flatt_trend.verdict {
+        Trend::Undetermined if f.karp_flatt.len() == 1 => "trend needs two p > 1",
+        verdict => verdict.name(),
+    };
     Some(KernelSeries::new(
-        format!("{} ({})", s.label, f.karp_flatt_trend.verdict.name()),
+        format!("{} ({verdict}{})", s.label, shared_mark(s.shared_machine)),
         m,
     ))
+}
+
+/// ", shared machine" after a label of a study measured on a shared machine, else nothing.
+fn shared_mark(shared: Option<SharedMachine>) -> String {
+    shared.map_or(String::new(), |_| format!(", {}", SharedMachine::MARK))
 }
 
 /// Weak scaling: one efficiency figure per scenario.
@@ -281,7 +291,10 @@ fn weak_series(o: &WeakAnalysis) -> KernelSeries {
                 .one_thread(forking::at_workers(&o.points, e.p).is_some())
         })
         .collect();
-    KernelSeries::new(o.label.clone(), m)
+    let shared = o
+        .shared_machine
+        .map_or(String::new(), |_| format!(" ({})", SharedMachine::MARK));
+    KernelSeries::new(format!("{}{shared}", o.label), m)
 }
 
 /// Phase breakdown and step-time percentiles per scenario, at each case's largest n.
@@ -447,16 +460,26 @@ fn time_series(c: &ComplexityAnalysis) -> KernelSeries {
         let lo = c.points.first().map(|p| p.n as f64).unwrap_or(1.0);
         let hi = c.points.last().map(|p| p.n as f64).unwrap_or(1.0);
         let xs = fig::grid(lo, hi, 40, Scale::Log);
-        series.fit = Some(Curve::from_fn(
-            format!(
-                "{}: {} (n^{:.2})",
+        // The legend says what the curve is: a named class's model, else the free power law
+        // (never a class beside an exponent that contradicts it).
+        let legend = match &f.reading {
+            GrowthReading::Class { class } => {
+                format!(
+                    "{}: {} (k = {:.2})",
+                    c.label,
+                    class.name(),
+                    f.exponent.estimate
+                )
+            }
+            GrowthReading::NotDistinguished { classes } => format!(
+                "{}: n^{:.2} ({})",
                 c.label,
-                f.class.name(),
-                f.exponent.estimate
+                f.exponent.estimate,
+                crate::fit::growth::either(classes)
             ),
-            &xs,
-            |n| f.predict(n),
-        ));
+            GrowthReading::ExponentOnly => format!("{}: n^{:.2}", c.label, f.exponent.estimate),
+        };
+        series.fit = Some(Curve::from_fn(legend, &xs, |n| f.curve(n)));
     }
     series
 }
@@ -490,11 +513,12 @@ fn speedup_series(s: &StrongAnalysis) -> KernelSeries {
         .collect();
     let curve = Curve::from_fn(
         format!(
-            "{}: Amdahl f = {:.3} [{:.3}, {:.3}]",
+            "{}: Amdahl f = {:.3} [{:.3}, {:.3}]{}",
             s.label,
             f.serial_fraction.estimate,
             f.serial_fraction.ci95[0],
-            f.serial_fraction.ci95[1]
+            f.serial_fraction.ci95[1],
+            shared_mark(s.shared_machine)
         ),
         &xs,
         |p| f.amdahl_speedup(p).0,

@@ -253,11 +253,11 @@ pub fn power(file: &str, fit: &PowerFit) -> String {
     } else {
         format!("c*{}", sel.class.name())
     };
+    let _ = writeln!(s, "growth              {}", fit.growth());
     let _ = writeln!(
         s,
-        "complexity class    {} ({model}, c = {}); leave-one-out SMAPE {:.2}%, chosen by {:.0}% \
-         of bootstrap replicates",
-        sel.class.name(),
+        "best model          {model}, c = {}; leave-one-out SMAPE {:.2}%, picked by {:.0}% of \
+         bootstrap replicates",
         WithCi::of(&sel.coefficient, Number),
         sel.loo_smape_percent,
         100.0 * sel.support

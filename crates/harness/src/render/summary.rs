@@ -31,7 +31,8 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
     if !a.complexity.is_empty() {
         let _ = writeln!(
             md,
-            "## Cost vs n\n\n{}\n\n{}",
+            "## Cost vs n\n\n{} {}\n\n{}",
+            tables::complexity_note(),
             tables::peak_note(),
             tables::complexity(a)
         );
@@ -57,7 +58,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             "## Strong scaling\n\n* = more workers than logical CPUs (oversubscribed).\n\n{}",
             tables::strong(a)
         );
-        md.push_str(&tables::strong_one_thread_notes(a));
+        md.push_str(&tables::strong_notes(a));
         let comparisons = tables::serial_comparisons(a);
         if !comparisons.is_empty() {
             let _ = writeln!(md, "Timed vs fitted serial fraction:\n\n{comparisons}");
@@ -69,7 +70,7 @@ pub fn markdown(a: &Analysis, figures: &[Figure]) -> String {
             "## Weak scaling\n\n* = oversubscribed.\n\n{}",
             tables::weak(a)
         );
-        md.push_str(&tables::weak_one_thread_notes(a));
+        md.push_str(&tables::weak_notes(a));
     }
     let phases = super::runs::external_phases(a);
     if !phases.is_empty() {

@@ -4,9 +4,10 @@
 //! REPORT.md both print these, so a number, a marker or a word reads the same in both: an
 //! oversubscribed case is marked `*`, an unbounded speedup is `∞`, a missing value `–`.
 
-use crate::analysis::forking;
 use crate::analysis::groups::Point;
 use crate::analysis::{Analysis, Fitted};
+use crate::analysis::{crossover, forking};
+use crate::fit::{SharedMachine, StrongFit, Trend};
 use crate::units::{Duration, Percent, Plain, WithCi};
 use nbody_engine::output::neutral::control::visible;
 use nbody_engine::physics::LawKind;
@@ -152,28 +153,37 @@ pub(crate) fn peak_note() -> String {
     )
 }
 
-/// Cost vs n: per series, the n range, the time at the largest n, the rates, the fitted
-/// exponent and the class chosen by cross-validation.
+/// Cost vs n: per series, the n range, the time and rates at the largest n (a column of its
+/// own, so that no value reads as if it were the whole range's), the fitted exponent and what
+/// it lets be said of the growth ([`crate::fit::GrowthReading`]).
 pub fn complexity(a: &Analysis) -> String {
     let mut table = Table::new([
         "scenario",
         "kernel",
-        "n",
+        "n measured",
+        "at n",
         "time/step",
         "ns/particle-step",
         "pair-evals/s",
         "peak",
         "k [95% CI]",
-        "class (LOO SMAPE)",
+        "growth",
     ]);
     for c in &a.complexity {
         let (Some(first), Some(last)) = (c.points.first(), c.points.last()) else {
             continue;
         };
-        let (k, class) = match &c.fit.fit {
+        let (k, growth) = match &c.fit.fit {
             Some(f) => (
                 format!("{:.2}", WithCi::of(&f.exponent, Plain)),
-                format!("{} ({:.1}%)", f.class.name(), f.selected.loo_smape_percent),
+                match f.reading.class() {
+                    Some(_) => format!(
+                        "{} (LOO SMAPE {:.1}%)",
+                        f.growth(),
+                        f.selected.loo_smape_percent
+                    ),
+                    None => f.growth(),
+                },
             ),
             None => (NONE.into(), not_fitted(&c.fit)),
         };
@@ -184,6 +194,7 @@ pub fn complexity(a: &Analysis) -> String {
             c.series.scenario.name().to_string(),
             c.label.clone(),
             format!("{}–{}", first.n, last.n),
+            last.n.to_string(),
             Duration(last.median_s).to_string(),
             format!("{:.1}", last.ns_per_particle_step),
             // An external program counts no pairs: none, rather than a rate of zero.
@@ -191,17 +202,38 @@ pub fn complexity(a: &Analysis) -> String {
                 .map_or(NONE.to_string(), |r| format!("{r:.2e}")),
             peak,
             k,
-            class,
+            growth,
         ]);
     }
     table.markdown()
 }
 
-/// The crossovers of the fitted cost curves, one line each.
+/// The sentence that says how to read the cost-vs-n table's columns.
+pub(crate) fn complexity_note() -> String {
+    "Time per step, its rates and the peak share are at the largest n measured (\"at n\"); k is \
+     the exponent of the free power law `T = c·n^k` with its bootstrap 95% CI. A growth class \
+     is named only where the class picked by leave-one-out cross-validation (SMAPE) grows with \
+     an exponent inside k's CI over the measured n; otherwise two classes the data do not tell \
+     apart, or the measured exponent alone."
+        .to_string()
+}
+
+/// The pairs of codes whose measured order changes over n or is not resolved somewhere, one
+/// line each, then how many pairs keep one order throughout.
 pub(crate) fn crossovers(a: &Analysis) -> String {
     let mut md = String::new();
-    for x in &a.crossovers {
-        let _ = writeln!(md, "- {}", crate::analysis::crossover_sentence(x));
+    let (told, settled): (Vec<_>, Vec<_>) = a.crossovers.iter().partition(|x| !x.settled());
+    for x in told {
+        let _ = writeln!(md, "- {}", crossover::sentence(x));
+    }
+    if !settled.is_empty() {
+        let _ = writeln!(
+            md,
+            "- {} other pair{} of codes measured at the same sizes: no crossover (one is \
+             faster at every size where either is, or the two are level).",
+            settled.len(),
+            if settled.len() == 1 { "" } else { "s" },
+        );
     }
     md
 }
@@ -262,20 +294,43 @@ pub fn strong(a: &Analysis) -> String {
             .timed_serial
             .as_ref()
             .map_or(NONE.to_string(), |t| format!("{:.2}", Percent(t.fraction)));
+        let shared = shared_mark(st.shared_machine.as_ref());
         table.row(head.into_iter().chain([
             cells.join("<br>"),
-            WithCi::of(&f.serial_fraction, Percent).to_string(),
+            format!("{}{shared}", WithCi::of(&f.serial_fraction, Percent)),
             bound,
-            f.karp_flatt_trend.verdict.name().to_string(),
+            format!("{}{shared}", karp_flatt_cell(f)),
             timed,
         ]));
     }
     table.markdown()
 }
 
-/// The notes of the one-thread markers ([`forking::OneThread::marker`]) that the strong
-/// table of `a` shows, each a paragraph; empty when it shows none.
-pub(crate) fn strong_one_thread_notes(a: &Analysis) -> String {
+/// `" (shared machine)"` after a reading of a study measured on a shared machine, else
+/// nothing ([`SharedMachine::note`] under the table says what it means).
+fn shared_mark(shared: Option<&SharedMachine>) -> String {
+    shared.map_or(String::new(), |_| format!(" ({})", SharedMachine::MARK))
+}
+
+/// The Karp-Flatt column: e(p) at each p > 1 with its interval, then the trend's verdict, or
+/// with one p > 1 that a trend needs two (its one value is a measurement all the same).
+fn karp_flatt_cell(f: &StrongFit) -> String {
+    let mut lines: Vec<String> = f
+        .karp_flatt
+        .iter()
+        .map(|k| format!("e({}) = {:.1}", k.p, WithCi::of(&k.e, Percent)))
+        .collect();
+    lines.push(match f.karp_flatt_trend.verdict {
+        Trend::Undetermined if f.karp_flatt.len() == 1 => "trend: needs two p > 1".to_string(),
+        verdict => format!("trend: {}", verdict.name()),
+    });
+    lines.join("<br>")
+}
+
+/// The notes that follow the strong table of `a`, each a paragraph: the one-thread markers
+/// ([`forking::OneThread::marker`]) it shows, and the machine shared with other processes;
+/// empty when there is none.
+pub(crate) fn strong_notes(a: &Analysis) -> String {
     let found = a
         .strong
         .iter()
@@ -286,7 +341,13 @@ pub(crate) fn strong_one_thread_notes(a: &Analysis) -> String {
                 .filter(|p| p.p > 1.0)
                 .filter_map(|p| forking::at_workers(&st.points, p.p))
         });
-    forking::notes(found)
+    let shared = a.strong.iter().find_map(|st| st.shared_machine);
+    forking::notes(found) + &shared_note(shared)
+}
+
+/// The paragraph of [`SharedMachine::note`], or nothing on a quiet machine.
+fn shared_note(shared: Option<SharedMachine>) -> String {
+    shared.map_or(String::new(), |s| format!("{}\n\n", s.note()))
 }
 
 /// `notes` to follow a table: after a blank line, ending in one newline; empty without notes,
@@ -298,15 +359,16 @@ pub(crate) fn after_table(notes: &str) -> String {
     }
 }
 
-/// [`strong_one_thread_notes`] for the weak table of `a`.
-pub(crate) fn weak_one_thread_notes(a: &Analysis) -> String {
+/// [`strong_notes`] for the weak table of `a`.
+pub(crate) fn weak_notes(a: &Analysis) -> String {
     let found = a.weak.iter().filter(|w| w.fit.fit.is_some()).flat_map(|w| {
         w.measured
             .iter()
             .filter_map(|e| w.points.iter().find(|c| c.has_workers(e.p)))
             .filter_map(forking::of_point)
     });
-    forking::notes(found)
+    let shared = a.weak.iter().find_map(|w| w.shared_machine);
+    forking::notes(found) + &shared_note(shared)
 }
 
 /// The notes of each complexity fit (a class not firmly determined, a range of n too short to
@@ -363,9 +425,10 @@ pub fn weak(a: &Analysis) -> String {
                 )
             })
             .collect();
+        let shared = shared_mark(w.shared_machine.as_ref());
         table.row(head.into_iter().chain([
-            cells.join("<br>"),
-            WithCi::of(&f.serial_fraction, Percent).to_string(),
+            format!("{}{shared}", cells.join("<br>")),
+            format!("{}{shared}", WithCi::of(&f.serial_fraction, Percent)),
         ]));
     }
     table.markdown()

@@ -193,9 +193,9 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
         let a = &s.analysis;
         let _ = writeln!(
             md,
-            "From {}. Time per step at the largest n, the free power law `T = c·n^k` (bootstrap 95% CI) and the \
-             complexity class chosen by leave-one-out cross-validation (SMAPE). {}\n",
+            "From {}. {} {}\n",
             code(&a.source),
+            tables::complexity_note(),
             tables::peak_note()
         );
         md.push_str(&tables::complexity(a));
@@ -204,7 +204,7 @@ fn complexity(md: &mut String, sweeps: &[Sweep]) {
             let _ = write!(md, "\nWhat the fits cannot tell:\n\n{notes}");
         }
         if !a.crossovers.is_empty() {
-            md.push_str("\nCrossovers of the fitted curves:\n\n");
+            md.push_str("\nCrossovers, from the measured order at each n:\n\n");
             md.push_str(&tables::crossovers(a));
         }
         md.push('\n');
@@ -231,7 +231,7 @@ fn strong(md: &mut String, sweeps: &[Sweep]) {
             code(&a.source)
         );
         md.push_str(&tables::strong(a));
-        md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
+        md.push_str(&tables::after_table(&tables::strong_notes(a)));
         md.push_str("\nTimed vs fitted serial fraction (the Barnes-Hut report's method next to the fit):\n\n");
         md.push_str(&tables::serial_comparisons(a));
         md.push('\n');
@@ -260,7 +260,7 @@ fn weak(md: &mut String, sweeps: &[Sweep]) {
             code(&a.source)
         );
         md.push_str(&tables::weak(a));
-        md.push_str(&tables::after_table(&tables::weak_one_thread_notes(a)));
+        md.push_str(&tables::after_table(&tables::weak_notes(a)));
         md.push('\n');
         s.figure_links(md, "weak-efficiency-");
     }
@@ -334,7 +334,7 @@ fn peers(md: &mut String, sweeps: &[Sweep]) {
         if !a.strong.is_empty() {
             md.push_str("Scaling of each code from 1 to 2 workers (speedup with 95% CI, ÷ the calibrated ceiling):\n\n");
             md.push_str(&tables::strong(a));
-            md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
+            md.push_str(&tables::after_table(&tables::strong_notes(a)));
             md.push('\n');
         }
         s.figure_links(md, "octree-accuracy");

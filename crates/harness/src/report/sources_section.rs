@@ -78,7 +78,7 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
                 code(&a.source)
             );
             md.push_str(&tables::strong(a));
-            md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
+            md.push_str(&tables::after_table(&tables::strong_notes(a)));
             md.push('\n');
             md.push_str(&tables::serial_comparisons(a));
             md.push('\n');
@@ -106,7 +106,7 @@ fn barnes_hut(md: &mut String, sweeps: &[Sweep]) {
                     code(&a.source)
                 );
                 md.push_str(&tables::weak(a));
-                md.push_str(&tables::after_table(&tables::weak_one_thread_notes(a)));
+                md.push_str(&tables::after_table(&tables::weak_notes(a)));
                 md.push('\n');
             }
         }
@@ -138,7 +138,7 @@ fn lj_box(md: &mut String, sweeps: &[Sweep]) {
     if !a.strong.is_empty() {
         md.push_str("Every code over its workers (÷ the calibrated ceiling for threads):\n\n");
         md.push_str(&tables::strong(a));
-        md.push_str(&tables::after_table(&tables::strong_one_thread_notes(a)));
+        md.push_str(&tables::after_table(&tables::strong_notes(a)));
         md.push('\n');
     }
     if !a.complexity.is_empty() {
