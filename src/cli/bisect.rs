@@ -38,7 +38,7 @@ pub struct BisectArgs {
     /// Interleaved rounds of each side-by-side measurement (a midpoint that differs from
     /// neither end is measured again with twice as many): even, from 2 to 100, as the gate's
     /// --rounds.
-    #[arg(long, default_value_t = AB_ROUNDS, value_parser = crate::cli::args::parse_ab_rounds)]
+    #[arg(long, default_value_t = AB_ROUNDS, value_parser = crate::cli::values::parse_ab_rounds)]
     pub rounds: usize,
     /// The smallest change taken for a step, as a fraction (the gate's A/B threshold).
     #[arg(long, default_value_t = AB_THRESHOLD)]

@@ -65,7 +65,7 @@ pub struct BackfillArgs {
     #[arg(value_name = "A..B")]
     pub range: String,
     /// Measure every K-th commit, counted back from B (B always measured); at least 1.
-    #[arg(long, value_name = "K", default_value_t = 1, value_parser = crate::cli::args::parse_count)]
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = crate::cli::values::parse_count)]
     pub every: usize,
     /// The config both sides sweep: one every commit of the range reads (configs/backfill.toml
     /// holds kernels and keys the project has had since the CI config began).
@@ -73,7 +73,7 @@ pub struct BackfillArgs {
     pub config: PathBuf,
     /// Interleaved rounds per case and side: even (each side goes first as often), from 2 to
     /// 100, as the gate's --rounds.
-    #[arg(long, default_value_t = 4, value_parser = crate::cli::args::parse_ab_rounds)]
+    #[arg(long, default_value_t = 4, value_parser = crate::cli::values::parse_ab_rounds)]
     pub rounds: usize,
     /// Where each commit's A/B run is kept.
     #[arg(long, value_name = "DIR", default_value = "results/runs/backfill")]

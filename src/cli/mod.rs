@@ -25,6 +25,7 @@ mod run;
 mod summary;
 mod sweep;
 mod validate;
+mod values;
 
 use crate::cli::args::{Cli, Command, KernelArgs, SkinArg, StartArgs, SystemArgs};
 use nbody_engine::kernels::{KernelKind, KernelParams};

@@ -13,7 +13,7 @@
 //! are warmer than at a large one, and the speedup is a rule of thumb (the calibrated ceiling
 //! of a 2-vCPU machine whose vCPUs are SMT siblings can be 1.0, not 1.9).
 
-use super::runner::samples_in_round;
+use super::measure::samples_in_round;
 use nbody_engine::kernels::{Complexity, KernelKind, Multipole};
 use nbody_engine::run::RunError;
 use nbody_engine::scenario::{Precision, ScenarioKind, Setup, SetupError};

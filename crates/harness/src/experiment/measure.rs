@@ -167,3 +167,24 @@ fn measure<C: Clock>(
         job: None,
     })
 }
+
+/// The share of `samples` taken in `round`: equal parts, the remainder in the first rounds.
+pub(crate) fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
+    samples / rounds + usize::from(round < samples % rounds)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_are_shared_between_rounds() {
+        assert_eq!(
+            (0..3)
+                .map(|r| samples_in_round(10, 3, r))
+                .collect::<Vec<_>>(),
+            vec![4, 3, 3]
+        );
+        assert_eq!((0..2).map(|r| samples_in_round(4, 2, r)).sum::<usize>(), 4);
+    }
+}

@@ -3,7 +3,7 @@
 
 use super::case_round::{case_setup, measure_case};
 use super::lock::WriterLock;
-use super::measure::RoundSpec;
+use super::measure::{RoundSpec, samples_in_round};
 use super::slowdown::{SLOWDOWN_ENV, TestSlowdown};
 use super::slurm;
 use nbody_engine::clock::Clock;
@@ -489,11 +489,6 @@ impl<C: Clock> Sweep<'_, C> {
     }
 }
 
-/// The share of `samples` taken in `round`: equal parts, the remainder in the first rounds.
-pub(crate) fn samples_in_round(samples: usize, rounds: usize, round: usize) -> usize {
-    samples / rounds + usize::from(round < samples % rounds)
-}
-
 /// One round of a case as a batch job: where its job directory goes and what it needs.
 struct JobRound<'a> {
     scheduler: &'a nbody_records::scheduler::Scheduler,
@@ -867,20 +862,4 @@ fn open(
         }
     }
     Ok(existing)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn samples_are_shared_between_rounds() {
-        assert_eq!(
-            (0..3)
-                .map(|r| samples_in_round(10, 3, r))
-                .collect::<Vec<_>>(),
-            vec![4, 3, 3]
-        );
-        assert_eq!((0..2).map(|r| samples_in_round(4, 2, r)).sum::<usize>(), 4);
-    }
 }

@@ -7,7 +7,7 @@
 use super::run::{measure_round, steps};
 use super::{Context, ExternalError};
 use crate::experiment::measure::RoundSpec;
-use crate::experiment::runner::samples_in_round;
+use crate::experiment::measure::samples_in_round;
 use nbody_records::config::SweepConfig;
 use nbody_records::external::External;
 use nbody_records::external::config::Steps;
