@@ -96,16 +96,19 @@ step "every test"
 scripts/install-lammps.sh
 # The unit tests of both crates; the suite but its timing tests; those alone on one test thread
 # (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
+# Every command names the whole workspace, as the build did: cargo resolves the shared
+# dependencies' features for the packages it is given, so a command for the root package
+# alone would compile the harness and the suite a second time (about 3 minutes).
 cargo test --release --workspace "${features[@]}" --lib --bins
-cargo test --release "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
-cargo test --release "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
-cargo test --release "${features[@]}" --benches
+cargo test --release --workspace "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
+cargo test --release --workspace "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
+cargo test --release --workspace "${features[@]}" --bench kernels
 
 step "the MPI drivers under mpirun, and the Slurm path beside them"
 # Sweeps through a one-node Slurm and the weak-scaling job script under sbatch
 # (scripts/slurm-tests.sh), run alongside: they check what comes back, not how fast, and one of
 # them waits out a job's time limit (over a minute).
-NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh "${features[@]}" >"$slurm_log" 2>&1 &
+NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh --workspace "${features[@]}" >"$slurm_log" 2>&1 &
 slurm_tests=$!
 NBODY_BENCH_BIN="$bin" scripts/mpi-tests.sh
 # The course's C codes: warning-free builds, their energy conservation and agreement with each
