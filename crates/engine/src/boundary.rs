@@ -20,6 +20,14 @@ pub enum Boundary<T, const D: usize> {
     },
     /// Unbounded space: particles go anywhere; the bounding box is tracked each step.
     Open,
+    /// Periodic in every dimension: the box `[lo, hi)` tiles space, so a particle that leaves
+    /// through one face comes back through the opposite one with its velocity unchanged.
+    Periodic {
+        /// Lower face on each axis (inside the box).
+        lo: [T; D],
+        /// Upper face on each axis (outside: the image of `lo`).
+        hi: [T; D],
+    },
 }
 
 /// A particle the boundary phase cannot place, usually because the time step is too large.
@@ -39,6 +47,22 @@ pub enum BoundaryError {
         /// The axis it is outside on.
         dim: usize,
         /// Its coordinate on that axis after the reflection.
+        value: f64,
+    },
+    /// A particle is more than one box length outside a periodic box (it crossed more than the
+    /// box in a step).
+    #[error(
+        "step {step}: particle {id} moved more than the periodic box's side in one step \
+         (coordinate {dim} = {value}); the time step is too large for these velocities — reduce --dt"
+    )]
+    Overshot {
+        /// The step being taken, counted from 1.
+        step: u64,
+        /// The particle's id.
+        id: u32,
+        /// The axis it is outside on.
+        dim: usize,
+        /// Its coordinate on that axis after one wrap.
         value: f64,
     },
     /// A particle's position is NaN or infinite.
@@ -93,6 +117,13 @@ impl<T: Real, const D: usize> Boundary<T, D> {
                 ),
                 extent: Extent::empty(),
             },
+            Boundary::Periodic { lo, hi } => BlockCheck {
+                outside: simd::dispatch(
+                    #[inline(always)]
+                    || wrap(x, lo, hi),
+                ),
+                extent: Extent::empty(),
+            },
             Boundary::Open => BlockCheck {
                 outside: [false; D],
                 extent: simd::dispatch(
@@ -115,7 +146,30 @@ impl<T: Real, const D: usize> Boundary<T, D> {
             Boundary::Reflecting { lo, hi } => {
                 if let Some(d) = (0..D).find(|&d| found.outside[d]) {
                     let (lo, hi) = (lo[d], hi[d]);
-                    return Err(first_offender(state, step, d, |x| !(x >= lo && x <= hi)));
+                    let e = first_offender(state, step, d, |x| !(x >= lo && x <= hi));
+                    return Err(e);
+                }
+                Ok(Bounds { lo, hi })
+            }
+            Boundary::Periodic { lo, hi } => {
+                if let Some(d) = (0..D).find(|&d| found.outside[d]) {
+                    let (lo, hi) = (lo[d], hi[d]);
+                    return Err(
+                        match first_offender(state, step, d, |x| !(x >= lo && x < hi)) {
+                            BoundaryError::MultipleReflection {
+                                step,
+                                id,
+                                dim,
+                                value,
+                            } => BoundaryError::Overshot {
+                                step,
+                                id,
+                                dim,
+                                value,
+                            },
+                            e => e,
+                        },
+                    );
                 }
                 Ok(Bounds { lo, hi })
             }
@@ -189,6 +243,28 @@ fn reflect<T: Real, const D: usize>(
             *v = select(below | above, -*v, *v);
             *x = nx;
             bad[d] |= !(nx >= lo && nx <= hi);
+        }
+    }
+    bad
+}
+
+/// Periodic wrapping for one chunk of positions; per dimension, whether a particle is still
+/// outside `[lo, hi)` after one wrap (it moved more than a box length, or is not finite).
+#[inline(always)]
+fn wrap<T: Real, const D: usize>(x: [&mut [T]; D], lo: [T; D], hi: [T; D]) -> [bool; D] {
+    let mut bad = [false; D];
+    for (d, x) in x.into_iter().enumerate() {
+        let (lo, hi) = (lo[d], hi[d]);
+        let side = hi - lo;
+        for x in x.iter_mut() {
+            // Selects, not branches: almost no particle crosses a face in a step.
+            let below = *x < lo;
+            let above = *x >= hi;
+            let nx = select(below, *x + side, select(above, *x - side, *x));
+            // A coordinate just below `lo` can round up to `hi` itself, which is `lo`'s image.
+            let nx = select(nx == hi, lo, nx);
+            *x = nx;
+            bad[d] |= !(nx >= lo && nx < hi);
         }
     }
     bad
@@ -292,6 +368,65 @@ mod tests {
             }
         );
         assert!(err.to_string().contains("step 42") && err.to_string().contains("--dt"));
+    }
+
+    #[test]
+    fn periodic_faces_wrap_positions_and_keep_velocities() {
+        let b = Boundary::Periodic {
+            lo: [0.0, -1.0],
+            hi: [1.0, 1.0],
+        };
+        let mut s = State::<f64, 2>::new(4);
+        s.pos = [vec![-0.25, 1.0, 0.5, 0.999], vec![0.0, 0.0, 1.5, -1.0]];
+        s.vel = [vec![-1.0, 2.0, 0.0, 1.0], vec![0.5, 0.0, 3.0, -1.0]];
+        let v = s.vel.clone();
+        let bounds = b.apply(&mut s, 1).unwrap();
+        assert_eq!(
+            s.pos,
+            [vec![0.75, 0.0, 0.5, 0.999], vec![0.0, 0.0, -0.5, -1.0]]
+        );
+        assert_eq!(s.vel, v);
+        assert_eq!((bounds.lo, bounds.hi), ([0.0, -1.0], [1.0, 1.0]));
+    }
+
+    #[test]
+    fn a_coordinate_that_rounds_onto_the_upper_face_is_its_image_at_the_lower() {
+        let b = Boundary::Periodic {
+            lo: [0.0f32],
+            hi: [10.0],
+        };
+        let mut s = State::<f32, 1>::new(1);
+        s.pos[0][0] = -1e-7;
+        assert_eq!(-1e-7f32 + 10.0, 10.0);
+        b.apply(&mut s, 1).unwrap();
+        assert_eq!(s.pos[0][0], 0.0);
+    }
+
+    #[test]
+    fn a_particle_past_a_whole_periodic_box_is_an_error_naming_it() {
+        let b = Boundary::Periodic {
+            lo: [0.0; 3],
+            hi: [1.0; 3],
+        };
+        let mut s = State::<f64, 3>::new(2);
+        s.pos[2][1] = 2.5;
+        s.id = vec![4, 9];
+        let err = b.apply(&mut s, 8).unwrap_err();
+        assert_eq!(
+            err,
+            BoundaryError::Overshot {
+                step: 8,
+                id: 9,
+                dim: 2,
+                value: 1.5
+            }
+        );
+        assert!(err.to_string().contains("--dt"));
+        s.pos[2][1] = f64::NAN;
+        assert_eq!(
+            b.apply(&mut s, 9).unwrap_err(),
+            BoundaryError::NonFinite { step: 9, id: 9 }
+        );
     }
 
     #[test]

@@ -100,7 +100,7 @@ fn lammps_data<T: Real, L: PairLaw<T>, const D: usize>(
     }
     let v_unit = (epsilon / m).sqrt();
     let (lo, hi) = match &s.boundary {
-        Boundary::Reflecting { lo, hi } => (
+        Boundary::Reflecting { lo, hi } | Boundary::Periodic { lo, hi } => (
             lo.map(|x| x.as_f64() / sigma),
             hi.map(|x| x.as_f64() / sigma),
         ),
@@ -187,6 +187,14 @@ fn text<T: Real, L: PairLaw<T>, const D: usize>(s: &System<T, L, D>) -> String {
             let _ = writeln!(
                 out,
                 "# box reflecting lo {:?} hi {:?}",
+                lo.map(|x| x.as_f64()),
+                hi.map(|x| x.as_f64())
+            );
+        }
+        Boundary::Periodic { lo, hi } => {
+            let _ = writeln!(
+                out,
+                "# box periodic lo {:?} hi {:?}",
                 lo.map(|x| x.as_f64()),
                 hi.map(|x| x.as_f64())
             );

@@ -1,5 +1,7 @@
 //! Force validation: every applicable kernel against the naive sum computed in f64.
 
+pub mod periodic;
+
 use crate::kernels::CompiledKernels;
 use crate::kernels::{ForceKernel, KernelKind, KernelParams, Naive};
 use crate::physics::PairLaw;

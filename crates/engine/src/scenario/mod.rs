@@ -8,6 +8,7 @@
 pub mod galaxy;
 pub mod initial;
 pub mod lj;
+pub mod melt;
 mod placement;
 
 use crate::boundary::Boundary;

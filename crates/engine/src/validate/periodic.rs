@@ -1,0 +1,200 @@
+//! The reference of the periodic kernels: the direct pair sum in f64 through each pair's
+//! nearest image, written apart from every kernel's image search so that it checks them.
+
+use crate::physics::{PairLaw, pair_force};
+use crate::state::{Field, State, zero_field};
+
+/// Why a periodic reference cannot be summed by nearest images.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum PeriodicReferenceError {
+    /// The law has no cutoff: every image interacts, which takes a lattice sum (Ewald), not a
+    /// nearest-image one.
+    #[error("the law has no cutoff: a periodic sum of it needs every image, not the nearest")]
+    NoCutoff,
+    /// A side is not more than twice the cutoff, so a pair can interact through two images.
+    #[error(
+        "side {side} of the periodic box is not more than twice the cutoff {rc}: a pair would \
+         interact through more than one image; use more particles or a larger box"
+    )]
+    BoxTooSmall {
+        /// The side at fault.
+        side: f64,
+        /// The law's cutoff.
+        rc: f64,
+    },
+}
+
+/// The displacement `dx` taken to its nearest image in a periodic box of sides `side`.
+#[inline]
+pub fn nearest_image<const D: usize>(dx: [f64; D], side: [f64; D]) -> [f64; D] {
+    std::array::from_fn(|d| dx[d] - side[d] * (dx[d] / side[d]).round())
+}
+
+/// The forces, the potential energy and, per particle, the sum of its pair forces' magnitudes
+/// (the scale of the rounding error any summation order makes) of `state` in the periodic box
+/// of sides `side`: each pair once, through its nearest image, in f64. Exact when every side is
+/// more than twice the law's cutoff, which it checks.
+pub fn periodic_reference_forces<L: PairLaw<f64>, const D: usize>(
+    law: &L,
+    state: &State<f64, D>,
+    side: [f64; D],
+) -> Result<(Field<f64, D>, f64, Vec<f64>), PeriodicReferenceError> {
+    let rc = law.cutoff().ok_or(PeriodicReferenceError::NoCutoff)?;
+    if let Some(&s) = side.iter().find(|&&s| !(s > 2.0 * rc)) {
+        return Err(PeriodicReferenceError::BoxTooSmall { side: s, rc });
+    }
+    let n = state.len();
+    let mut forces = zero_field::<f64, D>(n);
+    let mut abs_sum = vec![0.0; n];
+    let mut energy = 0.0;
+    for i in 0..n {
+        let xi = state.position(i);
+        for j in i + 1..n {
+            let dx = nearest_image(std::array::from_fn(|d| state.pos[d][j] - xi[d]), side);
+            let (si, sj) = (state.source[i], state.source[j]);
+            let f = pair_force(law, dx, si, sj);
+            let r2: f64 = dx.iter().map(|x| x * x).sum();
+            energy += law.energy(r2, si, sj);
+            let magnitude = f.iter().map(|c| c * c).sum::<f64>().sqrt();
+            abs_sum[i] += magnitude;
+            abs_sum[j] += magnitude;
+            for d in 0..D {
+                forces[d][i] += f[d];
+                forces[d][j] -= f[d];
+            }
+        }
+    }
+    Ok((forces, energy, abs_sum))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::LennardJones;
+    use crate::testing::{SEED_1, random_state};
+
+    /// The force on each particle summed over every image of every other particle in the
+    /// 3^D boxes around it: no nearest-image arithmetic at all.
+    fn all_images<const D: usize>(
+        law: &LennardJones<f64>,
+        state: &State<f64, D>,
+        side: [f64; D],
+    ) -> Field<f64, D> {
+        let n = state.len();
+        let mut forces = zero_field::<f64, D>(n);
+        let shifts: Vec<[f64; D]> = (0..3usize.pow(D as u32))
+            .map(|k| std::array::from_fn(|d| ((k / 3usize.pow(d as u32)) % 3) as f64 - 1.0))
+            .collect();
+        for i in 0..n {
+            for j in (0..n).filter(|&j| j != i) {
+                for s in &shifts {
+                    let dx: [f64; D] =
+                        std::array::from_fn(|d| state.pos[d][j] + s[d] * side[d] - state.pos[d][i]);
+                    let f = pair_force(law, dx, 1.0, 1.0);
+                    for d in 0..D {
+                        forces[d][i] += f[d];
+                    }
+                }
+            }
+        }
+        forces
+    }
+
+    fn agrees<const D: usize>(state: &State<f64, D>, side: [f64; D]) {
+        let law = LennardJones::new(1.0, 1.0, 2.5);
+        let (got, _, abs_sum) = periodic_reference_forces(&law, state, side).unwrap();
+        let want = all_images(&law, state, side);
+        for i in 0..state.len() {
+            for d in 0..D {
+                let err = (got[d][i] - want[d][i]).abs();
+                assert!(
+                    err <= 1e-12 * abs_sum[i].max(1.0),
+                    "particle {i} axis {d}: {err}"
+                );
+            }
+        }
+        // Newton's third law through the images: the forces sum to zero.
+        for d in 0..D {
+            let total: f64 = got[d].iter().sum();
+            assert!(total.abs() < 1e-9 * abs_sum.iter().sum::<f64>(), "{total}");
+        }
+    }
+
+    #[test]
+    fn nearest_images_give_the_sum_over_every_image_in_2d_and_3d() {
+        let side3 = [6.0, 6.5, 7.0];
+        let mut s3 = random_state::<f64, 3>(150, 1.0, false, SEED_1);
+        for i in 0..150 {
+            for d in 0..3 {
+                s3.pos[d][i] *= side3[d];
+            }
+        }
+        agrees(&s3, side3);
+        let side2 = [5.5, 8.0];
+        let mut s2 = random_state::<f64, 2>(60, 1.0, false, SEED_1);
+        for i in 0..60 {
+            for d in 0..2 {
+                s2.pos[d][i] *= side2[d];
+            }
+        }
+        agrees(&s2, side2);
+    }
+
+    #[test]
+    fn pairs_across_every_face_edge_and_corner_meet_through_the_boundary() {
+        // One particle near the lower corner, one near each face, edge and corner opposite:
+        // each pair is 1.1 apart through the boundary and 4.9 or more apart inside the box.
+        let side = [6.0; 3];
+        let mut pos = vec![[0.3, 0.3, 0.3]];
+        for k in 1..27usize {
+            let shift: [f64; 3] = std::array::from_fn(|d| ((k / 3usize.pow(d as u32)) % 3) as f64);
+            if shift.iter().all(|&s| s != 1.0) {
+                pos.push(std::array::from_fn(|d| {
+                    if shift[d] == 2.0 { 6.0 - 0.8 } else { 0.3 }
+                }));
+            }
+        }
+        let mut state = State::<f64, 3>::new(pos.len());
+        for (i, p) in pos.iter().enumerate() {
+            for d in 0..3 {
+                state.pos[d][i] = p[d];
+            }
+        }
+        agrees(&state, side);
+        let law = LennardJones::new(1.0, 1.0, 2.5);
+        let (f, _, _) = periodic_reference_forces(&law, &state, side).unwrap();
+        assert!(
+            (0..3).all(|d| f[d][0] != 0.0),
+            "the corner particle feels its images"
+        );
+    }
+
+    #[test]
+    fn a_pair_at_exactly_the_cutoff_through_an_image_does_not_interact() {
+        let side = [6.0; 3];
+        let mut state = State::<f64, 3>::new(2);
+        state.pos[0][0] = 0.5;
+        state.pos[0][1] = 6.0 - 2.0; // 2.5 from particle 0 through the face at x = 0
+        let law = LennardJones::new(1.0, 1.0, 2.5);
+        let (f, e, _) = periodic_reference_forces(&law, &state, side).unwrap();
+        assert_eq!((f[0][0], e), (0.0, 0.0));
+        state.pos[0][1] = 6.0 - 1.9;
+        let (f, _, _) = periodic_reference_forces(&law, &state, side).unwrap();
+        assert!(f[0][0] != 0.0 && f[0][0] == -f[0][1]);
+    }
+
+    #[test]
+    fn a_box_too_small_for_nearest_images_or_a_law_without_cutoff_is_refused() {
+        let law = LennardJones::new(1.0, 1.0, 2.5);
+        let state = State::<f64, 3>::new(2);
+        assert_eq!(
+            periodic_reference_forces(&law, &state, [6.0, 5.0, 6.0]).unwrap_err(),
+            PeriodicReferenceError::BoxTooSmall { side: 5.0, rc: 2.5 }
+        );
+        let gravity = crate::physics::Gravity::new(1.0, 0.01);
+        assert_eq!(
+            periodic_reference_forces(&gravity, &state, [6.0; 3]).unwrap_err(),
+            PeriodicReferenceError::NoCutoff
+        );
+    }
+}
