@@ -390,6 +390,14 @@ pub enum KernelError {
     /// default.
     #[error("{0}")]
     BadParam(String),
+    /// The kernel has no periodic form (yet): the system's box is periodic.
+    #[error(
+        "kernel `{kernel}` does not sum pairs through periodic boundaries; kernels that do: naive"
+    )]
+    NotPeriodic {
+        /// The kernel's name.
+        kernel: &'static str,
+    },
     /// The fmm kernel was asked for a system that is not 3-D.
     #[error(
         "kernel `{kernel}` runs in three dimensions only and this system has {dim}; the long-range \
@@ -509,6 +517,15 @@ pub trait ForceKernel<T: Real, const D: usize>: Send {
     /// step and answers `None` in between.
     fn sort_every(&self) -> u64 {
         SORT_EVERY
+    }
+
+    /// Makes every pair meet through its nearest image in a periodic box of sides `side`
+    /// (each more than twice the law's cutoff), or says the kernel cannot. A kernel sums pairs
+    /// in open space (or between walls) until this is called.
+    fn set_periodic(&mut self, _side: [T; D]) -> Result<(), KernelError> {
+        Err(KernelError::NotPeriodic {
+            kernel: self.kind().name(),
+        })
     }
 
     /// The kernel's step as the phases of a team region ([`teamed`]), when its structure

@@ -1,25 +1,39 @@
 //! `naive`: every target against every other particle, n(n−1) pair evaluations (the form of the
 //! MPI source code). Targets are independent, so it parallelizes over them without races.
 
+mod periodic;
+
 use super::broadcast::{Tile, tile_forces};
 use super::rows::{Exclude, LANES, RowSum, Sources, Target, gather_excluding};
-use super::{ForceKernel, ForceReport, KernelKind, WorkCounters, worth_parallel};
+use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters, worth_parallel};
 use crate::par::{chunk_len, for_chunks};
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
+use periodic::PeriodicBox;
 use std::ops::Range;
 
 /// The `naive` kernel: every particle against every other, parallel over targets.
 pub struct Naive<L> {
     law: L,
+    /// The sides of the periodic box the pairs meet through (their nearest images), or
+    /// `None` for walls and open space.
+    periodic: Option<Vec<f64>>,
 }
 
 impl<L> Naive<L> {
     /// The kernel for `law`.
     pub fn new(law: L) -> Self {
-        Naive { law }
+        Naive {
+            law,
+            periodic: None,
+        }
+    }
+
+    fn periodic_box<T: Real, const D: usize>(&self) -> Option<PeriodicBox<T, D>> {
+        let side = self.periodic.as_ref()?;
+        Some(PeriodicBox::new(std::array::from_fn(|d| T::of(side[d]))))
     }
 }
 
@@ -86,6 +100,18 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
     ) -> ForceReport {
         let n = state.len();
         let out = forces.each_mut().map(|f| f.as_mut_slice());
+        if let (true, Some(pbox)) = (probe, self.periodic_box()) {
+            let probed = periodic::rows::<T, L, D, true>(&self.law, state, &pbox, 0, out);
+            return ForceReport {
+                energy: Some(0.5 * probed.energy),
+                build_s: 0.0,
+                work: WorkCounters {
+                    pair_checks: (n as u64) * (n.saturating_sub(1) as u64),
+                    pairs_interacting: probed.interacting / 2,
+                    ..Default::default()
+                },
+            };
+        }
         if probe {
             let law = &self.law;
             let total = simd::dispatch(
@@ -117,6 +143,28 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
         let n = state.len();
         let law = &self.law;
         let pair_checks = (targets.len() as u64) * (n.saturating_sub(1) as u64);
+        let report = ForceReport {
+            work: WorkCounters {
+                pair_checks,
+                ..Default::default()
+            },
+            ..Default::default()
+        };
+        if let Some(pbox) = self.periodic_box() {
+            if worth_parallel(pair_checks) {
+                for_chunks(
+                    out,
+                    targets.start,
+                    chunk_len(targets.len()),
+                    &|offset, chunk: [&mut [T]; D]| {
+                        periodic::rows::<T, L, D, false>(law, state, &pbox, offset, chunk);
+                    },
+                );
+            } else {
+                periodic::rows::<T, L, D, false>(law, state, &pbox, targets.start, out);
+            }
+            return report;
+        }
         if worth_parallel(pair_checks) {
             for_chunks(
                 out,
@@ -135,12 +183,11 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
                 || tiles(law, state, targets.start, out),
             );
         }
-        ForceReport {
-            work: WorkCounters {
-                pair_checks,
-                ..Default::default()
-            },
-            ..Default::default()
-        }
+        report
+    }
+
+    fn set_periodic(&mut self, side: [T; D]) -> Result<(), KernelError> {
+        self.periodic = Some(side.iter().map(|s| s.as_f64()).collect());
+        Ok(())
     }
 }

@@ -183,6 +183,103 @@ mod tests {
         assert!(f[0][0] != 0.0 && f[0][0] == -f[0][1]);
     }
 
+    /// A melt of `cells`³ fcc cells, each atom moved off its site by up to `jitter`, in f64.
+    fn melt(cells: usize, jitter: f64) -> (State<f64, 3>, [f64; 3]) {
+        use crate::scenario::melt::{MELT_DENSITY, fcc_lattice};
+        let (side, sites) = fcc_lattice(cells, MELT_DENSITY);
+        let shake = random_state::<f64, 3>(sites.len(), 1.0, false, SEED_1);
+        let mut state = State::<f64, 3>::new(sites.len());
+        for (i, p) in sites.iter().enumerate() {
+            for d in 0..3 {
+                let x = p[d] + jitter * (2.0 * shake.pos[d][i] - 1.0);
+                state.pos[d][i] = x.rem_euclid(side);
+            }
+        }
+        (state, [side; 3])
+    }
+
+    #[test]
+    fn the_periodic_naive_kernel_gives_the_reference_at_every_thread_count() {
+        use crate::kernels::{ForceKernel, Naive};
+        use crate::testing::on_threads;
+        let law = LennardJones::new(1.0, 1.0, 2.5);
+        // 4000 atoms: enough pairs that the kernel forks on two and three threads.
+        let (state, side) = melt(10, 0.2);
+        let (want, energy, abs_sum) = periodic_reference_forces(&law, &state, side).unwrap();
+        let run = |threads, probe| {
+            on_threads(threads, || {
+                let mut kernel = Naive::new(law);
+                ForceKernel::<f64, 3>::set_periodic(&mut kernel, side).unwrap();
+                let mut f = zero_field::<f64, 3>(state.len());
+                let report = kernel.compute(&state, &mut f, probe);
+                (f, report)
+            })
+        };
+        let (one, _) = run(1, false);
+        for i in 0..state.len() {
+            for d in 0..3 {
+                let err = (one[d][i] - want[d][i]).abs();
+                assert!(err <= 1e-12 * abs_sum[i], "particle {i} axis {d}: {err}");
+            }
+        }
+        for threads in [2, 3] {
+            assert_eq!(run(threads, false).0, one, "{threads} threads");
+        }
+        let (probed, report) = run(1, true);
+        assert_eq!(probed, one);
+        let e = report.energy.unwrap();
+        assert!(
+            (e - energy).abs() <= 1e-10 * energy.abs(),
+            "{e} vs {energy}"
+        );
+        // An fcc melt at ρ = 0.8442 has about 4πρ·2.5³/3 ≈ 55 neighbours inside the cutoff.
+        let per_atom = 2.0 * report.work.pairs_interacting as f64 / state.len() as f64;
+        assert!((45.0..65.0).contains(&per_atom), "{per_atom}");
+    }
+
+    #[test]
+    fn the_periodic_naive_kernel_in_f32_is_the_reference_to_single_precision() {
+        use crate::kernels::{ForceKernel, Naive};
+        let wide = LennardJones::new(1.0, 1.0, 2.5);
+        let (state, side) = melt(4, 0.2);
+        let (want, _, abs_sum) = periodic_reference_forces(&wide, &state, side).unwrap();
+        let mut narrow = State::<f32, 3>::new(state.len());
+        for d in 0..3 {
+            narrow.pos[d] = state.pos[d].iter().map(|&x| x as f32).collect();
+        }
+        let mut kernel = Naive::new(LennardJones::<f32>::new(1.0, 1.0, 2.5));
+        ForceKernel::<f32, 3>::set_periodic(&mut kernel, side.map(|s| s as f32)).unwrap();
+        let mut f = zero_field::<f32, 3>(state.len());
+        kernel.compute(&narrow, &mut f, false);
+        for i in 0..state.len() {
+            for d in 0..3 {
+                let err = (f[d][i] as f64 - want[d][i]).abs();
+                assert!(err <= 1e-4 * abs_sum[i], "particle {i} axis {d}: {err}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_kernel_without_a_periodic_form_says_so() {
+        use crate::kernels::{KernelError, KernelKind, KernelParams};
+        let law = LennardJones::new(1.0, 1.0, 2.5);
+        for kind in [
+            KernelKind::CellList,
+            KernelKind::Verlet,
+            KernelKind::Symmetric,
+        ] {
+            let mut kernel = kind
+                .build::<f64, _, 2>(law, &KernelParams::default())
+                .unwrap();
+            let e = kernel.set_periodic([6.0, 6.0]).unwrap_err();
+            assert!(
+                matches!(e, KernelError::NotPeriodic { kernel } if kernel == kind.name()),
+                "{e}"
+            );
+            assert!(e.to_string().contains("naive"), "{e}");
+        }
+    }
+
     #[test]
     fn a_box_too_small_for_nearest_images_or_a_law_without_cutoff_is_refused() {
         let law = LennardJones::new(1.0, 1.0, 2.5);
