@@ -40,7 +40,7 @@ pub fn periodic_reference_forces<L: PairLaw<f64>, const D: usize>(
     side: [f64; D],
 ) -> Result<(Field<f64, D>, f64, Vec<f64>), PeriodicReferenceError> {
     let rc = law.cutoff().ok_or(PeriodicReferenceError::NoCutoff)?;
-    if let Some(&s) = side.iter().find(|&&s| !(s > 2.0 * rc)) {
+    if let Some(&s) = side.iter().find(|&&s| s.is_nan() || s <= 2.0 * rc) {
         return Err(PeriodicReferenceError::BoxTooSmall { side: s, rc });
     }
     let n = state.len();
