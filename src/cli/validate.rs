@@ -127,7 +127,9 @@ fn refuse_long_check(
         return Ok(());
     }
     let mut probe = setup.clone();
-    probe.n = Some(PROBE_N);
+    // The largest count the scenario builds at the probe's size (the melt's lattices).
+    let probe_n = setup.scenario.count_at_most(PROBE_N);
+    probe.n = Some(probe_n);
     let job = ValidateJob {
         params,
         threads,
@@ -135,12 +137,12 @@ fn refuse_long_check(
     };
     let started = std::time::Instant::now();
     validate_setup(&probe, job)??;
-    let ratio = n as f64 / PROBE_N as f64;
+    let ratio = n as f64 / probe_n as f64;
     let wall_s = started.elapsed().as_secs_f64() * ratio * ratio;
     let limit = super::dry_run::LONG_SWEEP_S;
     if wall_s > limit {
         anyhow::bail!(
-            "checking {} at n = {n} is estimated at {} (the check at n = {PROBE_N}, carried as n²); \
+            "checking {} at n = {n} is estimated at {} (the check at n = {probe_n}, carried as n²); \
              it is refused above {}: lower -n, or pass --yes to run it anyway",
             setup.scenario.name(),
             WallTime(wall_s),

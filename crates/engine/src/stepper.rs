@@ -78,7 +78,7 @@ impl<Dc: KernelDecorator> SystemJob for Build<'_, Dc> {
         system: System<T, L, D>,
     ) -> Self::Output {
         let law = system.law;
-        let kernel = self.kernel.build::<T, L, D>(law, self.params)?;
+        let kernel = system.kernel(self.kernel, self.params)?;
         let kernel = self.decorator.decorate(kernel);
         Ok(Box::new(WithLaw {
             sim: Simulation::new(system, kernel),

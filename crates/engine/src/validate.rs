@@ -117,11 +117,30 @@ impl SystemJob for ValidateJob {
 
     fn run<T: Real, L: CompiledKernels<T, D>, const D: usize>(
         self,
-        system: System<T, L, D>,
+        mut system: System<T, L, D>,
     ) -> Self::Output {
+        if let crate::boundary::Boundary::Periodic { lo, hi } = system.boundary {
+            shaken(
+                &mut system.state,
+                lo,
+                hi,
+                system.law.cutoff(),
+                system.info.seed,
+            );
+        }
         let state = &system.state;
         let n = state.len();
-        let (reference, abs_sum) = reference_forces(&system.law.widen(), &state.convert::<f64>());
+        let (reference, abs_sum) = match system.boundary {
+            crate::boundary::Boundary::Periodic { lo, hi } => {
+                let side = std::array::from_fn(|d| (hi[d] - lo[d]).as_f64());
+                let wide = state.convert::<f64>();
+                let (f, _, abs_sum) =
+                    periodic::periodic_reference_forces(&system.law.widen(), &wide, side)
+                        .expect("Setup::validate keeps a periodic side above twice the cutoff");
+                (f, abs_sum)
+            }
+            _ => reference_forces(&system.law.widen(), &state.convert::<f64>()),
+        };
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(self.threads)
             .build()
@@ -136,7 +155,8 @@ impl SystemJob for ValidateJob {
         // run can also differ from the f64 reference where a pair sits within rounding of the
         // cutoff (the truncated force jumps there), which says nothing about the kernel.
         let mut naive = zero_field::<T, D>(n);
-        pool.install(|| Naive::new(system.law).compute(state, &mut naive, false));
+        let mut naive_kernel = system.kernel(KernelKind::Naive, &self.params)?;
+        pool.install(|| naive_kernel.compute(state, &mut naive, false));
         for kind in KernelKind::ALL
             .into_iter()
             .filter(|k| k.supports(system.law.kind()))
@@ -147,8 +167,13 @@ impl SystemJob for ValidateJob {
                 checks.push(KernelCheck::skipped(kind, "fmm needs theta below 1"));
                 continue;
             }
-            let mut kernel: Box<dyn ForceKernel<T, D>> =
-                kind.build::<T, L, D>(system.law, &self.params)?;
+            let mut kernel: Box<dyn ForceKernel<T, D>> = match system.kernel(kind, &self.params) {
+                Err(crate::kernels::KernelError::NotPeriodic { .. }) => {
+                    checks.push(KernelCheck::skipped(kind, "no periodic form yet"));
+                    continue;
+                }
+                built => built?,
+            };
             let mut forces = zero_field::<T, D>(n);
             pool.install(|| kernel.compute(state, &mut forces, false));
             checks.push(check(
@@ -183,6 +208,32 @@ impl SystemJob for ValidateJob {
             kernels: checks,
             dump,
         })
+    }
+}
+
+/// Moves every particle of a periodic system by up to a twenty-fifth of the cutoff on each
+/// axis (a tenth of σ for Lennard-Jones), seeded, wrapped back into the box: on a perfect
+/// lattice every force cancels by symmetry, and a check of forces that are all zero checks
+/// nothing.
+fn shaken<T: Real, const D: usize>(
+    state: &mut State<T, D>,
+    lo: [T; D],
+    hi: [T; D],
+    cutoff: Option<T>,
+    seed: u64,
+) {
+    use rand::{Rng, SeedableRng};
+    let Some(rc) = cutoff else { return };
+    let amplitude = rc.as_f64() / 25.0;
+    let mut rng = rand_pcg::Pcg64Mcg::seed_from_u64(seed);
+    for i in 0..state.len() {
+        for d in 0..D {
+            let (low, side) = (lo[d].as_f64(), (hi[d] - lo[d]).as_f64());
+            let x = state.pos[d][i].as_f64() + amplitude * (2.0 * rng.random::<f64>() - 1.0);
+            let x = T::of(low + (x - low).rem_euclid(side));
+            // Rounding may land on the upper face, the image of the lower.
+            state.pos[d][i] = if x >= hi[d] { lo[d] } else { x };
+        }
     }
 }
 

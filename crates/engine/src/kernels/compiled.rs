@@ -11,7 +11,7 @@ use crate::physics::{Coulomb, Gravity, LennardJones, PairLaw};
 use crate::real::Real;
 
 /// A pair law in `D` dimensions whose kernels this crate compiles: the laws and dimensions of
-/// the scenarios (Lennard-Jones in 2-D, Coulomb and gravity in 3-D), in f32 and f64.
+/// the scenarios (Lennard-Jones in 2-D and 3-D, Coulomb and gravity in 3-D), in f32 and f64.
 pub trait CompiledKernels<T: Real, const D: usize>: PairLaw<T> {
     /// The kernel `kind` for this law, or why the combination does not exist.
     fn build_kernel(
@@ -40,6 +40,8 @@ macro_rules! compiled {
 compiled! {
     LennardJones<f32>, 2;
     LennardJones<f64>, 2;
+    LennardJones<f32>, 3;
+    LennardJones<f64>, 3;
     Coulomb<f32>, 3;
     Coulomb<f64>, 3;
     Gravity<f32>, 3;

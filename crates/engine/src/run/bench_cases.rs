@@ -75,8 +75,8 @@ impl SystemJob for Prepare {
         let params = KernelParams::default();
         let kernel_error = |e: &dyn std::fmt::Display| BenchCaseError::Kernel(e.to_string());
         let build = || {
-            self.kernel
-                .build::<T, L, D>(system.law, &params)
+            system
+                .kernel(self.kernel, &params)
                 .map_err(|e| kernel_error(&e))
         };
         Ok(match self.work {

@@ -94,7 +94,7 @@ impl<C: Clock> SystemJob for RunJob<'_, C> {
         system: System<T, L, D>,
     ) -> Self::Output {
         let spec = self.0;
-        let kernel = spec.kernel.build::<T, L, D>(system.law, &spec.params)?;
+        let kernel = system.kernel(spec.kernel, &spec.params)?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(spec.threads)
             .build()

@@ -5,11 +5,19 @@
 //! The benchmark's own generator is LAMMPS's random stream, which no other code reproduces;
 //! a peer is given this state through `export` instead, so both start from the same atoms.
 
+use super::{Setup, SetupError, System};
+use crate::boundary::Boundary;
+use crate::physics::{LJ_SIGMA, LennardJones};
+use crate::real::Real;
+use crate::state::State;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 
 /// The benchmark's reduced number density ρσ³.
 pub const MELT_DENSITY: f64 = 0.8442;
+/// The melt's number density at the default σ (lengths are in the same unit as the other
+/// Lennard-Jones scenarios', σ = [`LJ_SIGMA`]).
+pub(crate) const LJ_MELT_DENSITY: f64 = MELT_DENSITY / (LJ_SIGMA * LJ_SIGMA * LJ_SIGMA);
 /// The benchmark's initial reduced temperature k_B·T/ε.
 pub const MELT_T0: f64 = 1.44;
 /// The fcc cell's four sites, in units of the lattice constant.
@@ -70,6 +78,44 @@ pub fn thermal_velocities(n: usize, t: f64, seed: u64) -> Vec<[f64; 3]> {
         }
     }
     v
+}
+
+/// The melt of `setup`: the bodies of its initial file, or the fcc lattice of n = 4k³ atoms
+/// with velocities at T0 (in units of ε), in the periodic cube of side (n/ρ)^(1/3).
+pub(super) fn build<T: Real>(setup: &Setup) -> Result<System<T, LennardJones<T>, 3>, SetupError> {
+    let lj = setup.lj;
+    let density = setup.density().expect("lj-melt has a density");
+    let side = setup.box_side(density);
+    let state = match &setup.initial {
+        Some(bodies) => bodies.state::<T, 3>(),
+        None => {
+            let n = setup.n();
+            let cells = fcc_cells(n).ok_or(SetupError::NotFcc(n))?;
+            let (_, sites) = fcc_lattice(cells, density);
+            let t0 = lj.t0.unwrap_or(MELT_T0) * lj.epsilon();
+            let velocities = thermal_velocities(n, t0, setup.seed);
+            let mut state = State::<T, 3>::new(n);
+            for (i, (p, v)) in sites.iter().zip(&velocities).enumerate() {
+                for d in 0..3 {
+                    state.pos[d][i] = T::of(p[d]);
+                    state.vel[d][i] = T::of(v[d]);
+                }
+            }
+            state
+        }
+    };
+    let n = state.len();
+    Ok(System {
+        state,
+        law: LennardJones::new(lj.epsilon(), lj.sigma(), lj.cutoff()),
+        boundary: Boundary::Periodic {
+            lo: [T::zero(); 3],
+            hi: [T::of(side); 3],
+        },
+        external: [T::zero(), T::zero(), T::of(-lj.g(setup.scenario))],
+        dt: T::of(setup.dt()),
+        info: setup.info(n, Some(side)),
+    })
 }
 
 #[cfg(test)]

@@ -24,7 +24,8 @@ use thiserror::Error;
 
 pub use initial::{InitialBodies, InitialError};
 pub use lj::{LJ_CUTOFF, LJ_GAS_DENSITY, LjOverrides};
-use lj::{LJ_LIQUID_DENSITY, LJ_LIQUID_REDUCED_DENSITY};
+use lj::{LJ_LIQUID_DENSITY, LJ_LIQUID_REDUCED_DENSITY, LJ_SIGMA};
+use melt::{LJ_MELT_DENSITY, MELT_DENSITY};
 pub use placement::PlacementError;
 
 /// The scenarios a user can pick.
@@ -36,6 +37,9 @@ pub enum ScenarioKind {
     LjBox,
     /// 2-D Lennard-Jones liquid (reduced density 0.8) in a walled box, no field.
     LjLiquid,
+    /// 3-D Lennard-Jones melt of LAMMPS's `bench/in.lj`: fcc lattice at reduced density
+    /// 0.8442, T0 = 1.44, periodic cube, no field.
+    LjMelt,
     /// 3-D charges ±1 at rest in the unit cube, open space (the Coulomb MPI tutorial).
     Coulomb,
     /// 3-D gravitating system: six massive bodies on circular orbits around a Plummer cloud (the Barnes-Hut report).
@@ -44,9 +48,10 @@ pub enum ScenarioKind {
 
 impl ScenarioKind {
     /// Every scenario, in the order `list` and `validate` go through them.
-    pub const ALL: [ScenarioKind; 4] = [
+    pub const ALL: [ScenarioKind; 5] = [
         ScenarioKind::LjBox,
         ScenarioKind::LjLiquid,
+        ScenarioKind::LjMelt,
         ScenarioKind::Coulomb,
         ScenarioKind::Galaxy,
     ];
@@ -56,6 +61,7 @@ impl ScenarioKind {
         match self {
             ScenarioKind::LjBox => "lj-box",
             ScenarioKind::LjLiquid => "lj-liquid",
+            ScenarioKind::LjMelt => "lj-melt",
             ScenarioKind::Coulomb => "coulomb",
             ScenarioKind::Galaxy => "galaxy",
         }
@@ -64,17 +70,20 @@ impl ScenarioKind {
     /// The pair law its particles interact by.
     pub fn law(self) -> LawKind {
         match self {
-            ScenarioKind::LjBox | ScenarioKind::LjLiquid => LawKind::LennardJones,
+            ScenarioKind::LjBox | ScenarioKind::LjLiquid | ScenarioKind::LjMelt => {
+                LawKind::LennardJones
+            }
             ScenarioKind::Coulomb => LawKind::Coulomb,
             ScenarioKind::Galaxy => LawKind::Gravity,
         }
     }
 
-    /// Spatial dimension: 2 for the Lennard-Jones boxes, 3 for coulomb and galaxy.
+    /// Spatial dimension: 2 for the walled Lennard-Jones boxes, 3 for the melt, coulomb and
+    /// galaxy.
     pub fn dim(self) -> usize {
         match self {
             ScenarioKind::LjBox | ScenarioKind::LjLiquid => 2,
-            ScenarioKind::Coulomb | ScenarioKind::Galaxy => 3,
+            ScenarioKind::LjMelt | ScenarioKind::Coulomb | ScenarioKind::Galaxy => 3,
         }
     }
 
@@ -93,6 +102,13 @@ impl ScenarioKind {
                 precision: Precision::F32,
                 density: Some(LJ_LIQUID_DENSITY),
             },
+            // in.lj's 32 000 atoms at its time step of 0.005 τ (τ = σ·√(m/ε)).
+            ScenarioKind::LjMelt => Defaults {
+                n: 32_000,
+                dt: 0.005 * LJ_SIGMA,
+                precision: Precision::F32,
+                density: Some(LJ_MELT_DENSITY),
+            },
             ScenarioKind::Coulomb => Defaults {
                 n: 1000,
                 dt: 1e-5,
@@ -108,6 +124,20 @@ impl ScenarioKind {
         }
     }
 
+    /// The largest particle count of at most `n` the scenario builds (the melt's lattices hold
+    /// 4k³ atoms, from 108 on), for probes that scale a case down; `n` itself for the others.
+    pub fn count_at_most(self, n: usize) -> usize {
+        match self {
+            ScenarioKind::LjMelt => {
+                let k = ((n / 4) as f64).cbrt().floor() as usize;
+                // The cube root of a perfect cube may round below it.
+                let k = if 4 * (k + 1).pow(3) <= n { k + 1 } else { k };
+                4 * k.max(3).pow(3)
+            }
+            _ => n,
+        }
+    }
+
     /// One line for `list`.
     pub fn summary(self) -> &'static str {
         match self {
@@ -115,6 +145,9 @@ impl ScenarioKind {
                 "2-D LJ gas, sigma=0.01, rc=2.5 sigma, walls, g=1, T0=1 (the LJ-box assignment)"
             }
             ScenarioKind::LjLiquid => "2-D LJ liquid, reduced density 0.8, walls, no field",
+            ScenarioKind::LjMelt => {
+                "3-D LJ melt, fcc at reduced density 0.8442, T0=1.44, periodic (LAMMPS's bench/in.lj); n = 4k^3"
+            }
             ScenarioKind::Coulomb => {
                 "3-D charges +-1 at rest in the unit cube, quench 1e-3, open (the Coulomb MPI tutorial)"
             }
@@ -141,7 +174,8 @@ pub struct Defaults {
     pub dt: f64,
     /// Precision when `--precision` is not given.
     pub precision: Precision,
-    /// Particles per unit area, for the scenarios that have a density parameter.
+    /// Particles per unit area (per unit volume in 3-D), for the scenarios that have a
+    /// density parameter.
     pub density: Option<f64>,
 }
 
@@ -236,6 +270,24 @@ pub enum SetupError {
         /// Particle size σ that positions must resolve.
         sigma: f64,
     },
+    /// lj-melt was asked for a count that is not 4k³, the atoms of an fcc lattice of k³ cells.
+    #[error(
+        "lj-melt places its atoms on an fcc lattice of k^3 cells, 4 atoms each: n must be 4k^3 \
+         (4000, 32000, 256000, ...), not {0}"
+    )]
+    NotFcc(usize),
+    /// The periodic box is not more than twice the cutoff wide, so a pair would interact
+    /// through two images.
+    #[error(
+        "the periodic box of side {side:.4} is not more than twice the cutoff {rc}: a pair would \
+         meet through two images; use more atoms (lj-melt: n = 108 or more) or a lower --density"
+    )]
+    PeriodicTooSmall {
+        /// The box's side.
+        side: f64,
+        /// The cutoff.
+        rc: f64,
+    },
     /// The seeded placement could not fit the particles at minimum spacing σ.
     #[error(transparent)]
     Placement(#[from] PlacementError),
@@ -323,6 +375,9 @@ impl Setup {
                 let sigma = self.lj.sigma();
                 Some(LJ_LIQUID_REDUCED_DENSITY / (sigma * sigma))
             }
+            (None, ScenarioKind::LjMelt) if self.lj.sigma.is_some() => {
+                Some(MELT_DENSITY / self.lj.sigma().powi(3))
+            }
             (None, _) => self.scenario.defaults().density,
         }
     }
@@ -348,6 +403,12 @@ impl Setup {
         if self.n() > MAX_PARTICLES {
             return Err(SetupError::TooManyParticles(self.n()));
         }
+        if self.scenario == ScenarioKind::LjMelt
+            && self.initial.is_none()
+            && melt::fcc_cells(self.n()).is_none()
+        {
+            return Err(SetupError::NotFcc(self.n()));
+        }
         let dt = self.dt();
         if !(dt.is_finite() && dt > 0.0) {
             return Err(SetupError::BadDt(dt));
@@ -363,7 +424,7 @@ impl Setup {
         if let Some(density) = self.density() {
             // A finite geometry the precision can resolve: positions near the far wall must
             // still tell apart points σ apart (and the side itself must be finite).
-            let side = (self.n() as f64 / density).sqrt();
+            let side = self.box_side(density);
             let epsilon = match self.precision() {
                 Precision::F32 => f32::EPSILON as f64,
                 Precision::F64 => f64::EPSILON,
@@ -379,11 +440,24 @@ impl Setup {
                 });
             }
         }
+        if let (ScenarioKind::LjMelt, Some(density)) = (self.scenario, self.density()) {
+            // Every pair meets through its nearest image only: no two images of a particle
+            // may both lie within the cutoff.
+            let (side, rc) = (self.box_side(density), self.lj.cutoff());
+            if side <= 2.0 * rc {
+                return Err(SetupError::PeriodicTooSmall { side, rc });
+            }
+        }
         if let Some(bodies) = &self.initial {
-            let side = self.density().map(|rho| (self.n() as f64 / rho).sqrt());
+            let side = self.density().map(|rho| self.box_side(rho));
             bodies.check(self.scenario, side)?;
         }
         Ok(())
+    }
+
+    /// The side of the scenario's box at number `density`: (n/ρ)^(1/D).
+    pub(crate) fn box_side(&self, density: f64) -> f64 {
+        (self.n() as f64 / density).powf(1.0 / self.scenario.dim() as f64)
     }
 
     /// Builds the system in the scenario's dimension, law and precision and runs `job` on it.
@@ -396,6 +470,8 @@ impl Setup {
             (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F64) => {
                 job.run(lj::build::<f64>(self)?)
             }
+            (ScenarioKind::LjMelt, Precision::F32) => job.run(melt::build::<f32>(self)?),
+            (ScenarioKind::LjMelt, Precision::F64) => job.run(melt::build::<f64>(self)?),
             (ScenarioKind::Coulomb, Precision::F32) => job.run(self.coulomb::<f32>()),
             (ScenarioKind::Coulomb, Precision::F64) => job.run(self.coulomb::<f64>()),
             (ScenarioKind::Galaxy, Precision::F32) => job.run(self.galaxy::<f32>()),
@@ -490,7 +566,7 @@ pub struct System<T: Real, L, const D: usize> {
     pub state: State<T, D>,
     /// The pair law, with the scenario's parameters.
     pub law: L,
-    /// Reflecting walls or open space.
+    /// Reflecting walls, a periodic box or open space.
     pub boundary: Boundary<T, D>,
     /// Constant external acceleration on every particle (the lj-box field).
     pub external: [T; D],
@@ -498,6 +574,22 @@ pub struct System<T: Real, L, const D: usize> {
     pub dt: T,
     /// What was built, for summaries and results.
     pub info: SystemInfo,
+}
+
+impl<T: Real, L: CompiledKernels<T, D>, const D: usize> System<T, L, D> {
+    /// The kernel `kind` for this system's law and box: in a periodic box it sums every pair
+    /// through its nearest image, or is refused when it has no periodic form.
+    pub fn kernel(
+        &self,
+        kind: crate::kernels::KernelKind,
+        params: &crate::kernels::KernelParams,
+    ) -> Result<Box<dyn crate::kernels::ForceKernel<T, D>>, crate::kernels::KernelError> {
+        let mut kernel = kind.build::<T, L, D>(self.law, params)?;
+        if let Boundary::Periodic { lo, hi } = self.boundary {
+            kernel.set_periodic(std::array::from_fn(|d| hi[d] - lo[d]))?;
+        }
+        Ok(kernel)
+    }
 }
 
 /// Work that runs on a system whatever its types (the visitor of [`Setup::dispatch`]).
@@ -535,7 +627,7 @@ mod tests {
     fn same_seed_same_state_different_seed_different_state() {
         for kind in ScenarioKind::ALL {
             let mut setup = Setup::new(kind);
-            setup.n = Some(300);
+            setup.n = Some(kind.count_at_most(300));
             let a = setup.dispatch(Snapshot).unwrap();
             let b = setup.dispatch(Snapshot).unwrap();
             assert_eq!(a, b, "{kind:?}");
@@ -543,6 +635,16 @@ mod tests {
             setup.seed = 2;
             assert_ne!(a.1, setup.dispatch(Snapshot).unwrap().1, "{kind:?}");
         }
+    }
+
+    #[test]
+    fn a_scaled_down_melt_is_still_a_lattice() {
+        let melt = ScenarioKind::LjMelt;
+        assert_eq!(melt.count_at_most(2000), 1372);
+        assert_eq!(melt.count_at_most(32_000), 32_000);
+        assert_eq!(melt.count_at_most(31_999), 27_436);
+        assert_eq!(melt.count_at_most(10), 108);
+        assert_eq!(ScenarioKind::LjBox.count_at_most(2000), 2000);
     }
 
     #[test]

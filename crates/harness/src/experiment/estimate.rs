@@ -395,7 +395,9 @@ fn probe_with_error_sample(error_sample: usize, cases: &[Case]) -> Result<Probed
             continue;
         }
         let same = cases.iter().filter(|c| key(c) == Some(this));
-        let n = same.map(|c| c.n).max().unwrap_or(case.n).min(PROBE_MAX_N);
+        let n = case
+            .scenario
+            .count_at_most(same.map(|c| c.n).max().unwrap_or(case.n).min(PROBE_MAX_N));
         let what = format!("{}/{}", case.scenario.name(), case.kernel.name());
         let mut setup = Setup::new(case.scenario);
         setup.n = Some(n);

@@ -92,7 +92,7 @@ impl SystemJob for MpiJob<'_> {
                 "--rank-grid applies to --decomp domain only".into(),
             ));
         }
-        let kernel = spec.kernel.build::<T, L, D>(system.law, &spec.params)?;
+        let kernel = system.kernel(spec.kernel, &spec.params)?;
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(spec.threads)
             .build()
