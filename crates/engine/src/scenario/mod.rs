@@ -614,8 +614,11 @@ mod tests {
             self,
             s: System<T, L, D>,
         ) -> Self::Output {
+            // Positions and velocities: the melt's lattice is the same at every seed, its
+            // velocities are not.
             let pos = (0..s.state.len())
                 .flat_map(|i| s.state.position(i))
+                .chain(s.state.vel.iter().flatten().copied())
                 .map(|x| x.as_f64())
                 .collect();
             let src = s.state.source.iter().map(|x| x.as_f64()).collect();

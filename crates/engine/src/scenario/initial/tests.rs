@@ -24,7 +24,7 @@ fn exported(scenario: ScenarioKind, n: usize) -> (Setup, String) {
 #[test]
 fn an_exported_state_starts_the_same_state_in_every_scenario() {
     for scenario in ScenarioKind::ALL {
-        let (setup, text) = exported(scenario, 300);
+        let (setup, text) = exported(scenario, scenario.count_at_most(300));
         let bodies = parse_str(&text).unwrap();
         assert_eq!(bodies.format, InitialFormat::Export);
         assert_eq!(bodies.dim, scenario.dim());
