@@ -56,12 +56,18 @@ pub fn list() -> anyhow::Result<i32> {
     }
     outln!("\nSupported combinations (law: kernels):");
     for s in ScenarioKind::ALL {
-        outln!(
-            "  {:<10} ({}): {}",
-            s.name(),
-            s.law().name(),
+        let kernels = if s.periodic() {
+            // A periodic box takes the kernels with a periodic form only.
+            let names: Vec<&str> = KernelKind::ALL
+                .into_iter()
+                .filter(|k| k.supports(s.law()) && k.periodic_form())
+                .map(KernelKind::name)
+                .collect();
+            format!("{} (periodic box)", names.join(", "))
+        } else {
             nbody_engine::kernels::supported_for(s.law())
-        );
+        };
+        outln!("  {:<10} ({}): {}", s.name(), s.law().name(), kernels);
     }
     Ok(0)
 }

@@ -43,6 +43,17 @@ fn check_scenario(
         // --density applies to the scenarios that have one.
         s.density = None;
     }
+    if let Some(n) = args.system.n.filter(|_| args.scenario.is_none()) {
+        // -n for every scenario: the melt is checked at the largest lattice of at most n.
+        let lattice = scenario.count_at_most(n);
+        if lattice != n {
+            eprintln!(
+                "{}: n = {n} is not a lattice of this scenario; checked at n = {lattice}",
+                scenario.name()
+            );
+            s.n = Some(lattice);
+        }
+    }
     s.validate()?;
     // The trees and the Verlet list hold the most memory of the kernels checked, the O(n²)
     // direct sums take the time: the f64 reference and the three quadratic kernels, one

@@ -105,7 +105,9 @@ impl SystemJob for Parts {
 
 #[test]
 fn parts_add_up_to_the_whole() {
-    for scenario in ScenarioKind::ALL {
+    // The periodic melt: only naive has a periodic form so far, checked against the
+    // nearest-image reference in the engine's validate::periodic tests.
+    for scenario in ScenarioKind::ALL.into_iter().filter(|s| !s.periodic()) {
         for n in [1, 5, 301, 1200] {
             for threads in [1, 2] {
                 let mut setup = Setup::new(scenario);

@@ -137,7 +137,9 @@ fn exact_kernels_agree_with_the_reference() {
         KernelKind::CellList,
         KernelKind::Verlet,
     ];
-    for scenario in ScenarioKind::ALL {
+    // The periodic melt: only naive has a periodic form so far, checked against the
+    // nearest-image reference in the engine's validate::periodic tests.
+    for scenario in ScenarioKind::ALL.into_iter().filter(|s| !s.periodic()) {
         for precision in [Precision::F32, Precision::F64] {
             for n in [1, 2, 7, 100, 1500, 3001] {
                 for threads in [1, 2, 3] {
@@ -176,7 +178,9 @@ fn probe_paths_agree_with_naive() {
         KernelKind::CellList,
         KernelKind::Verlet,
     ];
-    for scenario in ScenarioKind::ALL {
+    // The periodic melt: only naive has a periodic form so far, checked against the
+    // nearest-image reference in the engine's validate::periodic tests.
+    for scenario in ScenarioKind::ALL.into_iter().filter(|s| !s.periodic()) {
         for precision in [Precision::F32, Precision::F64] {
             for n in [2, 7, 1500] {
                 for threads in [1, 2] {

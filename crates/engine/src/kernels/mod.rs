@@ -157,6 +157,12 @@ impl KernelKind {
         )
     }
 
+    /// Whether the kernel sums pairs through periodic boundaries
+    /// ([`ForceKernel::set_periodic`] succeeds).
+    pub fn periodic_form(self) -> bool {
+        matches!(self, KernelKind::Naive)
+    }
+
     /// Whether the build phase (binning and sorting) runs on the pool's threads when the
     /// particles are many (from `par::MIN_FORK_ELEMENTS` on).
     pub fn parallel_build(self) -> bool {

@@ -124,6 +124,11 @@ impl ScenarioKind {
         }
     }
 
+    /// Whether the scenario's box is periodic (pairs meet through nearest images).
+    pub fn periodic(self) -> bool {
+        self == ScenarioKind::LjMelt
+    }
+
     /// The largest particle count of at most `n` the scenario builds (the melt's lattices hold
     /// 4k³ atoms, from 108 on), for probes that scale a case down; `n` itself for the others.
     pub fn count_at_most(self, n: usize) -> usize {
@@ -280,7 +285,7 @@ pub enum SetupError {
     /// through two images.
     #[error(
         "the periodic box of side {side:.4} is not more than twice the cutoff {rc}: a pair would \
-         meet through two images; use more atoms (lj-melt: n = 108 or more) or a lower --density"
+         meet through two images: give more atoms (lj-melt: n = 108 or more) or a lower --density"
     )]
     PeriodicTooSmall {
         /// The box's side.

@@ -260,18 +260,20 @@ mod tests {
     }
 
     #[test]
-    fn a_kernel_without_a_periodic_form_says_so() {
+    fn a_kernel_without_a_periodic_form_says_so_and_the_list_knows_which() {
         use crate::kernels::{KernelError, KernelKind, KernelParams};
+        use crate::physics::PairLaw;
         let law = LennardJones::new(1.0, 1.0, 2.5);
-        for kind in [
-            KernelKind::CellList,
-            KernelKind::Verlet,
-            KernelKind::Symmetric,
-        ] {
+        for kind in KernelKind::ALL
+            .into_iter()
+            .filter(|k| k.supports(law.kind()))
+        {
             let mut kernel = kind
                 .build::<f64, _, 2>(law, &KernelParams::default())
                 .unwrap();
-            let e = kernel.set_periodic([6.0, 6.0]).unwrap_err();
+            let set = kernel.set_periodic([6.0, 6.0]);
+            assert_eq!(set.is_ok(), kind.periodic_form(), "{kind:?}");
+            let Err(e) = set else { continue };
             assert!(
                 matches!(e, KernelError::NotPeriodic { kernel } if kernel == kind.name()),
                 "{e}"
