@@ -136,7 +136,14 @@ impl SystemJob for ValidateJob {
                 let wide = state.convert::<f64>();
                 let (f, _, abs_sum) =
                     periodic::periodic_reference_forces(&system.law.widen(), &wide, side)
-                        .expect("Setup::validate keeps a periodic side above twice the cutoff");
+                        // Setup::validate checks the side in f64; in f32 a side within
+                        // rounding of twice the cutoff can still fail, and says so.
+                        .map_err(|e| {
+                            crate::kernels::KernelError::BadParam(format!(
+                                "{e} (at {} precision)",
+                                T::NAME
+                            ))
+                        })?;
                 (f, abs_sum)
             }
             _ => reference_forces(&system.law.widen(), &state.convert::<f64>()),
