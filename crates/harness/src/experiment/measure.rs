@@ -32,10 +32,9 @@ pub(crate) struct RoundSpec {
     pub slowdown: Option<TestSlowdown>,
 }
 
-#[cfg(test)]
 impl RoundSpec {
     /// `samples` samples and nothing else: no warm-up, no minimum length, steps chosen, no
-    /// force error or reference (the unit tests' round).
+    /// force error or reference (the unit tests' round, and the dry run's trial of a program).
     pub(crate) fn bare(samples: usize) -> RoundSpec {
         RoundSpec {
             samples,

@@ -91,15 +91,7 @@ fn try_one(
         warmup_runs: 0,
         ..ext.clone()
     };
-    let spec = RoundSpec {
-        samples: 1,
-        warmup_s: 0.0,
-        min_sample_s: 0.0,
-        steps_per_sample: None,
-        force_error_sample: 0,
-        reference_s: 0.0,
-        slowdown: None,
-    };
+    let spec = RoundSpec::bare(1);
     let started = std::time::Instant::now();
     let outcome = measure_round(&once, case, &spec, config.mpi.as_ref(), context)?;
     let round_s = started.elapsed().as_secs_f64();
