@@ -160,7 +160,7 @@ impl KernelKind {
     /// Whether the kernel sums pairs through periodic boundaries
     /// ([`ForceKernel::set_periodic`] succeeds).
     pub fn periodic_form(self) -> bool {
-        matches!(self, KernelKind::Naive)
+        matches!(self, KernelKind::Naive | KernelKind::Verlet)
     }
 
     /// Whether the build phase (binning and sorting) runs on the pool's threads when the
@@ -398,7 +398,7 @@ pub enum KernelError {
     BadParam(String),
     /// The kernel has no periodic form (yet): the system's box is periodic.
     #[error(
-        "kernel `{kernel}` does not sum pairs through periodic boundaries; kernels that do: naive"
+        "kernel `{kernel}` does not sum pairs through periodic boundaries; kernels that do: naive, verlet"
     )]
     NotPeriodic {
         /// The kernel's name.
@@ -525,10 +525,10 @@ pub trait ForceKernel<T: Real, const D: usize>: Send {
         SORT_EVERY
     }
 
-    /// Makes every pair meet through its nearest image in a periodic box of sides `side`
-    /// (each more than twice the law's cutoff), or says the kernel cannot. A kernel sums pairs
+    /// Makes every pair meet through its nearest image in the periodic box `[lo, hi)` (each
+    /// side more than twice the law's cutoff), or says the kernel cannot. A kernel sums pairs
     /// in open space (or between walls) until this is called.
-    fn set_periodic(&mut self, _side: [T; D]) -> Result<(), KernelError> {
+    fn set_periodic(&mut self, _lo: [T; D], _hi: [T; D]) -> Result<(), KernelError> {
         Err(KernelError::NotPeriodic {
             kernel: self.kind().name(),
         })

@@ -186,8 +186,8 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Naive<L> {
         report
     }
 
-    fn set_periodic(&mut self, side: [T; D]) -> Result<(), KernelError> {
-        self.periodic = Some(side.iter().map(|s| s.as_f64()).collect());
+    fn set_periodic(&mut self, lo: [T; D], hi: [T; D]) -> Result<(), KernelError> {
+        self.periodic = Some((0..D).map(|d| (hi[d] - lo[d]).as_f64()).collect());
         Ok(())
     }
 }

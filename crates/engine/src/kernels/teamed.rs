@@ -27,18 +27,20 @@ pub struct Colors {
 impl Colors {
     /// The colouring of parts whose touched places are `spans` (in part order).
     pub fn of(spans: impl Iterator<Item = Range<usize>>) -> Colors {
-        let mut reach = [0usize; 2];
-        let (mut parts, mut disjoint) = (0, true);
-        for span in spans {
-            let c = parts % 2;
-            if span.is_empty() {
-                parts += 1;
-                continue;
-            }
-            disjoint &= span.start >= reach[c];
-            reach[c] = reach[c].max(span.end);
-            parts += 1;
-        }
+        Self::of_sets(spans.map(|s| [s]))
+    }
+
+    /// The colouring of parts each touching the places of `K` ranges (a list in a periodic box
+    /// reaches across the faces to places far from its other ones).
+    pub fn of_sets<const K: usize>(sets: impl Iterator<Item = [Range<usize>; K]>) -> Colors {
+        let sets: Vec<[Range<usize>; K]> = sets.collect();
+        let parts = sets.len();
+        let meet = |a: &Range<usize>, b: &Range<usize>| {
+            !a.is_empty() && !b.is_empty() && a.start < b.end && b.start < a.end
+        };
+        let apart =
+            |p: usize, q: usize| sets[p].iter().all(|a| sets[q].iter().all(|b| !meet(a, b)));
+        let disjoint = (0..parts).all(|p| (p + 2..parts).step_by(2).all(|q| apart(p, q)));
         Colors { parts, disjoint }
     }
 
@@ -152,5 +154,23 @@ mod tests {
         // Empty parts touch nothing.
         let c = Colors::of([0..10, 5..5, 10..20, 15..15].into_iter());
         assert!(c.disjoint());
+    }
+
+    #[test]
+    fn a_part_reaching_across_the_faces_meets_the_parts_of_its_colour_there() {
+        // Four bands of 10 places; the first reaches into the last across the faces.
+        let bands = |wrap: Range<usize>| {
+            [
+                [0..15, wrap],
+                [10..25, 0..0],
+                [20..35, 0..0],
+                [30..40, 0..0],
+            ]
+            .into_iter()
+        };
+        // The last band is of the other colour: disjoint.
+        assert!(Colors::of_sets(bands(35..40)).disjoint());
+        // Reaching into the third band (the first's colour) is not.
+        assert!(!Colors::of_sets(bands(30..40)).disjoint());
     }
 }

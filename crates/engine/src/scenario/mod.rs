@@ -591,7 +591,7 @@ impl<T: Real, L: CompiledKernels<T, D>, const D: usize> System<T, L, D> {
     ) -> Result<Box<dyn crate::kernels::ForceKernel<T, D>>, crate::kernels::KernelError> {
         let mut kernel = kind.build::<T, L, D>(self.law, params)?;
         if let Boundary::Periodic { lo, hi } = self.boundary {
-            kernel.set_periodic(std::array::from_fn(|d| hi[d] - lo[d]))?;
+            kernel.set_periodic(lo, hi)?;
         }
         Ok(kernel)
     }

@@ -209,7 +209,7 @@ mod tests {
         let run = |threads, probe| {
             on_threads(threads, || {
                 let mut kernel = Naive::new(law);
-                ForceKernel::<f64, 3>::set_periodic(&mut kernel, side).unwrap();
+                ForceKernel::<f64, 3>::set_periodic(&mut kernel, [0.0; 3], side).unwrap();
                 let mut f = zero_field::<f64, 3>(state.len());
                 let report = kernel.compute(&state, &mut f, probe);
                 (f, report)
@@ -248,7 +248,7 @@ mod tests {
             narrow.pos[d] = state.pos[d].iter().map(|&x| x as f32).collect();
         }
         let mut kernel = Naive::new(LennardJones::<f32>::new(1.0, 1.0, 2.5));
-        ForceKernel::<f32, 3>::set_periodic(&mut kernel, side.map(|s| s as f32)).unwrap();
+        ForceKernel::<f32, 3>::set_periodic(&mut kernel, [0.0; 3], side.map(|s| s as f32)).unwrap();
         let mut f = zero_field::<f32, 3>(state.len());
         kernel.compute(&narrow, &mut f, false);
         for i in 0..state.len() {
@@ -271,7 +271,7 @@ mod tests {
             let mut kernel = kind
                 .build::<f64, _, 2>(law, &KernelParams::default())
                 .unwrap();
-            let set = kernel.set_periodic([6.0, 6.0]);
+            let set = kernel.set_periodic([0.0, 0.0], [8.0, 8.0]);
             assert_eq!(set.is_ok(), kind.periodic_form(), "{kind:?}");
             let Err(e) = set else { continue };
             assert!(

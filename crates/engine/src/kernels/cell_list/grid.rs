@@ -15,6 +15,10 @@ const SIDE_MARGIN: f64 = 1e-5;
 /// the bins grow (still ≥ rc, so still correct, just more candidates per particle).
 const MAX_BINS_PER_PARTICLE: usize = 4;
 
+/// Fewest bins per axis of a periodic grid: with three or more, the 3^D bins around a bin are
+/// distinct even through the faces, so a search over them meets every pair once.
+pub(crate) const PERIODIC_MIN_BINS: usize = 3;
+
 /// Geometry of the bins for one step.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Grid<const D: usize> {
@@ -71,6 +75,41 @@ impl<const D: usize> Grid<D> {
             row_len: dims[0] + 1,
             rows: dims[1..].iter().product(),
         }
+    }
+
+    /// Bins of side ≥ `rc` that tile the periodic box `[lo, lo + side)` exactly, `n` particles
+    /// in it: as many per axis as fit, fewer when a dilute box would have more than
+    /// [`MAX_BINS_PER_PARTICLE`] per particle, but never fewer than [`PERIODIC_MIN_BINS`] (the
+    /// caller checked that they fit), so that a bin's neighbours through the faces are distinct
+    /// bins.
+    pub fn periodic(lo: [f64; D], side: [f64; D], rc: f64, n: usize) -> Self {
+        let fit = Self::periodic_fit(side, rc);
+        let cap = (MAX_BINS_PER_PARTICLE * n + 64) as f64;
+        let total: f64 = fit.iter().map(|&w| w as f64).product();
+        let shrink = (cap / total).powf(1.0 / D as f64).min(1.0);
+        let dims: [usize; D] = std::array::from_fn(|d| {
+            ((fit[d] as f64 * shrink).floor() as usize).clamp(PERIODIC_MIN_BINS.min(fit[d]), fit[d])
+        });
+        Grid {
+            lo,
+            inv_side: std::array::from_fn(|d| dims[d] as f64 / side[d]),
+            dims,
+            row_len: dims[0] + 1,
+            rows: dims[1..].iter().product(),
+        }
+    }
+
+    /// Bins of side ≥ `rc` that fit along each side of a periodic box.
+    pub fn periodic_fit(side: [f64; D], rc: f64) -> [usize; D] {
+        let side_min = rc * (1.0 + SIDE_MARGIN);
+        side.map(|s| {
+            let w = (s / side_min).floor();
+            if w.is_finite() && w >= 1.0 {
+                w.min(u32::MAX as f64) as usize
+            } else {
+                1
+            }
+        })
     }
 
     fn bins_of(dims: &[usize; D]) -> usize {

@@ -5,6 +5,7 @@
 //! row-major with a phantom bin ending each row, so the bins `x−1 ..= x+1` of one row are a
 //! single run of sorted indices: the stencil of a bin is `3^(D−1)` runs.
 
+use super::images::Images;
 use crate::geometry::Bounds;
 use crate::kernels::cell_list::grid::Grid;
 use crate::kernels::cell_list::strips::bin_all;
@@ -50,9 +51,22 @@ impl<T: Real, const D: usize> Bins<T, D> {
             #[inline(always)]
             || state.bounding_box(),
         );
-        self.grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
+        let grid = Grid::new(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
+        self.sort_on(grid, std::array::from_fn(|d| &state.pos[d][..n]));
+    }
+
+    /// Sorts the particles at `wrapped` (inside the periodic box of `images`) into bins of
+    /// side ≥ `radius` that tile the box.
+    pub fn sort_periodic(&mut self, wrapped: [&[T]; D], images: &Images<T, D>, radius: f64) {
+        let n = wrapped[0].len();
+        let grid = Grid::periodic(images.lo64(), images.side64(), radius, n);
+        self.sort_on(grid, wrapped);
+    }
+
+    fn sort_on(&mut self, grid: Grid<D>, pos: [&[T]; D]) {
+        let n = pos[0].len();
+        self.grid = grid;
         self.bin.resize(n, 0);
-        let pos: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..n]);
         bin_all(&self.grid, pos, [&mut self.bin[..n]]);
         let place = &mut self.place;
         self.sorter

@@ -4,10 +4,11 @@
 //! the force loop ever copies entries from one buffer into another.
 
 use super::bins::Bins;
+use super::images::{Images, crosses_slowest_axis, no_shift};
+use super::search_periodic;
 use crate::kernels::cell_list::strips::position;
 use crate::kernels::rows::LANES;
 use crate::real::Real;
-use crate::state::State;
 use std::ops::Range;
 
 /// Which pairs a list holds.
@@ -34,8 +35,14 @@ pub(crate) struct Part {
     /// last entry.
     pub partner: Vec<u32>,
     pub owner: Vec<u32>,
-    /// The lowest slot the part's pairs touch and one past the highest.
+    /// In a periodic box, per entry (and its padding): the code of the partner's image
+    /// ([`super::images`]); empty otherwise.
+    pub shift: Vec<u8>,
+    /// The lowest slot the part's pairs touch and one past the highest, but for the partners
+    /// met across the faces of the slowest axis, which `wrap` covers (far from the rest in bin
+    /// order; empty outside a periodic box).
     pub span: Range<usize>,
+    pub wrap: Range<usize>,
 }
 
 impl Part {
@@ -61,33 +68,49 @@ impl std::ops::AddAssign for BuildWork {
     }
 }
 
-/// Fills `part` with the rows `rows` of a list of `cover` over `state`: the pairs within
-/// `sqrt(radius2)` among `bins`, sorted from `state` with a side at least that radius.
-/// Inline so that it is compiled inside `simd::dispatch` with the wide instruction set.
+/// Fills `part` with the rows `rows` of a list of `cover`: the pairs within `sqrt(radius2)`
+/// among `bins`, sorted with a side at least that radius. Inline so that it is compiled inside
+/// `simd::dispatch` with the wide instruction set.
+/// `slots` are the slots' positions (for the targets' rows). In a periodic box (`images`),
+/// they are the positions of the build wrapped into the box, and pairs meet through the
+/// images of the bins across the faces.
 #[inline(always)]
 pub fn build<T: Real, const D: usize>(
     bins: &Bins<T, D>,
-    state: &State<T, D>,
+    slots: [&[T]; D],
     cover: &Cover,
     radius2: f64,
     rows: Range<usize>,
     part: &mut Part,
+    images: Option<&Images<T, D>>,
 ) -> BuildWork {
     part.rows = rows.clone();
     part.first.clear();
     part.first.push(0);
     part.target.clear();
     part.owner.clear();
+    if images.is_none() {
+        part.shift.clear();
+    }
     let mut rows_out = Rows {
         part,
         len: 0,
         span: (usize::MAX, 0),
+        wrap: (usize::MAX, 0),
+        periodic: images.is_some(),
     };
-    let work = match cover {
-        Cover::Half => half(bins, radius2, rows, &mut rows_out),
-        Cover::Targets(t) => targets(bins, state, t.start, radius2, rows, &mut rows_out),
+    let work = match (cover, images) {
+        (Cover::Half, None) => half(bins, radius2, rows, &mut rows_out),
+        (Cover::Targets(t), None) => targets(bins, slots, t.start, radius2, rows, &mut rows_out),
+        (Cover::Half, Some(images)) => {
+            search_periodic::half(bins, images, radius2, rows, &mut rows_out)
+        }
+        (Cover::Targets(t), Some(images)) => {
+            let first = t.start;
+            search_periodic::targets(bins, images, slots, first, radius2, rows, &mut rows_out)
+        }
     };
-    rows_out.finish();
+    rows_out.finish::<D>();
     work
 }
 
@@ -155,11 +178,11 @@ fn half<T: Real, const D: usize>(
                 xk[d] = sorted[d][k].as_f64();
             }
             let before = out.len;
-            let mut candidates = scan(bins, &xk, (k + 1, own_end), u32::MAX, radius2, out);
+            let mut candidates = scan(bins, &xk, (k + 1, own_end), u32::MAX, radius2, out, None);
             for &run in &ahead[..count] {
-                candidates += scan(bins, &xk, run, u32::MAX, radius2, out);
+                candidates += scan(bins, &xk, run, u32::MAX, radius2, out, None);
             }
-            out.row(bins.order[k] as usize, before);
+            out.row::<D>(bins.order[k] as usize, before);
             work.candidates += candidates as u64;
             work.bins += bins_searched;
         }
@@ -172,7 +195,7 @@ fn half<T: Real, const D: usize>(
 #[inline(always)]
 fn targets<T: Real, const D: usize>(
     bins: &Bins<T, D>,
-    state: &State<T, D>,
+    slots: [&[T]; D],
     first: usize,
     radius2: f64,
     rows: Range<usize>,
@@ -180,7 +203,6 @@ fn targets<T: Real, const D: usize>(
 ) -> BuildWork {
     let mut work = BuildWork::default();
     let g = &bins.grid;
-    let slots: [&[T]; D] = std::array::from_fn(|d| &state.pos[d][..]);
     for r in rows {
         let i = first + r;
         let x = position(&slots, i);
@@ -193,34 +215,52 @@ fn targets<T: Real, const D: usize>(
         for zz in za..=zb {
             for yy in ya..=yb {
                 let run = bins.run(xa, xb, yy, zz);
-                work.candidates += scan(bins, &xi, run, i as u32, radius2, out) as u64;
+                work.candidates += scan(bins, &xi, run, i as u32, radius2, out, None) as u64;
                 work.bins += (xb + 1 - xa) as u64;
             }
         }
-        out.row(i, before);
+        out.row::<D>(i, before);
     }
     work
 }
 
-/// The rows of a part being written: entries so far, and the span of the slots they touch.
-struct Rows<'a> {
+/// The rows of a part being written: entries so far, and the spans of the slots they touch
+/// (the partners across the slowest axis's faces apart, in a periodic box).
+pub(super) struct Rows<'a> {
     part: &'a mut Part,
     len: usize,
     span: (usize, usize),
+    wrap: (usize, usize),
+    periodic: bool,
+}
+
+/// Widens the range `(lo, hi)` to hold slot `j`.
+#[inline(always)]
+fn widen((lo, hi): &mut (usize, usize), j: usize) {
+    *lo = (*lo).min(j);
+    *hi = (*hi).max(j + 1);
 }
 
 impl Rows<'_> {
+    /// Entries written so far.
+    #[inline(always)]
+    pub(super) fn len(&self) -> usize {
+        self.len
+    }
+
     /// Ends the row of target slot `i`, whose entries start at `before`.
     #[inline(always)]
-    fn row(&mut self, i: usize, before: usize) {
+    pub(super) fn row<const D: usize>(&mut self, i: usize, before: usize) {
         let p = &mut *self.part;
         if self.len > before {
-            let (lo, hi) = &mut self.span;
-            *lo = (*lo).min(i);
-            *hi = (*hi).max(i + 1);
-            for &j in &p.partner[before..self.len] {
-                *lo = (*lo).min(j as usize);
-                *hi = (*hi).max(j as usize + 1);
+            widen(&mut self.span, i);
+            for e in before..self.len {
+                let j = p.partner[e] as usize;
+                if self.periodic && crosses_slowest_axis::<D>(p.shift[e]) {
+                    widen(&mut self.wrap, j);
+                } else {
+                    widen(&mut self.span, j);
+                }
             }
         }
         p.target.push(i as u32);
@@ -228,32 +268,47 @@ impl Rows<'_> {
         p.first.push(self.len);
     }
 
-    /// Sets the span and pads the entries.
-    fn finish(self) {
+    /// Sets the spans and pads the entries.
+    fn finish<const D: usize>(self) {
         let p = self.part;
-        let (lo, hi) = self.span;
-        p.span = if lo < hi { lo..hi } else { 0..0 };
+        let range = |(lo, hi): (usize, usize)| if lo < hi { lo..hi } else { 0..0 };
+        p.span = range(self.span);
+        p.wrap = range(self.wrap);
         let pad = p.span.start as u32;
         p.partner.truncate(self.len);
         p.partner.resize(self.len + LANES, pad);
         p.owner.resize(self.len + LANES, pad);
+        if self.periodic {
+            p.shift.truncate(self.len);
+            p.shift.resize(self.len + LANES, no_shift::<D>());
+        }
     }
 }
 
 /// Appends to the row being written the slots of the sorted particles `lo..hi` within
 /// `sqrt(radius2)` of `x`, except slot `skip`; returns the candidates examined. Branch-free:
-/// every candidate is written, and the length only advances over those kept.
+/// every candidate is written, and the length only advances over those kept. In a periodic
+/// box, `x` is the target moved against the image searched, whose `code` every entry records.
 #[inline(always)]
-fn scan<T: Real, const D: usize>(
+pub(super) fn scan<T: Real, const D: usize>(
     bins: &Bins<T, D>,
     x: &[f64; D],
     (lo, hi): (usize, usize),
     skip: u32,
     radius2: f64,
     rows: &mut Rows<'_>,
+    code: Option<u8>,
 ) -> usize {
     if hi <= lo {
         return 0;
+    }
+    let len = rows.len;
+    if let Some(code) = code {
+        let shift = &mut rows.part.shift;
+        if shift.len() < len + (hi - lo) {
+            shift.resize((2 * shift.len()).max(len + hi - lo), 0);
+        }
+        shift[len..len + (hi - lo)].fill(code);
     }
     let out = &mut rows.part.partner;
     let mut len = rows.len;

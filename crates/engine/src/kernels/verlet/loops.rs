@@ -14,6 +14,7 @@
 //!   medians of 8 runs, within the spread of either); so it was not kept.
 //! - [`target_rows`]: every partner of each target (a full list: no reactions).
 
+use super::images::Images;
 use super::list::Part;
 use crate::kernels::rows::{LANES, RowSum, lane_sum};
 use crate::physics::PairLaw;
@@ -146,28 +147,91 @@ fn block_of(v: &[u32], e: usize) -> &[u32; LANES] {
     v[e..e + LANES].try_into().expect("entries are padded")
 }
 
-/// Adds the forces of the pairs of `part` to `out` (slot `s` at `out[d][s - base]`), both ends
-/// of each pair, in blocks of entries that ignore the rows.
+/// The partners of the entries `e..e + LANES` of `part`, each at the image its entry met in a
+/// periodic box (`images`).
+#[inline(always)]
+fn partners<T: Real, const D: usize>(
+    slots: &Slots<'_, T, D>,
+    part: &Part,
+    e: usize,
+    images: Option<&Images<T, D>>,
+) -> ([[T; LANES]; D], [T; LANES]) {
+    let (mut x, s) = slots.gather(block_of(&part.partner, e));
+    if let Some(images) = images {
+        let codes: &[u8; LANES] = part.shift[e..e + LANES]
+            .try_into()
+            .expect("entries are padded");
+        let shift = images.shifts(codes);
+        for d in 0..D {
+            for l in 0..LANES {
+                x[d][l] += shift[d][l];
+            }
+        }
+    }
+    (x, s)
+}
+
+/// Where the forces of a part go, by slot.
+pub(crate) trait Scatter<T> {
+    /// Adds `v` to component `d` of the force on slot `s`.
+    fn add(&mut self, s: usize, d: usize, v: T);
+}
+
+/// The forces of the slots from `base` on: slot `s` at `out[d][s - base]`.
+pub(crate) struct Window<'a, T, const D: usize> {
+    pub out: [&'a mut [T]; D],
+    pub base: usize,
+}
+
+impl<T: Real, const D: usize> Scatter<T> for Window<'_, T, D> {
+    #[inline(always)]
+    fn add(&mut self, s: usize, d: usize, v: T) {
+        self.out[d][s - self.base] += v;
+    }
+}
+
+/// Two windows, the slots from `split` on in `high`: a part of a periodic list whose pairs
+/// reach across the faces into slots far from its own.
+pub(crate) struct Split<'a, T, const D: usize> {
+    pub low: Window<'a, T, D>,
+    pub high: Window<'a, T, D>,
+}
+
+impl<T: Real, const D: usize> Scatter<T> for Split<'_, T, D> {
+    #[inline(always)]
+    fn add(&mut self, s: usize, d: usize, v: T) {
+        if s >= self.high.base {
+            self.high.add(s, d, v);
+        } else {
+            self.low.add(s, d, v);
+        }
+    }
+}
+
+/// Adds the forces of the pairs of `part` to `out`, both ends of each pair, in blocks of
+/// entries that ignore the rows; in a periodic box (`images`), each partner at the image its
+/// entry met.
 #[inline(always)]
 pub(crate) fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     law: &L,
     slots: &Slots<'_, T, D>,
     part: &Part,
-    out: &mut [&mut [T]; D],
-    base: usize,
+    out: &mut impl Scatter<T>,
+    images: Option<&Images<T, D>>,
 ) -> RowSum<T, D> {
     let mut probe = Probe::new();
     let m = part.entries();
     let mut e = 0;
     while e < m {
         let (ii, jj) = (block_of(&part.owner, e), block_of(&part.partner, e));
-        let (xi, xj) = (slots.gather(ii), slots.gather(jj));
+        let (xi, xj) = (slots.gather(ii), partners(slots, part, e, images));
         let f = evaluate::<T, L, D, PROBE>(law, &xi, &xj, m - e, &mut probe);
         for l in 0..LANES {
-            let (i, j) = (ii[l] as usize - base, jj[l] as usize - base);
+            let (i, j) = (ii[l] as usize, jj[l] as usize);
             for d in 0..D {
-                out[d][i] += f[d][l];
-                out[d][j] -= f[d][l];
+                // `x + (−v)` is `x − v`, bit for bit.
+                out.add(i, d, f[d][l]);
+                out.add(j, d, -f[d][l]);
             }
         }
         e += LANES;
@@ -176,13 +240,14 @@ pub(crate) fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bo
 }
 
 /// Overwrites `out[d][r]` with the force on the target of row `part.rows.start + r` from
-/// all its partners (a full list).
+/// all its partners (a full list), each at its entry's image in a periodic box (`images`).
 #[inline(always)]
 pub(crate) fn target_rows<T: Real, L: PairLaw<T>, const D: usize>(
     law: &L,
     slots: &Slots<'_, T, D>,
     part: &Part,
     out: &mut [&mut [T]; D],
+    images: Option<&Images<T, D>>,
 ) {
     let mut probe = Probe::new();
     for (r, &i) in part.target.iter().enumerate() {
@@ -191,7 +256,7 @@ pub(crate) fn target_rows<T: Real, L: PairLaw<T>, const D: usize>(
         let mut acc = [[T::zero(); LANES]; D];
         let mut e = a;
         while e < b {
-            let partners = slots.gather(block_of(&part.partner, e));
+            let partners = partners(slots, part, e, images);
             let f = evaluate::<T, L, D, false>(law, &target, &partners, b - e, &mut probe);
             for d in 0..D {
                 for l in 0..LANES {

@@ -23,20 +23,28 @@
 //!   the list stays right as long as every slot is within half the skin of where it was.
 //! - [`ForceKernel::compute_targets`] keeps a full list of the targets' partners instead (the
 //!   replicated-data MPI driver computes a block of targets every step).
+//! - In a periodic box ([`ForceKernel::set_periodic`]) the bins tile the box, the search meets
+//!   the bins beyond the faces as images, and the loops read positions continued from the
+//!   build rather than wrapped ([`images`]).
 //!
 //! Memory, kept between rebuilds: the positions at the build and a sorted copy (2·D values per
 //! particle), the bins and the sort (at most 4 bins and 4 values of 4 bytes per particle), and
 //! 8 bytes per list entry (partner and target slots).
 
 mod bins;
+mod images;
 mod list;
 mod loops;
+#[cfg(test)]
+mod periodic_tests;
+mod search_periodic;
 #[cfg(test)]
 mod tests;
 mod work;
 
 use super::teamed::{Colors, StateView, TeamPlan};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters};
+use crate::kernels::cell_list::grid::{Grid, PERIODIC_MIN_BINS};
 use crate::par::team::{SharedSlice, Worker, shared};
 use crate::par::{pass_chunk, worth_forking};
 use crate::physics::PairLaw;
@@ -44,8 +52,9 @@ use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
 use bins::Bins;
+use images::Images;
 use list::{BuildWork, Cover, Part};
-use loops::Slots;
+use loops::{Slots, Split, Window};
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
@@ -74,6 +83,11 @@ pub struct Verlet<L, T, const D: usize> {
     handed_out: bool,
     /// The colours of the half list's parts.
     colors: Colors,
+    /// The periodic box, if any.
+    periodic: Option<Images<T, D>>,
+    /// In a periodic box: each slot's position continued from its place at the build (the
+    /// positions the loops read), or scratch for the wrapped positions of a sort.
+    continued: [Vec<T>; D],
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
@@ -93,6 +107,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             at_build: std::array::from_fn(|_| Vec::new()),
             handed_out: false,
             colors: Colors::default(),
+            periodic: None,
+            continued: std::array::from_fn(|_| Vec::new()),
         })
     }
 
@@ -111,20 +127,48 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
     /// Makes the list hold `cover` for `state`, rebuilding it when it holds something else,
     /// was handed out for a re-ordering, or some slot moved too far; returns the build's work.
     fn refresh(&mut self, state: &State<T, D>, cover: Cover) -> BuildWork {
-        let kept = self.cover.as_ref() == Some(&cover)
-            && !self.handed_out
-            && !moved_too_far(state, &self.at_build, self.skin);
+        let kept =
+            self.cover.as_ref() == Some(&cover) && !self.handed_out && !self.moved_too_far(state);
         if kept {
             return BuildWork::default();
         }
         self.rebuild(state, cover)
     }
 
+    /// Whether some slot moved more than half the skin since the build; in a periodic box,
+    /// the slots' continued positions are left in `continued`.
+    fn moved_too_far(&mut self, state: &State<T, D>) -> bool {
+        match &self.periodic {
+            Some(images) => {
+                images.continue_all(state, &self.at_build, self.skin, &mut self.continued)
+            }
+            None => moved_too_far(state, &self.at_build, self.skin),
+        }
+    }
+
+    /// Sorts the bins from `state`: in a periodic box, from its positions wrapped into `into`.
+    fn sort_bins(&mut self, state: &State<T, D>, wrapped_into_build: bool) {
+        let side = self.radius * (1.0 + LIST_MARGIN);
+        let Some(images) = &self.periodic else {
+            return self.bins.sort(state, side);
+        };
+        let into = if wrapped_into_build {
+            &mut self.at_build
+        } else {
+            &mut self.continued
+        };
+        images.wrap_all(state, into);
+        self.bins
+            .sort_periodic(into.each_ref().map(|x| x.as_slice()), images, side);
+    }
+
     fn rebuild(&mut self, state: &State<T, D>, cover: Cover) -> BuildWork {
         let n = state.len();
-        let side = self.radius * (1.0 + LIST_MARGIN);
+        if let Some(images) = &self.periodic {
+            images.wrap_all(state, &mut self.at_build);
+        }
         if !(self.handed_out && self.bins.adopt(state)) {
-            self.bins.sort(state, side);
+            self.sort_bins(state, true);
         }
         self.handed_out = false;
         let rows = match &cover {
@@ -137,14 +181,28 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         } else {
             work::expected_entries(&self.bins, &cover)
         };
-        let count = parts_for(rows, step_work(rows, entries));
+        let mut count = parts_for(rows, step_work(rows, entries));
+        let periodic = self.periodic.is_some();
+        let layers = self.bins.grid.dims[D - 1];
+        let by_layers = cover == Cover::Half && work::cut_at_layers::<D>(periodic);
+        if by_layers {
+            count = work::parts_at_layers(count, layers, periodic);
+        }
         self.parts.resize_with(count, Part::default);
-        let (bins, radius2) = (&self.bins, self.radius2);
+        let (bins, radius2, images) = (&self.bins, self.radius2, self.periodic.as_ref());
+        let slots: [&[T]; D] = match images {
+            Some(_) => self.at_build.each_ref().map(|x| x.as_slice()),
+            None => state.pos.each_ref().map(|x| x.as_slice()),
+        };
+        let cut = |k: usize| match by_layers {
+            true => work::layer_start(bins, k * layers / count),
+            false => k * rows / count,
+        };
         let build = |(k, part): (usize, &mut Part)| {
-            let range = k * rows / count..(k + 1) * rows / count;
+            let range = cut(k)..cut(k + 1);
             simd::dispatch(
                 #[inline(always)]
-                || list::build(bins, state, &cover, radius2, range, part),
+                || list::build(bins, slots, &cover, radius2, range, part, images),
             )
         };
         let mut work = if count > 1 {
@@ -159,13 +217,29 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             build((0, &mut self.parts[0]))
         };
         work.rebuilds = 1;
-        self.colors = Colors::of(self.parts.iter().map(|p| p.span.clone()));
+        self.colors = Colors::of_sets(self.parts.iter().map(|p| [p.span.clone(), p.wrap.clone()]));
         for d in 0..D {
-            self.at_build[d].clear();
-            self.at_build[d].extend_from_slice(&state.pos[d]);
+            if self.periodic.is_some() {
+                self.continued[d].clone_from(&self.at_build[d]);
+            } else {
+                self.at_build[d].clear();
+                self.at_build[d].extend_from_slice(&state.pos[d]);
+            }
         }
         self.cover = Some(cover);
         work
+    }
+
+    /// The positions the loops read: the slots' own, or in a periodic box their continued
+    /// ones.
+    fn slots<'s>(&'s self, state: &'s State<T, D>) -> Slots<'s, T, D> {
+        match self.periodic {
+            Some(_) => Slots::new(
+                self.continued.each_ref().map(|x| x.as_slice()),
+                &state.source,
+            ),
+            None => Slots::of(state),
+        }
     }
 
     /// Adds the forces of the half list to `forces` (zeroed), on one thread, part by part in
@@ -175,15 +249,32 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         state: &State<T, D>,
         forces: &mut Field<T, D>,
     ) -> (f64, u64) {
-        let (law, slots) = (&self.law, Slots::of(state));
-        let mut out = forces.each_mut().map(|f| f.as_mut_slice());
+        let (law, slots) = (&self.law, self.slots(state));
+        let mut out = Window {
+            out: forces.each_mut().map(|f| f.as_mut_slice()),
+            base: 0,
+        };
         let (mut energy, mut interacting) = (0.0, 0);
         for k in self.colors.order() {
             let part = &self.parts[k];
-            let sum = simd::dispatch(
-                #[inline(always)]
-                || loops::half_pairs::<T, L, D, PROBE>(law, &slots, part, &mut out, 0),
-            );
+            let sum = match &self.periodic {
+                Some(images) => simd::dispatch(
+                    #[inline(always)]
+                    || {
+                        loops::half_pairs::<T, L, D, PROBE>(
+                            law,
+                            &slots,
+                            part,
+                            &mut out,
+                            Some(images),
+                        )
+                    },
+                ),
+                None => simd::dispatch(
+                    #[inline(always)]
+                    || loops::half_pairs::<T, L, D, PROBE>(law, &slots, part, &mut out, None),
+                ),
+            };
             energy += sum.energy.as_f64();
             interacting += sum.interacting;
         }
@@ -192,15 +283,15 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
 
     /// Adds the forces of the half list to `forces` (zeroed), one colour at a time, its parts
     /// on the pool's threads: the serial loop's additions in the serial loop's order.
-    fn parallel(&self, state: &State<T, D>, forces: &mut Field<T, D>) {
-        let plan = self.plan();
+    fn parallel(&mut self, state: &State<T, D>, forces: &mut Field<T, D>) {
+        let plan = self.plan(false);
         let view = StateView {
             pos: state.pos.each_ref().map(|x| x.as_slice()),
             source: &state.source,
         };
         let out = SharedSlice::each(forces.each_mut().map(|f| f.as_mut_slice()));
         for c in 0..2 {
-            let parts: Vec<usize> = self.colors.of_color(c).collect();
+            let parts: Vec<usize> = plan.colors.of_color(c).collect();
             parts.par_iter().for_each(|&k| {
                 // SAFETY: the parts of one colour touch disjoint slots (the caller checked
                 // `colors.disjoint()`), and nothing else uses `out` until the colour is done.
@@ -209,16 +300,43 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         }
     }
 
-    fn plan(&self) -> Plan<'_, L, T, D> {
+    /// The plan of a step on the list; on a team (`team`), in a periodic box, the workers
+    /// write the continued positions of their blocks first.
+    fn plan(&mut self, team: bool) -> Plan<'_, L, T, D> {
+        let entries = self.entries();
+        let Verlet {
+            law,
+            parts,
+            colors,
+            at_build,
+            skin,
+            periodic,
+            continued,
+            ..
+        } = self;
         Plan {
-            law: &self.law,
-            parts: &self.parts,
-            colors: &self.colors,
-            at_build: self.at_build.each_ref().map(|x| x.as_slice()),
-            skin: self.skin,
-            entries: self.entries(),
+            law,
+            parts,
+            colors,
+            at_build: at_build.each_ref().map(|x| x.as_slice()),
+            skin: *skin,
+            entries,
+            periodic: periodic.map(|images| Periodic {
+                images,
+                continued: SharedSlice::each(continued.each_mut().map(|c| c.as_mut_slice())),
+                write: team,
+            }),
         }
     }
+}
+
+/// A plan's periodic box: the positions its loops read, continued from the build.
+struct Periodic<'k, T, const D: usize> {
+    images: Images<T, D>,
+    continued: [SharedSlice<'k, T>; D],
+    /// Whether each worker writes its block of `continued` in `prepare` (the team's step) or
+    /// `continued` is written already (the kernel's own `compute`).
+    write: bool,
 }
 
 /// The half list's step in a team region: the displacement test on each worker's block, the
@@ -230,11 +348,21 @@ struct Plan<'k, L, T, const D: usize> {
     at_build: [&'k [T]; D],
     skin: f64,
     entries: u64,
+    periodic: Option<Periodic<'k, T, D>>,
 }
 
 impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
     fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
-        block_kept(pos, self.at_build, block, self.skin)
+        match &self.periodic {
+            Some(p) => simd::dispatch(
+                #[inline(always)]
+                || {
+                    p.images
+                        .block_kept(pos, self.at_build, block.clone(), self.skin, None)
+                },
+            ),
+            None => block_kept(pos, self.at_build, block, self.skin),
+        }
     }
 
     fn colors(&self) -> &Colors {
@@ -244,13 +372,28 @@ impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D
     unsafe fn prepare(
         &self,
         worker: &Worker,
-        _state: StateView<'_, T, D>,
+        state: StateView<'_, T, D>,
         forces: &[SharedSlice<'_, T>; D],
     ) {
+        let block = worker.block(forces[0].len());
         // SAFETY: each worker zeroes its own block (the caller's promise on `forces`).
-        let out = unsafe { shared::ranges_mut(forces, worker.block(forces[0].len())) };
+        let out = unsafe { shared::ranges_mut(forces, block.clone()) };
         for f in out {
             f.fill(T::zero());
+        }
+        if let Some(p) = self.periodic.as_ref().filter(|p| p.write) {
+            // SAFETY: each worker writes its own block, and nothing reads `continued` before
+            // the barrier that ends this phase.
+            let out = unsafe { shared::ranges_mut(&p.continued, block.clone()) };
+            let now = state.pos.map(|x| &x[block.clone()]);
+            let (at_build, skin) = (self.at_build, self.skin);
+            simd::dispatch(
+                #[inline(always)]
+                || {
+                    p.images
+                        .block_kept(now, at_build, block.clone(), skin, Some(out))
+                },
+            );
         }
     }
 
@@ -261,14 +404,53 @@ impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D
         forces: &[SharedSlice<'_, T>; D],
     ) {
         let part = &self.parts[part];
-        let slots = Slots::new(state.pos, state.source);
-        // SAFETY: no other part running now touches the part's span (the caller's promise).
-        let mut out = unsafe { shared::ranges_mut(forces, part.span.clone()) };
-        let base = part.span.start;
-        simd::dispatch(
-            #[inline(always)]
-            || loops::half_pairs::<T, L, D, false>(self.law, &slots, part, &mut out, base),
-        );
+        let window = |range: Range<usize>| Window {
+            // SAFETY: no other part running now touches the part's span or wrap (the
+            // caller's promise), each of which is one window.
+            out: unsafe { shared::ranges_mut(forces, range.clone()) },
+            base: range.start,
+        };
+        let Some(p) = &self.periodic else {
+            let slots = Slots::new(state.pos, state.source);
+            let mut out = window(part.span.clone());
+            simd::dispatch(
+                #[inline(always)]
+                || loops::half_pairs::<T, L, D, false>(self.law, &slots, part, &mut out, None),
+            );
+            return;
+        };
+        // SAFETY: `continued` is written before the pair work only (by `prepare` or before the
+        // plan was made).
+        let slots = Slots::new(unsafe { shared::wholes(&p.continued) }, state.source);
+        let images = Some(&p.images);
+        let (span, wrap) = (part.span.clone(), part.wrap.clone());
+        let apart = !wrap.is_empty() && (wrap.start >= span.end || span.start >= wrap.end);
+        if apart {
+            let (low, high) = if wrap.start >= span.end {
+                (span, wrap)
+            } else {
+                (wrap, span)
+            };
+            let mut out = Split {
+                low: window(low),
+                high: window(high),
+            };
+            simd::dispatch(
+                #[inline(always)]
+                || loops::half_pairs::<T, L, D, false>(self.law, &slots, part, &mut out, images),
+            );
+        } else {
+            let whole = if wrap.is_empty() {
+                span
+            } else {
+                span.start.min(wrap.start)..span.end.max(wrap.end)
+            };
+            let mut out = window(whole);
+            simd::dispatch(
+                #[inline(always)]
+                || loops::half_pairs::<T, L, D, false>(self.law, &slots, part, &mut out, images),
+            );
+        }
     }
 
     unsafe fn finish(&self, _worker: &Worker, _forces: &[SharedSlice<'_, T>; D]) {}
@@ -331,7 +513,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
         let clock = Instant::now();
         let built = self.refresh(state, Cover::Targets(targets));
         let build_s = clock.elapsed().as_secs_f64();
-        let (law, slots) = (&self.law, Slots::of(state));
+        let (law, slots, images) = (&self.law, self.slots(state), self.periodic.as_ref());
         // Each part's rows, as its own slices of the output.
         let mut rest = out;
         let mut pieces = Vec::with_capacity(self.parts.len());
@@ -344,7 +526,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
         let gather = |(part, piece): (&Part, &mut [&mut [T]; D])| {
             simd::dispatch(
                 #[inline(always)]
-                || loops::target_rows::<T, L, D>(law, &slots, part, piece),
+                || loops::target_rows::<T, L, D>(law, &slots, part, piece, images),
             )
         };
         if self.parts.len() > 1 && rayon::current_num_threads() > 1 {
@@ -361,13 +543,11 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
     /// The bin order, exactly when the list is due for a rebuild; between rebuilds a new order
     /// would only force one.
     fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
-        if self.cover.is_some()
-            && !self.handed_out
-            && !moved_too_far(state, &self.at_build, self.skin)
-        {
+        if self.cover.is_some() && !self.handed_out && !self.moved_too_far(state) {
             return None;
         }
-        self.bins.sort(state, self.radius * (1.0 + LIST_MARGIN));
+        // The list is rebuilt next: `continued` is free until then.
+        self.sort_bins(state, false);
         self.handed_out = true;
         Some(self.bins.order.clone())
     }
@@ -379,7 +559,27 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
     fn team_plan(&mut self, n: usize) -> Option<Box<dyn TeamPlan<T, D> + '_>> {
         let ready =
             self.cover == Some(Cover::Half) && !self.handed_out && self.at_build[0].len() == n;
-        ready.then(|| Box::new(self.plan()) as Box<dyn TeamPlan<T, D> + '_>)
+        ready.then(|| Box::new(self.plan(true)) as Box<dyn TeamPlan<T, D> + '_>)
+    }
+
+    /// Refused when fewer than three bins of the cutoff plus the skin fit along a side (the
+    /// search's images would repeat bins).
+    fn set_periodic(&mut self, lo: [T; D], hi: [T; D]) -> Result<(), KernelError> {
+        let images = Images::new(lo, hi);
+        let side = self.radius * (1.0 + LIST_MARGIN);
+        let fit = Grid::<D>::periodic_fit(images.side64(), side);
+        if let Some(d) = (0..D).find(|&d| fit[d] < PERIODIC_MIN_BINS) {
+            return Err(KernelError::BadParam(format!(
+                "verlet in a periodic box needs a side of at least {PERIODIC_MIN_BINS} times the \
+                 cutoff plus the skin ({:.4}); side {d} is {:.4}: use more particles, a smaller \
+                 skin, or naive",
+                PERIODIC_MIN_BINS as f64 * side,
+                images.side64()[d]
+            )));
+        }
+        self.periodic = Some(images);
+        self.cover = None;
+        Ok(())
     }
 }
 
