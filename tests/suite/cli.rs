@@ -435,7 +435,11 @@ fn validate_passes_for_every_scenario_and_dumps_forces() {
     ]);
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(o.status.success(), "{out}\n{}", stderr(&o));
-    assert!(out.contains("all kernels agree"));
+    // The melt's largest lattice within 700 atoms is a box too small for verlet's bins.
+    assert!(
+        out.contains("all kernels checked agree with the reference; skipped: lj-melt/verlet"),
+        "{out}"
+    );
     let text = std::fs::read_to_string(dir.path().join("f.txt.coulomb")).unwrap();
     assert!(
         text.lines()

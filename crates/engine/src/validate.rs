@@ -178,6 +178,14 @@ impl SystemJob for ValidateJob {
                 // Like a kernel of another law, one with no periodic form does not apply to
                 // a periodic system (`list` shows which do).
                 Err(crate::kernels::KernelError::NotPeriodic { .. }) => continue,
+                // A list whose bins do not fit this small a box: said, not failed.
+                Err(crate::kernels::KernelError::PeriodicBoxTooSmall(_)) => {
+                    checks.push(KernelCheck::skipped(
+                        kind,
+                        "the periodic box is too small for it",
+                    ));
+                    continue;
+                }
                 built => built?,
             };
             let mut forces = zero_field::<T, D>(n);

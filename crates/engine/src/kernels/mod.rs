@@ -404,6 +404,10 @@ pub enum KernelError {
         /// The kernel's name.
         kernel: &'static str,
     },
+    /// The periodic box is too small for the kernel's search (a list needs three bins of the
+    /// cutoff plus the skin along each side); holds the message, which says what to change.
+    #[error("{0}")]
+    PeriodicBoxTooSmall(String),
     /// The fmm kernel was asked for a system that is not 3-D.
     #[error(
         "kernel `{kernel}` runs in three dimensions only and this system has {dim}; the long-range \

@@ -4,8 +4,7 @@
 //! the force loop ever copies entries from one buffer into another.
 
 use super::bins::Bins;
-use super::images::{Images, crosses_slowest_axis, no_shift};
-use super::search_periodic;
+use super::images::{crosses_slowest_axis, no_shift};
 use crate::kernels::cell_list::strips::position;
 use crate::kernels::rows::LANES;
 use crate::real::Real;
@@ -68,12 +67,10 @@ impl std::ops::AddAssign for BuildWork {
     }
 }
 
-/// Fills `part` with the rows `rows` of a list of `cover`: the pairs within `sqrt(radius2)`
-/// among `bins`, sorted with a side at least that radius. Inline so that it is compiled inside
-/// `simd::dispatch` with the wide instruction set.
-/// `slots` are the slots' positions (for the targets' rows). In a periodic box (`images`),
-/// they are the positions of the build wrapped into the box, and pairs meet through the
-/// images of the bins across the faces.
+/// Fills `part` with the rows `rows` of a list of `cover` in an open box (or between walls):
+/// the pairs within `sqrt(radius2)` among `bins`, sorted with a side at least that radius;
+/// `slots` are the slots' positions (for the targets' rows). Inline so that it is compiled
+/// inside `simd::dispatch` with the wide instruction set.
 #[inline(always)]
 pub fn build<T: Real, const D: usize>(
     bins: &Bins<T, D>,
@@ -82,14 +79,28 @@ pub fn build<T: Real, const D: usize>(
     radius2: f64,
     rows: Range<usize>,
     part: &mut Part,
-    images: Option<&Images<T, D>>,
 ) -> BuildWork {
-    part.rows = rows.clone();
+    fill::<D>(part, rows.clone(), false, |out| match cover {
+        Cover::Half => half(bins, radius2, rows, out),
+        Cover::Targets(t) => targets(bins, slots, t.start, radius2, rows, out),
+    })
+}
+
+/// Fills `part` with the rows `rows` that `search` writes (each entry with the code of its
+/// partner's image when `periodic`), then sets its spans and pads its entries.
+#[inline(always)]
+pub(super) fn fill<const D: usize>(
+    part: &mut Part,
+    rows: Range<usize>,
+    periodic: bool,
+    search: impl FnOnce(&mut Rows<'_>) -> BuildWork,
+) -> BuildWork {
+    part.rows = rows;
     part.first.clear();
     part.first.push(0);
     part.target.clear();
     part.owner.clear();
-    if images.is_none() {
+    if !periodic {
         part.shift.clear();
     }
     let mut rows_out = Rows {
@@ -97,19 +108,9 @@ pub fn build<T: Real, const D: usize>(
         len: 0,
         span: (usize::MAX, 0),
         wrap: (usize::MAX, 0),
-        periodic: images.is_some(),
+        periodic,
     };
-    let work = match (cover, images) {
-        (Cover::Half, None) => half(bins, radius2, rows, &mut rows_out),
-        (Cover::Targets(t), None) => targets(bins, slots, t.start, radius2, rows, &mut rows_out),
-        (Cover::Half, Some(images)) => {
-            search_periodic::half(bins, images, radius2, rows, &mut rows_out)
-        }
-        (Cover::Targets(t), Some(images)) => {
-            let first = t.start;
-            search_periodic::targets(bins, images, slots, first, radius2, rows, &mut rows_out)
-        }
-    };
+    let work = search(&mut rows_out);
     rows_out.finish::<D>();
     work
 }

@@ -202,7 +202,12 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
             let range = cut(k)..cut(k + 1);
             simd::dispatch(
                 #[inline(always)]
-                || list::build(bins, slots, &cover, radius2, range, part, images),
+                || match images {
+                    Some(images) => {
+                        search_periodic::build(bins, images, slots, &cover, radius2, range, part)
+                    }
+                    None => list::build(bins, slots, &cover, radius2, range, part),
+                },
             )
         };
         let mut work = if count > 1 {
@@ -569,9 +574,9 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for Verlet<L, T, 
         let side = self.radius * (1.0 + LIST_MARGIN);
         let fit = Grid::<D>::periodic_fit(images.side64(), side);
         if let Some(d) = (0..D).find(|&d| fit[d] < PERIODIC_MIN_BINS) {
-            return Err(KernelError::BadParam(format!(
+            return Err(KernelError::PeriodicBoxTooSmall(format!(
                 "verlet in a periodic box needs a side of at least {PERIODIC_MIN_BINS} times the \
-                 cutoff plus the skin ({:.4}); side {d} is {:.4}: use more particles, a smaller \
+                 cutoff plus the skin ({:.6}); side {d} is {:.6}: use more particles, a smaller \
                  skin, or naive",
                 PERIODIC_MIN_BINS as f64 * side,
                 images.side64()[d]

@@ -202,6 +202,6 @@ fn a_box_with_fewer_than_three_bins_along_a_side_is_refused_with_the_reason() {
     let mut k = Verlet::<_, f64, 3>::new(law::<f64>(), SKIN).unwrap();
     let e = k.set_periodic([0.0; 3], [9.0, 9.0, 8.0]).unwrap_err();
     let message = e.to_string();
-    assert!(message.contains("side 2 is 8.0000"), "{message}");
+    assert!(message.contains("side 2 is 8.000000"), "{message}");
     assert!(message.contains("naive"), "{message}");
 }

@@ -12,7 +12,7 @@
 
 use super::bins::Bins;
 use super::images::{Images, code_of, no_shift};
-use super::list::{BuildWork, Rows, scan};
+use super::list::{BuildWork, Cover, Part, Rows, fill, scan};
 use crate::kernels::cell_list::grid::Grid;
 use crate::kernels::cell_list::strips::position;
 use crate::real::Real;
@@ -131,10 +131,29 @@ fn coordinates<const D: usize>(g: &Grid<D>, b: usize) -> [usize; D] {
     c
 }
 
+/// Fills `part` with the rows `rows` of a list of `cover` in the periodic box of `images`:
+/// [`super::list::build`] through the faces, `slots` the positions of the build wrapped into
+/// the box.
+#[inline(always)]
+pub(super) fn build<T: Real, const D: usize>(
+    bins: &Bins<T, D>,
+    images: &Images<T, D>,
+    slots: [&[T]; D],
+    cover: &Cover,
+    radius2: f64,
+    rows: Range<usize>,
+    part: &mut Part,
+) -> BuildWork {
+    fill::<D>(part, rows.clone(), true, |out| match cover {
+        Cover::Half => half(bins, images, radius2, rows, out),
+        Cover::Targets(t) => targets(bins, images, slots, t.start, radius2, rows, out),
+    })
+}
+
 /// The half list's rows `rows` (sorted indices) in a periodic box, bin by bin: a particle's
 /// partners later in its own bin, then in the bins of higher index around it.
 #[inline(always)]
-pub(super) fn half<T: Real, const D: usize>(
+fn half<T: Real, const D: usize>(
     bins: &Bins<T, D>,
     images: &Images<T, D>,
     radius2: f64,
@@ -190,7 +209,7 @@ pub(super) fn half<T: Real, const D: usize>(
 /// The full lists of the target slots `first + rows` (at `slots`, wrapped into the box) in a
 /// periodic box, each from the 3^D bins around it.
 #[inline(always)]
-pub(super) fn targets<T: Real, const D: usize>(
+fn targets<T: Real, const D: usize>(
     bins: &Bins<T, D>,
     images: &Images<T, D>,
     slots: [&[T]; D],
