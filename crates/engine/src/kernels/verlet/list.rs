@@ -255,12 +255,18 @@ impl Rows<'_> {
         let p = &mut *self.part;
         if self.len > before {
             widen(&mut self.span, i);
-            for e in before..self.len {
-                let j = p.partner[e] as usize;
-                if self.periodic && crosses_slowest_axis::<D>(p.shift[e]) {
-                    widen(&mut self.wrap, j);
-                } else {
-                    widen(&mut self.span, j);
+            let partners = &p.partner[before..self.len];
+            if self.periodic {
+                for (&j, &code) in partners.iter().zip(&p.shift[before..self.len]) {
+                    let far = crosses_slowest_axis::<D>(code);
+                    widen(
+                        if far { &mut self.wrap } else { &mut self.span },
+                        j as usize,
+                    );
+                }
+            } else {
+                for &j in partners {
+                    widen(&mut self.span, j as usize);
                 }
             }
         }

@@ -176,8 +176,10 @@ fn partners<T: Real, const D: usize>(
 
 /// Where the forces of a part go, by slot.
 pub(crate) trait Scatter<T> {
-    /// Adds `v` to component `d` of the force on slot `s`.
-    fn add(&mut self, s: usize, d: usize, v: T);
+    /// Adds component `d` of lane `l` of `f` to the force on slot `s`, for every `d`.
+    fn add<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize);
+    /// Subtracts it (a reaction).
+    fn sub<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize);
 }
 
 /// The forces of the slots from `base` on: slot `s` at `out[d][s - base]`.
@@ -186,10 +188,21 @@ pub(crate) struct Window<'a, T, const D: usize> {
     pub base: usize,
 }
 
-impl<T: Real, const D: usize> Scatter<T> for Window<'_, T, D> {
+impl<T: Real, const K: usize> Scatter<T> for Window<'_, T, K> {
     #[inline(always)]
-    fn add(&mut self, s: usize, d: usize, v: T) {
-        self.out[d][s - self.base] += v;
+    fn add<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize) {
+        let at = s - self.base;
+        for d in 0..D.min(K) {
+            self.out[d][at] += f[d][l];
+        }
+    }
+
+    #[inline(always)]
+    fn sub<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize) {
+        let at = s - self.base;
+        for d in 0..D.min(K) {
+            self.out[d][at] -= f[d][l];
+        }
     }
 }
 
@@ -200,13 +213,22 @@ pub(crate) struct Split<'a, T, const D: usize> {
     pub high: Window<'a, T, D>,
 }
 
-impl<T: Real, const D: usize> Scatter<T> for Split<'_, T, D> {
+impl<T: Real, const K: usize> Scatter<T> for Split<'_, T, K> {
     #[inline(always)]
-    fn add(&mut self, s: usize, d: usize, v: T) {
+    fn add<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize) {
         if s >= self.high.base {
-            self.high.add(s, d, v);
+            self.high.add(s, f, l);
         } else {
-            self.low.add(s, d, v);
+            self.low.add(s, f, l);
+        }
+    }
+
+    #[inline(always)]
+    fn sub<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize) {
+        if s >= self.high.base {
+            self.high.sub(s, f, l);
+        } else {
+            self.low.sub(s, f, l);
         }
     }
 }
@@ -233,12 +255,8 @@ pub(crate) fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bo
         let (xi, xj) = (slots.gather(ii), partners(slots, part, e, images));
         let f = evaluate::<T, L, D, PROBE>(law, &xi, &xj, m - e, &mut probe);
         for l in 0..LANES {
-            let (i, j) = (ii[l] as usize, jj[l] as usize);
-            for d in 0..D {
-                // `x + (−v)` is `x − v`, bit for bit.
-                out.add(i, d, f[d][l]);
-                out.add(j, d, -f[d][l]);
-            }
+            out.add(ii[l] as usize, &f, l);
+            out.sub(jj[l] as usize, &f, l);
         }
         e += LANES;
     }
@@ -270,9 +288,7 @@ fn half_rows<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
             let partners = partners(slots, part, e, images);
             let f = evaluate::<T, L, D, PROBE>(law, &target, &partners, b - e, &mut probe);
             for l in 0..LANES.min(b - e) {
-                for d in 0..D {
-                    out.add(jj[l] as usize, d, -f[d][l]);
-                }
+                out.sub(jj[l] as usize, &f, l);
             }
             for d in 0..D {
                 for l in 0..LANES {
@@ -281,9 +297,11 @@ fn half_rows<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
             }
             e += LANES;
         }
+        let mut sum = [[T::zero(); LANES]; D];
         for d in 0..D {
-            out.add(i as usize, d, lane_sum(acc[d]));
+            sum[d][0] = lane_sum(acc[d]);
         }
+        out.add(i as usize, &sum, 0);
     }
     probe.finish()
 }
