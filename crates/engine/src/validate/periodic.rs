@@ -68,7 +68,7 @@ pub fn periodic_reference_forces<L: PairLaw<f64>, const D: usize>(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::physics::LennardJones;
     use crate::testing::{SEED_1, random_state};
@@ -183,8 +183,9 @@ mod tests {
         assert!(f[0][0] != 0.0 && f[0][0] == -f[0][1]);
     }
 
-    /// A melt of `cells`³ fcc cells, each atom moved off its site by up to `jitter`, in f64.
-    fn melt(cells: usize, jitter: f64) -> (State<f64, 3>, [f64; 3]) {
+    /// A melt of `cells`³ fcc cells, each atom moved off its site by up to `jitter`, in f64
+    /// (also the periodic lists' test state).
+    pub(crate) fn melt(cells: usize, jitter: f64) -> (State<f64, 3>, [f64; 3]) {
         use crate::scenario::melt::{MELT_DENSITY, fcc_lattice};
         let (side, sites) = fcc_lattice(cells, MELT_DENSITY);
         let shake = random_state::<f64, 3>(sites.len(), 1.0, false, SEED_1);

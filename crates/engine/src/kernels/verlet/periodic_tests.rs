@@ -6,10 +6,10 @@
 use super::*;
 use crate::kernels::ForceKernel;
 use crate::physics::LennardJones;
-use crate::scenario::melt::{MELT_DENSITY, fcc_lattice};
 use crate::state::zero_field;
-use crate::testing::{SEED_1, SEED_2, on_threads, random_state};
+use crate::testing::{SEED_2, on_threads, random_state};
 use crate::validate::periodic::periodic_reference_forces;
+use crate::validate::periodic::tests::melt;
 
 const RC: f64 = 2.5;
 const SKIN: f64 = 0.3;
@@ -79,20 +79,6 @@ fn square(jitter: f64) -> (State<f64, 2>, [f64; 2]) {
         }
     }
     (state, [side; 2])
-}
-
-/// A melt of `cells`³ fcc cells at LAMMPS's density, shaken by up to `jitter`.
-fn melt(cells: usize, jitter: f64) -> (State<f64, 3>, [f64; 3]) {
-    let (side, sites) = fcc_lattice(cells, MELT_DENSITY);
-    let shake = random_state::<f64, 3>(sites.len(), 1.0, false, SEED_1);
-    let mut state = State::<f64, 3>::new(sites.len());
-    for (i, p) in sites.iter().enumerate() {
-        for d in 0..3 {
-            let x = p[d] + jitter * (2.0 * shake.pos[d][i] - 1.0);
-            state.pos[d][i] = x.rem_euclid(side);
-        }
-    }
-    (state, [side; 3])
 }
 
 #[test]
