@@ -103,6 +103,7 @@ fn a_list_run_is_bitwise_the_same_on_one_two_and_three_workers() {
         (KernelKind::Verlet, ScenarioKind::LjMelt),
         (KernelKind::ClusterPair, ScenarioKind::LjBox),
         (KernelKind::ClusterPair, ScenarioKind::LjLiquid),
+        (KernelKind::ClusterPair, ScenarioKind::LjMelt),
     ];
     for (kernel, scenario) in cases {
         {

@@ -3,6 +3,8 @@
 //! the short-range kernels' own).
 
 #[cfg(test)]
+pub(crate) mod periodic;
+#[cfg(test)]
 pub(crate) mod short_range;
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ mod counting_sort;
 pub mod decorator;
 mod fmm;
 pub mod footprint;
+mod images;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 mod naive;
@@ -160,7 +161,10 @@ impl KernelKind {
     /// Whether the kernel sums pairs through periodic boundaries
     /// ([`ForceKernel::set_periodic`] succeeds).
     pub fn periodic_form(self) -> bool {
-        matches!(self, KernelKind::Naive | KernelKind::Verlet)
+        matches!(
+            self,
+            KernelKind::Naive | KernelKind::Verlet | KernelKind::ClusterPair
+        )
     }
 
     /// Whether the build phase (binning and sorting) runs on the pool's threads when the

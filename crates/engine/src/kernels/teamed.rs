@@ -72,6 +72,27 @@ impl Colors {
     }
 }
 
+/// Whether a half list in `D` dimensions is cut into parts at the layers of its grid across
+/// the slowest axis: in 3-D and in a periodic box, where a row's pairs reach past the next
+/// layers' start (its neighbours one row back there, or across the faces of the middle axis),
+/// so parts cut anywhere else would need more layers each to keep parts two apart disjoint.
+pub(crate) fn cut_at_layers<const D: usize>(periodic: bool) -> bool {
+    D >= 2 && (D == 3 || periodic)
+}
+
+/// `count` parts cut at the `layers` layers of a grid: at most one per layer; in a periodic box,
+/// whose first part reaches across the faces into the last layer, an even number (those two
+/// parts of two colours), and a multiple of four beyond four (two workers then share a
+/// colour's parts evenly). A function of the grid only, never of the threads.
+pub(crate) fn parts_at_layers(count: usize, layers: usize, periodic: bool) -> usize {
+    let count = count.min(layers).max(1);
+    match (periodic, count) {
+        (false, _) | (true, 0..=1) => count,
+        (true, 2..=7) => count - count % 2,
+        (true, _) => count - count % 4,
+    }
+}
+
 /// Read-only inputs of the pair work, valid between the barriers of a phase.
 #[derive(Clone, Copy)]
 pub struct StateView<'s, T, const D: usize> {

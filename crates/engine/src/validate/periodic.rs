@@ -71,6 +71,7 @@ pub fn periodic_reference_forces<L: PairLaw<f64>, const D: usize>(
 pub(crate) mod tests {
     use super::*;
     use crate::physics::LennardJones;
+    use crate::testing::periodic::melt;
     use crate::testing::{SEED_1, random_state};
 
     /// The force on each particle summed over every image of every other particle in the
@@ -181,22 +182,6 @@ pub(crate) mod tests {
         state.pos[0][1] = 6.0 - 1.9;
         let (f, _, _) = periodic_reference_forces(&law, &state, side).unwrap();
         assert!(f[0][0] != 0.0 && f[0][0] == -f[0][1]);
-    }
-
-    /// A melt of `cells`³ fcc cells, each atom moved off its site by up to `jitter`, in f64
-    /// (also the periodic lists' test state).
-    pub(crate) fn melt(cells: usize, jitter: f64) -> (State<f64, 3>, [f64; 3]) {
-        use crate::scenario::melt::{MELT_DENSITY, fcc_lattice};
-        let (side, sites) = fcc_lattice(cells, MELT_DENSITY);
-        let shake = random_state::<f64, 3>(sites.len(), 1.0, false, SEED_1);
-        let mut state = State::<f64, 3>::new(sites.len());
-        for (i, p) in sites.iter().enumerate() {
-            for d in 0..3 {
-                let x = p[d] + jitter * (2.0 * shake.pos[d][i] - 1.0);
-                state.pos[d][i] = x.rem_euclid(side);
-            }
-        }
-        (state, [side; 3])
     }
 
     #[test]

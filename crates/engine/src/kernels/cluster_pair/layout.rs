@@ -8,11 +8,9 @@
 //! Memory, kept between builds: per padded slot its particle and a copy of its position and
 //! strength; per particle its padded slot and the sort's scratch; per cluster its bounding box.
 
-use crate::geometry::Bounds;
 use crate::kernels::counting_sort::{CountingSort, order_of};
 use crate::par::{Disjoint, gather, pass_chunk, worth_forking};
 use crate::real::Real;
-use crate::simd;
 use crate::simd::LANES;
 use crate::state::State;
 use rayon::prelude::*;
@@ -23,10 +21,20 @@ pub(crate) const CLUSTER: usize = 4;
 pub(crate) const GROUP: usize = LANES / CLUSTER;
 const _: () = assert!(GROUP * CLUSTER == LANES);
 
+/// The region the columns tile: the particles' bounding box, or a periodic box, whose sides
+/// the columns then divide exactly.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Region<const D: usize> {
+    pub lo: [f64; D],
+    pub hi: [f64; D],
+    pub periodic: bool,
+}
+
 pub struct Layout<T, const D: usize> {
-    /// The grid of columns: origin, width, and columns along each axis but the last.
+    /// The grid of columns: origin, widths (along the last axis, the nominal width the sort's
+    /// cells are cut from), and columns along each axis but the last.
     origin: [f64; D],
-    pub width: f64,
+    pub width: [f64; D],
     /// The box's extent along the last axis.
     extent_last: f64,
     pub columns: [usize; D],
@@ -59,7 +67,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
     pub fn new() -> Self {
         Layout {
             origin: [0.0; D],
-            width: 1.0,
+            width: [1.0; D],
             extent_last: 0.0,
             columns: [1; D],
             column_start: Vec::new(),
@@ -89,7 +97,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
     fn column_of(&self, x: [f64; D]) -> usize {
         let mut c = 0;
         for d in (0..D.saturating_sub(1)).rev() {
-            let k = ((x[d] - self.origin[d]) / self.width).max(0.0) as usize;
+            let k = ((x[d] - self.origin[d]) / self.width[d]).max(0.0) as usize;
             c = c * self.columns[d] + k.min(self.columns[d] - 1);
         }
         c
@@ -98,30 +106,35 @@ impl<T: Real, const D: usize> Layout<T, D> {
     /// The columns along axis `d` that the interval `lo..=hi` overlaps, clamped to the grid.
     pub(crate) fn column_range(&self, d: usize, lo: f64, hi: f64) -> (usize, usize) {
         let last = self.columns[d] - 1;
-        let a = ((lo - self.origin[d]) / self.width).max(0.0) as usize;
-        let b = ((hi - self.origin[d]) / self.width).max(0.0) as usize;
+        let a = ((lo - self.origin[d]) / self.width[d]).max(0.0) as usize;
+        let b = ((hi - self.origin[d]) / self.width[d]).max(0.0) as usize;
         (a.min(last), b.min(last))
     }
 
-    /// Sorts `state` into clusters, with columns no narrower than a quarter of `radius` (so a
-    /// search spans a few columns at most), and fills the padded copy.
-    pub fn build(&mut self, state: &State<T, D>, radius: f64) {
-        let n = state.len();
-        let Bounds { lo, hi } = simd::dispatch(
-            #[inline(always)]
-            || state.bounding_box(),
-        );
-        self.grid(lo.map(|x| x.as_f64()), hi.map(|x| x.as_f64()), radius, n);
-        self.sort(state);
+    /// The columns along axis `d` of a periodic box that the interval `lo..=hi` overlaps,
+    /// counted on past the faces (below 0 and from `columns[d]` on: images).
+    pub(crate) fn column_span(&self, d: usize, lo: f64, hi: f64) -> (i64, i64) {
+        let at = |x: f64| ((x - self.origin[d]) / self.width[d]).floor() as i64;
+        (at(lo), at(hi))
+    }
+
+    /// Sorts the particles at `pos` (with strengths `src`) into clusters over columns that
+    /// tile `region`, no narrower than a quarter of `radius` (so a search spans a few columns
+    /// at most), and fills the padded copy.
+    pub fn build(&mut self, pos: [&[T]; D], src: &[T], region: Region<D>, radius: f64) {
+        self.grid(region, radius, src.len());
+        self.sort(pos);
         self.cut();
-        self.refresh(state);
+        self.refresh(pos, src);
         self.boxes();
         self.column_extents();
     }
 
     /// Chooses the columns: as wide as a cluster is long at the box's mean density, and at most
-    /// a few per particle (an elongated box or a sparse one widens them).
-    fn grid(&mut self, lo: [f64; D], hi: [f64; D], radius: f64, n: usize) {
+    /// a few per particle (an elongated box or a sparse one widens them). In a periodic box as
+    /// many whole columns as fit along each side, stretched to tile it.
+    fn grid(&mut self, region: Region<D>, radius: f64, n: usize) {
+        let Region { lo, hi, periodic } = region;
         let extent: [f64; D] = std::array::from_fn(|d| (hi[d] - lo[d]).max(0.0));
         let volume: f64 = extent.iter().map(|e| e.max(radius * 1e-3)).product();
         let mut width = (CLUSTER as f64 * volume / n.max(1) as f64)
@@ -134,10 +147,10 @@ impl<T: Real, const D: usize> Layout<T, D> {
         loop {
             let mut total = 1usize;
             for d in 0..D {
-                self.columns[d] = if d + 1 < D {
-                    (extent[d] / width) as usize + 1
-                } else {
-                    1
+                self.columns[d] = match (d + 1 < D, periodic) {
+                    (false, _) => 1,
+                    (true, false) => (extent[d] / width) as usize + 1,
+                    (true, true) => ((extent[d] / width) as usize).max(1),
                 };
                 total = total.saturating_mul(self.columns[d]);
             }
@@ -147,7 +160,10 @@ impl<T: Real, const D: usize> Layout<T, D> {
             width *= 2.0;
         }
         self.origin = lo;
-        self.width = width;
+        self.width = std::array::from_fn(|d| match d + 1 < D && periodic {
+            true => extent[d] / self.columns[d] as f64,
+            false => width,
+        });
         self.extent_last = extent[D - 1];
     }
 
@@ -155,10 +171,10 @@ impl<T: Real, const D: usize> Layout<T, D> {
     /// column is wide), then each column sorted along the last axis by insertion, which moves
     /// a particle only within its cell (ties by slot, so the order does not depend on the
     /// thread count).
-    fn sort(&mut self, state: &State<T, D>) {
-        let n = state.len();
+    fn sort(&mut self, pos: [&[T]; D]) {
+        let n = pos[0].len();
         let columns: usize = self.columns.iter().product();
-        let cell = 0.5 * self.width;
+        let cell = 0.5 * self.width[D - 1];
         let (base, extent) = (self.origin[D - 1], self.extent_last);
         let cells = ((extent / cell) as usize + 1)
             .min((4 * n + 64) / columns.max(1))
@@ -167,7 +183,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
         key.resize(n, 0);
         let fill = |offset: usize, out: &mut [u32]| {
             for (k, c) in out.iter_mut().enumerate() {
-                let x: [f64; D] = std::array::from_fn(|d| state.pos[d][offset + k].as_f64());
+                let x: [f64; D] = std::array::from_fn(|d| pos[d][offset + k].as_f64());
                 let along = (((x[D - 1] - base) / cell).max(0.0) as usize).min(cells - 1);
                 *c = (self.column_of(x) * cells + along) as u32;
             }
@@ -192,7 +208,7 @@ impl<T: Real, const D: usize> Layout<T, D> {
         let bounds: Vec<u32> = (0..=columns).map(|c| self.start[c * cells]).collect();
         self.start.clear();
         self.start.extend_from_slice(&bounds);
-        let last = &state.pos[D - 1];
+        let last = pos[D - 1];
         let by_last = |run: &mut [u32]| {
             let key = |s: u32| (last[s as usize].as_f64(), s);
             for i in 1..run.len() {
@@ -289,12 +305,25 @@ impl<T: Real, const D: usize> Layout<T, D> {
         self.column_start.last().map_or(0, |&c| c as usize)
     }
 
-    /// Copies the positions and strengths of `state` into the padded slots.
-    pub fn refresh(&mut self, state: &State<T, D>) {
+    /// Copies the positions `pos` and strengths `src` of the state's slots into the padded
+    /// slots.
+    pub fn refresh(&mut self, pos: [&[T]; D], src: &[T]) {
         for d in 0..D {
-            gather(&state.pos[d], &self.slot_of, &mut self.pos[d]);
+            gather(pos[d], &self.slot_of, &mut self.pos[d]);
         }
-        gather(&state.source, &self.slot_of, &mut self.src);
+        gather(src, &self.slot_of, &mut self.src);
+    }
+
+    /// The layers of columns across the slowest column axis (the columns of axis `D - 2`, in
+    /// the order of the clusters), and the clusters of one layer's columns.
+    pub(crate) fn layers(&self) -> usize {
+        self.columns[D.saturating_sub(2)]
+    }
+
+    /// The first cluster of layer `k` (the number of filled clusters from `layers()` on).
+    pub(crate) fn layer_start(&self, k: usize) -> usize {
+        let per_layer: usize = self.columns[..D.saturating_sub(2)].iter().product();
+        self.column_start[k * per_layer] as usize
     }
 
     /// Each cluster's bounding box, from the padded copy (padding repeats a real particle).

@@ -21,34 +21,44 @@
 //! - At a rebuild the particles are re-sorted into cluster order ([`ForceKernel::sort_every`]
 //!   is 1, [`ForceKernel::spatial_order`] answers exactly when a rebuild is due), so the copy of
 //!   the positions into the padded slots reads the state in order.
+//! - In a periodic box ([`ForceKernel::set_periodic`]) the columns tile the box, the search
+//!   meets the columns beyond the faces as images and each run keeps its shift ([`list`]); the
+//!   padded copy holds positions continued from the build, as the `verlet` list's loops read
+//!   them ([`crate::kernels::images`]), so a wrap neither forces a rebuild nor meets the wrong
+//!   image.
 //!
 //! Memory, kept between rebuilds: per padded slot (at most one slot of padding per column) its
 //! particle, position, strength and force; per particle its position at the build and its
-//! slot; per cluster its box; per run 12 bytes (its first cluster and four lane masks).
+//! slot (and in a periodic box its continued position); per cluster its box; per run 13 bytes
+//! (its first cluster, shift and four lane masks).
 
 mod layout;
 mod list;
 #[cfg(test)]
+mod periodic_tests;
+mod plan;
+#[cfg(test)]
 mod tests;
 mod tile;
 
-use super::teamed::{Colors, StateView, TeamPlan};
-use super::verlet::{block_kept, list_cutoff, moved_too_far};
+use super::images::Images;
+use super::teamed::{Colors, TeamPlan, cut_at_layers, parts_at_layers};
+use super::verlet::{list_cutoff, moved_too_far};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, MIN_PARALLEL_PAIRS, WorkCounters};
 use crate::par::gather;
-use crate::par::team::{SharedSlice, Worker, shared};
+use crate::par::team::SharedSlice;
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
 use crate::simd::LANES;
 use crate::state::{Field, State};
-use layout::CLUSTER;
 use layout::Layout;
+use layout::{CLUSTER, Region};
 use list::Part;
+use plan::{Plan, add_part};
 use rayon::prelude::*;
-use std::ops::Range;
 use std::time::Instant;
-use tile::{Clusters, TileSum, part_forces};
+use tile::{Clusters, Out, TileSum, part_forces};
 
 /// Relative margin of the list radius (as the `verlet` list's): boxes are compared in f64 at
 /// the build and pairs rounded in `T` at every step.
@@ -63,6 +73,22 @@ const MIN_PART_CLUSTERS: usize = 128;
 /// Cost of one run (`CLUSTER × LANES` pair evaluations and the reactions) in naive pair
 /// evaluations, the unit of `worth_parallel`.
 const RUN_COST: u64 = (CLUSTER * LANES) as u64;
+
+/// The positions of a build: the state's, or in a periodic box wrapped into it (written to
+/// `into`).
+fn build_positions<'s, T: Real, const D: usize>(
+    images: Option<&Images<T, D>>,
+    state: &'s State<T, D>,
+    into: &'s mut [Vec<T>; D],
+) -> [&'s [T]; D] {
+    match images {
+        Some(images) => {
+            images.wrap_all(state, into);
+            into.each_ref().map(|x| x.as_slice())
+        }
+        None => state.pos.each_ref().map(|x| x.as_slice()),
+    }
+}
 
 /// The `cluster-pair` kernel for the short-range law `L`: a Verlet list of 4-particle clusters.
 pub struct ClusterPair<L, T, const D: usize> {
@@ -83,6 +109,11 @@ pub struct ClusterPair<L, T, const D: usize> {
     force: [Vec<T>; D],
     /// The colours of the parts.
     colors: Colors,
+    /// The periodic box, if any.
+    periodic: Option<Images<T, D>>,
+    /// In a periodic box: each state slot's position continued from its place at the build
+    /// (as of the last displacement test).
+    continued: [Vec<T>; D],
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
@@ -103,6 +134,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
             at_build: std::array::from_fn(|_| Vec::new()),
             force: std::array::from_fn(|_| Vec::new()),
             colors: Colors::default(),
+            periodic: None,
+            continued: std::array::from_fn(|_| Vec::new()),
         })
     }
 
@@ -111,8 +144,46 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         self.parts.iter().map(|p| p.runs() as u64).sum()
     }
 
-    fn due(&self, state: &State<T, D>) -> bool {
-        !self.built || moved_too_far(state, &self.at_build, self.skin)
+    /// Whether the list is missing or some slot moved more than half the skin since the
+    /// build; in a periodic box, the slots' continued positions are left in `continued`.
+    fn due(&mut self, state: &State<T, D>) -> bool {
+        if !self.built {
+            return true;
+        }
+        match &self.periodic {
+            Some(images) => {
+                images.continue_all(state, &self.at_build, self.skin, &mut self.continued)
+            }
+            None => moved_too_far(state, &self.at_build, self.skin),
+        }
+    }
+
+    /// Sorts `state` into clusters.
+    fn build_layout(&mut self, state: &State<T, D>) {
+        let region = match &self.periodic {
+            Some(images) => {
+                let lo = images.lo64();
+                let side = images.side64();
+                Region {
+                    lo,
+                    hi: std::array::from_fn(|d| lo[d] + side[d]),
+                    periodic: true,
+                }
+            }
+            None => {
+                let bounds = simd::dispatch(
+                    #[inline(always)]
+                    || state.bounding_box(),
+                );
+                Region {
+                    lo: bounds.lo.map(|x| x.as_f64()),
+                    hi: bounds.hi.map(|x| x.as_f64()),
+                    periodic: false,
+                }
+            }
+        };
+        let pos = build_positions(self.periodic.as_ref(), state, &mut self.at_build);
+        self.layout.build(pos, &state.source, region, self.radius);
     }
 
     /// Brings the list up to date with `state`; returns the boxes compared by a rebuild, or
@@ -120,21 +191,28 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
     fn refresh(&mut self, state: &State<T, D>) -> Option<u64> {
         if self.handed_out {
             self.handed_out = false;
-            if !self.layout.adopt(state) {
-                self.layout.build(state, self.radius);
+            if self.layout.adopt(state) {
+                let pos = state.pos.each_ref().map(|x| x.as_slice());
+                self.layout.refresh(pos, &state.source);
+            } else {
+                self.build_layout(state);
             }
-            self.layout.refresh(state);
             return Some(self.rebuild(state));
         }
         if self.due(state) {
-            self.layout.build(state, self.radius);
+            self.build_layout(state);
             return Some(self.rebuild(state));
         }
-        self.layout.refresh(state);
+        let pos = match self.periodic {
+            Some(_) => self.continued.each_ref().map(|x| x.as_slice()),
+            None => state.pos.each_ref().map(|x| x.as_slice()),
+        };
+        self.layout.refresh(pos, &state.source);
         None
     }
 
-    /// Builds the list over the current layout, in parts on the pool's threads.
+    /// Builds the list over the current layout, in parts on the pool's threads, and takes
+    /// the positions of the build.
     fn rebuild(&mut self, state: &State<T, D>) -> u64 {
         let m = self.layout.filled();
         // The previous list's size tells the new one's; before the first build, a guess of
@@ -146,30 +224,55 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         };
         let work = runs * RUN_COST + state.len() as u64;
         // Never a function of the threads: the parts fix the order in which forces are added.
-        let count = if work >= MIN_PARALLEL_PAIRS {
+        let mut count = if work >= MIN_PARALLEL_PAIRS {
             (m / MIN_PART_CLUSTERS).clamp(1, PARTS)
         } else {
             1
         };
+        let periodic = self.periodic.is_some();
+        let layers = self.layout.layers();
+        let by_layers = cut_at_layers::<D>(periodic);
+        // A cluster's runs reach `reach` layers on (and, in the first layers, back across the
+        // faces into the last ones), and a run's last clusters a little past its window: parts
+        // of `reach + 1` layers keep the parts of a colour apart, and the last part, which
+        // the first reaches into, gets `reach` layers more.
+        let reach = (self.radius / self.layout.width[D.saturating_sub(2)]) as usize + 1;
+        let extra = if periodic { reach } else { 0 };
+        if by_layers {
+            let most = layers.saturating_sub(extra) / (reach + 1);
+            count = parts_at_layers(count.min(most), layers, periodic);
+        }
         self.parts.resize_with(count, Part::default);
         let (layout, radius, radius2) = (&self.layout, self.radius, self.radius2);
+        let images = self.periodic.as_ref();
+        let cut = |k: usize| match (by_layers, k == count) {
+            (true, false) => layout.layer_start(k * layers.saturating_sub(extra) / count),
+            (true, true) => layout.layer_start(layers),
+            (false, _) => k * m / count,
+        };
         let build = |(k, part): (usize, &mut Part)| {
-            let range = k * m / count..(k + 1) * m / count;
-            list::build(layout, radius, radius2, range, part)
+            let range = cut(k)..cut(k + 1);
+            list::build(layout, images, radius, radius2, range, part)
         };
         let compared = if count > 1 {
             self.parts.par_iter_mut().enumerate().map(build).sum()
         } else {
             build((0, &mut self.parts[0]))
         };
-        self.colors = Colors::of(
+        let slots = |r: &std::ops::Range<usize>| r.start * CLUSTER..r.end * CLUSTER;
+        self.colors = Colors::of_sets(
             self.parts
                 .iter()
-                .map(|p| p.clusters.start * CLUSTER..p.end * CLUSTER),
+                .map(|p| [slots(&(p.clusters.start..p.end)), slots(&p.far)]),
         );
-        for d in 0..D {
-            self.at_build[d].clear();
-            self.at_build[d].extend_from_slice(&state.pos[d]);
+        match &self.periodic {
+            Some(images) => images.wrap_all(state, &mut self.at_build),
+            None => {
+                for d in 0..D {
+                    self.at_build[d].clear();
+                    self.at_build[d].extend_from_slice(&state.pos[d]);
+                }
+            }
         }
         self.built = true;
         compared
@@ -183,19 +286,20 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
             f.clear();
             f.resize(slots, T::zero());
         }
-        let mut out = force.each_mut().map(|f| f.as_mut_slice());
+        let mut out = Out::whole(force.each_mut().map(|f| f.as_mut_slice()));
         let (law, clusters) = (&self.law, Clusters::of(&self.layout));
+        let images = self.periodic.as_ref();
         let mut sum = TileSum::default();
         for k in self.colors.order() {
             let part = &self.parts[k];
             // Probe steps are not timed: their loop is compiled once, for the baseline
             // instruction set, rather than once per set (less to compile).
             let s = if PROBE {
-                part_forces::<T, L, D, true>(law, &clusters, part, &mut out, 0)
+                part_forces::<T, L, D, true>(law, &clusters, part, images, &mut out)
             } else {
                 simd::dispatch(
                     #[inline(always)]
-                    || part_forces::<T, L, D, false>(law, &clusters, part, &mut out, 0),
+                    || part_forces::<T, L, D, false>(law, &clusters, part, images, &mut out),
                 )
             };
             sum.energy += s.energy;
@@ -214,134 +318,15 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
             f.resize(slots, T::zero());
         }
         let (law, clusters) = (&self.law, Clusters::of(&self.layout));
+        let images = self.periodic.as_ref();
         let out = SharedSlice::each(self.force.each_mut().map(|f| f.as_mut_slice()));
         for c in 0..2 {
             let parts: Vec<usize> = self.colors.of_color(c).collect();
             parts.par_iter().for_each(|&k| {
                 // SAFETY: the parts of one colour touch disjoint slots (the caller checked
                 // `colors.disjoint()`), and nothing else uses `out` until the colour is done.
-                unsafe { add_part(law, &clusters, &self.parts[k], &out) }
+                unsafe { add_part(law, &clusters, &self.parts[k], images, &out) }
             });
-        }
-    }
-}
-
-/// Adds the forces of `part` to the padded slots of `out` its runs touch.
-///
-/// # Safety
-/// No other thread touches those slots of `out` meanwhile.
-unsafe fn add_part<T: Real, L: PairLaw<T>, const D: usize>(
-    law: &L,
-    clusters: &Clusters<'_, T, D>,
-    part: &Part,
-    out: &[SharedSlice<'_, T>; D],
-) {
-    let span = part.clusters.start * CLUSTER..part.end * CLUSTER;
-    let base = span.start;
-    // SAFETY: the caller's promise.
-    let mut out = unsafe { shared::ranges_mut(out, span) };
-    simd::dispatch(
-        #[inline(always)]
-        || part_forces::<T, L, D, false>(law, clusters, part, &mut out, base),
-    );
-}
-
-/// The cluster list's step in a team region: the displacement test on each worker's block,
-/// the padded copy and forces by blocks of padded slots, the parts colour by colour, the
-/// forces gathered back by blocks of state slots.
-struct Plan<'k, L, T, const D: usize> {
-    law: &'k L,
-    parts: &'k [Part],
-    colors: &'k Colors,
-    at_build: [&'k [T]; D],
-    skin: f64,
-    runs: u64,
-    slot_of: &'k [u32],
-    padded_of: &'k [u32],
-    pos: [SharedSlice<'k, T>; D],
-    src: SharedSlice<'k, T>,
-    force: [SharedSlice<'k, T>; D],
-}
-
-impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
-    fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
-        block_kept(pos, self.at_build, block, self.skin)
-    }
-
-    fn colors(&self) -> &Colors {
-        self.colors
-    }
-
-    unsafe fn prepare(
-        &self,
-        worker: &Worker,
-        state: StateView<'_, T, D>,
-        _forces: &[SharedSlice<'_, T>; D],
-    ) {
-        let block = worker.block(self.slot_of.len());
-        let from = &self.slot_of[block.clone()];
-        // SAFETY: each worker writes its own block of padded slots, and nobody reads them
-        // before the next barrier (the caller's promise for this phase).
-        let (pos, src, force) = unsafe {
-            (
-                shared::ranges_mut(&self.pos, block.clone()),
-                self.src.range_mut(block.clone()),
-                shared::ranges_mut(&self.force, block),
-            )
-        };
-        for (d, x) in pos.into_iter().enumerate() {
-            for (x, &i) in x.iter_mut().zip(from) {
-                *x = state.pos[d][i as usize];
-            }
-        }
-        for (s, &i) in src.iter_mut().zip(from) {
-            *s = state.source[i as usize];
-        }
-        for f in force {
-            f.fill(T::zero());
-        }
-    }
-
-    unsafe fn interact(
-        &self,
-        part: usize,
-        _state: StateView<'_, T, D>,
-        _forces: &[SharedSlice<'_, T>; D],
-    ) {
-        // SAFETY: the padded copy is written only before the previous barrier; no other part
-        // running now touches this part's slots (the caller's promise).
-        unsafe {
-            let clusters = Clusters {
-                pos: shared::wholes(&self.pos),
-                src: self.src.whole(),
-            };
-            add_part(self.law, &clusters, &self.parts[part], &self.force);
-        }
-    }
-
-    unsafe fn finish(&self, worker: &Worker, forces: &[SharedSlice<'_, T>; D]) {
-        let block = worker.block(self.padded_of.len());
-        let from = &self.padded_of[block.clone()];
-        // SAFETY: the padded forces are final (every part ran before the last barrier); each
-        // worker writes its own block of the output.
-        let (force, out) = unsafe {
-            (
-                shared::wholes(&self.force),
-                shared::ranges_mut(forces, block),
-            )
-        };
-        for (d, out) in out.into_iter().enumerate() {
-            for (o, &k) in out.iter_mut().zip(from) {
-                *o = force[d][k as usize];
-            }
-        }
-    }
-
-    fn work(&self) -> WorkCounters {
-        WorkCounters {
-            pair_checks: self.runs * RUN_COST,
-            list_entries: self.runs,
-            ..Default::default()
         }
     }
 }
@@ -402,7 +387,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
         if !self.due(state) && !self.handed_out {
             return None;
         }
-        self.layout.build(state, self.radius);
+        self.build_layout(state);
         self.handed_out = true;
         Some(self.layout.order.clone())
     }
@@ -428,6 +413,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
             law: &self.law,
             parts: &self.parts,
             colors: &self.colors,
+            images: self.periodic.as_ref(),
             at_build: self.at_build.each_ref().map(|x| x.as_slice()),
             skin: self.skin,
             runs,
@@ -437,5 +423,23 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
             src: SharedSlice::new(&mut layout.src),
             force: SharedSlice::each(self.force.each_mut().map(|f| f.as_mut_slice())),
         }))
+    }
+
+    /// Refused when a side is shorter than twice the cutoff plus the skin (a pair could then
+    /// meet within the cutoff through two images).
+    fn set_periodic(&mut self, lo: [T; D], hi: [T; D]) -> Result<(), KernelError> {
+        let images = Images::new(lo, hi);
+        let least = 2.0 * self.radius;
+        if let Some(d) = (0..D).find(|&d| images.side64()[d] < least || images.side64()[d].is_nan()) {
+            return Err(KernelError::PeriodicBoxTooSmall(format!(
+                "cluster-pair in a periodic box needs a side of at least twice the cutoff plus \
+                 the skin ({least:.6}); side {d} is {:.6}: use more particles, a smaller skin, \
+                 or naive",
+                images.side64()[d]
+            )));
+        }
+        self.periodic = Some(images);
+        self.built = false;
+        Ok(())
     }
 }

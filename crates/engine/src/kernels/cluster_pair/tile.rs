@@ -4,10 +4,12 @@
 //! the i-cluster's list, and the reactions of the four i-particles add up lane by lane into
 //! one contiguous update of the run. Lanes that must not act (outside the run's window,
 //! padding, and in the i-cluster itself each pair's second copy and a particle with itself)
-//! are zeroed with a select, never a branch.
+//! are zeroed with a select, never a branch. In a periodic box a run met through an image
+//! shifts the i-cluster instead: `CLUSTER · D` subtractions per run, none per pair.
 
 use super::layout::{CLUSTER, Layout};
 use super::list::Part;
+use crate::kernels::images::{Images, no_shift};
 use crate::kernels::rows::lane_sum;
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
@@ -36,17 +38,52 @@ impl<'a, T: Real, const D: usize> Clusters<'a, T, D> {
     }
 }
 
-/// Adds the forces of the runs of `part` to `out`, where padded slot `s` is at
-/// `out[d][s - base]`: both ends of every pair, each pair once.
+/// Where the forces of a part go: padded slot `s` at `near[d][s - near_base]`, or from
+/// `far_base` on (the clusters a part reaches across the faces, see [`Part::far`]) at
+/// `far[d][s - far_base]`.
+pub(crate) struct Out<'a, T, const D: usize> {
+    pub near: [&'a mut [T]; D],
+    pub near_base: usize,
+    pub far: [&'a mut [T]; D],
+    pub far_base: usize,
+}
+
+impl<'a, T, const D: usize> Out<'a, T, D> {
+    /// Every padded slot, `out[d][s]`.
+    pub fn whole(out: [&'a mut [T]; D]) -> Self {
+        Out {
+            near: out,
+            near_base: 0,
+            far: std::array::from_fn(|_| &mut [][..]),
+            far_base: usize::MAX,
+        }
+    }
+
+    /// The `LANES` forces along axis `d` of the run from padded slot `js`.
+    #[inline(always)]
+    fn run(&mut self, d: usize, js: usize) -> &mut [T; LANES] {
+        let (out, at) = match js >= self.far_base {
+            true => (&mut self.far[d], js - self.far_base),
+            false => (&mut self.near[d], js - self.near_base),
+        };
+        (&mut out[at..at + LANES])
+            .try_into()
+            .expect("runs are whole")
+    }
+}
+
+/// Adds the forces of the runs of `part` to `out`, each run through its image of `images` in
+/// a periodic box: both ends of every pair, each pair once.
 #[inline(always)]
 pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
     law: &L,
     clusters: &Clusters<'_, T, D>,
     part: &Part,
-    out: &mut [&mut [T]; D],
-    base: usize,
+    images: Option<&Images<T, D>>,
+    out: &mut Out<'_, T, D>,
 ) -> TileSum {
     let (pos, src) = (&clusters.pos, clusters.src);
+    let unshifted = no_shift::<D>();
     let mut energy = [T::zero(); LANES];
     let mut interacting = [0u32; LANES];
     for (k, c) in part.clusters.clone().enumerate() {
@@ -66,13 +103,22 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
             let xj: [&[T; LANES]; D] =
                 std::array::from_fn(|d| pos[d][js..js + LANES].try_into().expect("runs are whole"));
             let sj: &[T; LANES] = src[js..js + LANES].try_into().expect("runs are whole");
+            // The i-cluster moved by minus the run's shift: each pair's difference is then
+            // the partner's image's.
+            let xs: [[T; CLUSTER]; D] = match images {
+                Some(im) if part.shift[r] != unshifted => {
+                    let s = im.shift_of(part.shift[r]);
+                    std::array::from_fn(|d| xi[d].map(|x| x - s[d]))
+                }
+                _ => xi,
+            };
             let mut fj = [[T::zero(); LANES]; D];
             for a in 0..CLUSTER {
                 let mut dx = [[T::zero(); LANES]; D];
                 let mut r2 = [T::zero(); LANES];
                 for d in 0..D {
                     for l in 0..LANES {
-                        dx[d][l] = xj[d][l] - xi[d][a];
+                        dx[d][l] = xj[d][l] - xs[d][a];
                         r2[l] += dx[d][l] * dx[d][l];
                     }
                 }
@@ -97,9 +143,7 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
                 }
             }
             for d in 0..D {
-                let dst: &mut [T; LANES] = (&mut out[d][js - base..js - base + LANES])
-                    .try_into()
-                    .expect("runs are whole");
+                let dst = out.run(d, js);
                 for l in 0..LANES {
                     dst[l] -= fj[d][l];
                 }
@@ -107,7 +151,7 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
         }
         for a in 0..CLUSTER {
             for d in 0..D {
-                out[d][ic - base + a] += lane_sum(fi[a][d]);
+                out.near[d][ic - out.near_base + a] += lane_sum(fi[a][d]);
             }
         }
     }

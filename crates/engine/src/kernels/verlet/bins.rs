@@ -5,11 +5,11 @@
 //! row-major with a phantom bin ending each row, so the bins `x−1 ..= x+1` of one row are a
 //! single run of sorted indices: the stencil of a bin is `3^(D−1)` runs.
 
-use super::images::Images;
 use crate::geometry::Bounds;
 use crate::kernels::cell_list::grid::Grid;
 use crate::kernels::cell_list::strips::bin_all;
 use crate::kernels::counting_sort::{CountingSort, order_of};
+use crate::kernels::images::Images;
 use crate::par::gather;
 use crate::real::Real;
 use crate::simd;

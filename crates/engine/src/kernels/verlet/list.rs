@@ -4,8 +4,8 @@
 //! the force loop ever copies entries from one buffer into another.
 
 use super::bins::Bins;
-use super::images::{crosses_slowest_axis, no_shift};
 use crate::kernels::cell_list::strips::position;
+use crate::kernels::images::{crosses_slowest_axis, no_shift};
 use crate::kernels::rows::LANES;
 use crate::real::Real;
 use std::ops::Range;

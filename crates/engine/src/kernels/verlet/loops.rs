@@ -17,8 +17,8 @@
 //!   it halves the scatters and gathers no target per entry.
 //! - [`target_rows`]: every partner of each target (a full list: no reactions).
 
-use super::images::Images;
 use super::list::Part;
+use crate::kernels::images::Images;
 use crate::kernels::rows::{LANES, RowSum, lane_sum};
 use crate::physics::PairLaw;
 use crate::real::{Real, select};

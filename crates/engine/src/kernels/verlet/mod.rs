@@ -32,7 +32,6 @@
 //! 8 bytes per list entry (partner and target slots).
 
 mod bins;
-mod images;
 mod list;
 mod loops;
 #[cfg(test)]
@@ -42,9 +41,10 @@ mod search_periodic;
 mod tests;
 mod work;
 
-use super::teamed::{Colors, StateView, TeamPlan};
+use super::teamed::{Colors, StateView, TeamPlan, cut_at_layers, parts_at_layers};
 use super::{ForceKernel, ForceReport, KernelError, KernelKind, WorkCounters};
 use crate::kernels::cell_list::grid::{Grid, PERIODIC_MIN_BINS};
+use crate::kernels::images::Images;
 use crate::par::team::{SharedSlice, Worker, shared};
 use crate::par::{pass_chunk, worth_forking};
 use crate::physics::PairLaw;
@@ -52,7 +52,6 @@ use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
 use bins::Bins;
-use images::Images;
 use list::{BuildWork, Cover, Part};
 use loops::{Slots, Split, Window};
 use rayon::prelude::*;
@@ -184,9 +183,9 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Verlet<L, T, D> {
         let mut count = parts_for(rows, step_work(rows, entries));
         let periodic = self.periodic.is_some();
         let layers = self.bins.grid.dims[D - 1];
-        let by_layers = cover == Cover::Half && work::cut_at_layers::<D>(periodic);
+        let by_layers = cover == Cover::Half && cut_at_layers::<D>(periodic);
         if by_layers {
-            count = work::parts_at_layers(count, layers, periodic);
+            count = parts_at_layers(count, layers, periodic);
         }
         self.parts.resize_with(count, Part::default);
         let (bins, radius2, images) = (&self.bins, self.radius2, self.periodic.as_ref());

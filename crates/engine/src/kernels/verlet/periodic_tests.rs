@@ -7,78 +7,14 @@ use super::*;
 use crate::kernels::ForceKernel;
 use crate::physics::LennardJones;
 use crate::state::zero_field;
-use crate::testing::{SEED_2, on_threads, random_state};
+use crate::testing::on_threads;
+use crate::testing::periodic::{RC, SKIN, agrees, law, melt, narrowed, shove, square};
 use crate::validate::periodic::periodic_reference_forces;
-use crate::validate::periodic::tests::melt;
-
-const RC: f64 = 2.5;
-const SKIN: f64 = 0.3;
-
-fn law<T: Real>() -> LennardJones<T> {
-    LennardJones::new(1.0, 1.0, RC)
-}
 
 fn kernel<T: Real, const D: usize>(side: [f64; D]) -> Verlet<LennardJones<T>, T, D> {
     let mut k = Verlet::new(law::<T>(), SKIN).unwrap();
     k.set_periodic([T::zero(); D], side.map(T::of)).unwrap();
     k
-}
-
-/// `state` in precision `T`.
-fn narrowed<T: Real, const D: usize>(state: &State<f64, D>) -> State<T, D> {
-    let mut out = State::<T, D>::new(state.len());
-    for d in 0..D {
-        out.pos[d] = state.pos[d].iter().map(|&x| T::of(x)).collect();
-    }
-    out
-}
-
-/// Forces of the periodic list on `state` (in `T`) against the reference, within `tol` of
-/// each particle's sum of absolute pair forces; the forces.
-fn agrees<T: Real, const D: usize>(
-    kernel: &mut Verlet<LennardJones<T>, T, D>,
-    state: &State<f64, D>,
-    side: [f64; D],
-    tol: f64,
-) -> Field<T, D> {
-    let (want, energy, abs_sum) = periodic_reference_forces(&law::<f64>(), state, side).unwrap();
-    let narrow = narrowed::<T, D>(state);
-    let mut f = zero_field::<T, D>(state.len());
-    let report = kernel.compute(&narrow, &mut f, true);
-    for i in 0..state.len() {
-        for d in 0..D {
-            let err = (f[d][i].as_f64() - want[d][i]).abs();
-            assert!(
-                err <= tol * abs_sum[i].max(1e-300),
-                "{} D={D} particle {i} axis {d}: {} against {} ({err:e})",
-                T::NAME,
-                f[d][i],
-                want[d][i]
-            );
-        }
-    }
-    let e = report.energy.unwrap();
-    assert!(
-        (e - energy).abs() <= tol * 10.0 * energy.abs().max(1.0),
-        "{e} vs {energy}"
-    );
-    f
-}
-
-/// A jittered square lattice of spacing 1 filling the 2-D box of side 9: sites on every face,
-/// edge and corner, shaken across them.
-fn square(jitter: f64) -> (State<f64, 2>, [f64; 2]) {
-    let side = 9.0;
-    let shake = random_state::<f64, 2>(81, 1.0, false, SEED_2);
-    let mut state = State::<f64, 2>::new(81);
-    for i in 0..81 {
-        let site = [(i % 9) as f64, (i / 9) as f64];
-        for d in 0..2 {
-            let x = site[d] + jitter * (2.0 * shake.pos[d][i] - 1.0);
-            state.pos[d][i] = x.rem_euclid(side);
-        }
-    }
-    (state, [side; 2])
 }
 
 #[test]
@@ -159,15 +95,7 @@ fn a_slot_wrapped_across_a_face_keeps_the_list_and_meets_the_right_image() {
     agrees(&mut k, &state, side, 1e-10);
     // Move every atom by up to a third of the skin, and wrap those that leave the box, as
     // the integrator does.
-    let shove = random_state::<f64, 3>(state.len(), 1.0, false, SEED_2);
-    let mut wrapped = 0;
-    for i in 0..state.len() {
-        for d in 0..3 {
-            let x = state.pos[d][i] + SKIN / 3.0 * (2.0 * shove.pos[d][i] - 1.0) / 3f64.sqrt();
-            wrapped += usize::from(!(0.0..side[d]).contains(&x));
-            state.pos[d][i] = x.rem_euclid(side[d]);
-        }
-    }
+    let wrapped = shove(&mut state, side, SKIN / 3.0);
     assert!(wrapped > 10, "{wrapped} coordinates wrapped");
     let (want, _, abs_sum) = periodic_reference_forces(&law::<f64>(), &state, side).unwrap();
     let mut f = zero_field::<f64, 3>(state.len());

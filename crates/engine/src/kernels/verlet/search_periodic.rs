@@ -11,10 +11,10 @@
 //! the list touches, besides the slots near its rows, at most that last layer (`Part::wrap`).
 
 use super::bins::Bins;
-use super::images::{Images, code_of, no_shift};
 use super::list::{BuildWork, Cover, Part, Rows, fill, scan};
 use crate::kernels::cell_list::grid::Grid;
 use crate::kernels::cell_list::strips::position;
+use crate::kernels::images::{Images, code_of, no_shift};
 use crate::real::Real;
 use std::ops::Range;
 

@@ -41,27 +41,6 @@ pub fn parts_for(rows: usize, work: u64) -> usize {
     }
 }
 
-/// Whether a half list in `D` dimensions is cut into parts at the layers of bins across the
-/// slowest axis: in 3-D and in a periodic box, where a row's pairs reach to the end of the next
-/// layer (its neighbours one row back there, or across the faces of the middle axis), so
-/// parts cut anywhere else would need two layers each to keep parts two apart disjoint.
-pub(crate) fn cut_at_layers<const D: usize>(periodic: bool) -> bool {
-    D >= 2 && (D == 3 || periodic)
-}
-
-/// `count` parts cut at the `layers` layers of bins: at most one per layer; in a periodic box,
-/// whose first part reaches across the faces into the last layer, an even number (those two
-/// parts of two colours), and a multiple of four beyond four (two workers then share a
-/// colour's parts evenly). A function of the grid only, never of the threads.
-pub(crate) fn parts_at_layers(count: usize, layers: usize, periodic: bool) -> usize {
-    let count = count.min(layers).max(1);
-    match (periodic, count) {
-        (false, _) | (true, 0..=1) => count,
-        (true, 2..=7) => count - count % 2,
-        (true, _) => count - count % 4,
-    }
-}
-
 /// The first sorted index of layer `z` of `bins` (`n` past the last layer).
 pub(crate) fn layer_start<T, const D: usize>(bins: &Bins<T, D>, z: usize) -> usize {
     let g = &bins.grid;

@@ -1,4 +1,4 @@
-//! The periodic box of a Verlet list: which image of its partner each entry meets, and the
+//! The periodic box of a neighbour list: which image of its partner each entry meets, and the
 //! positions the force loop reads.
 //!
 //! The search finds a pair through a bin on the far side of a face and records, with the
@@ -80,6 +80,16 @@ impl<T: Real, const D: usize> Images<T, D> {
             }
         }
         s
+    }
+
+    /// The shift of the code `code`.
+    #[inline(always)]
+    pub fn shift_of(&self, code: u8) -> [T; D] {
+        std::array::from_fn(|d| match (code >> (2 * d)) & 3 {
+            0 => -self.side[d],
+            2 => self.side[d],
+            _ => T::zero(),
+        })
     }
 
     /// `x` (on axis `d`) moved by whole sides into the box: itself when inside.
@@ -195,6 +205,8 @@ mod tests {
         assert_eq!((s[0][0], s[1][0], s[2][0]), (0.0, 0.0, 0.0));
         assert_eq!((s[0][1], s[1][1], s[2][1]), (-10.0, 0.0, 40.0));
         assert_eq!(images.shift64([-1, 0, 1]), [-10.0, 0.0, 40.0]);
+        assert_eq!(images.shift_of(code), [-10.0, 0.0, 40.0]);
+        assert_eq!(images.shift_of(no_shift::<3>()), [0.0; 3]);
         assert!(crosses_slowest_axis::<3>(code));
         assert!(!crosses_slowest_axis::<3>(code_of([1, -1, 0])));
         assert!(crosses_slowest_axis::<2>(code_of([0, -1])));
