@@ -17,9 +17,16 @@ use rayon::prelude::*;
 
 /// Particles per cluster.
 pub(crate) const CLUSTER: usize = 4;
-/// Clusters whose particles fill the `LANES` of a block: a run of the list.
-pub(crate) const GROUP: usize = LANES / CLUSTER;
-const _: () = assert!(GROUP * CLUSTER == LANES);
+/// Clusters of a run of the list in `D` dimensions, whose particles are the lanes of one block
+/// of the force loop: four (`LANES`) in the plane; in space, where a column's window of
+/// clusters within reach is short (about five), two, which leave fewer lanes idle past the
+/// window's end.
+pub(crate) const fn group_of(d: usize) -> usize {
+    if d >= 3 { 2 } else { LANES / CLUSTER }
+}
+/// The most clusters of a run: the empty clusters after the last are one fewer.
+pub(crate) const MAX_GROUP: usize = LANES / CLUSTER;
+const _: () = assert!(MAX_GROUP * CLUSTER == LANES && group_of(3) <= MAX_GROUP);
 
 /// The region the columns tile: the particles' bounding box, or a periodic box, whose sides
 /// the columns then divide exactly.
@@ -255,8 +262,8 @@ impl<T: Real, const D: usize> Layout<T, D> {
             clusters += ((self.start[c + 1] - self.start[c]) as usize).div_ceil(CLUSTER);
         }
         self.column_start.push(clusters as u32);
-        self.slot_of.resize((clusters + GROUP - 1) * CLUSTER, 0);
-        self.count.resize(clusters + GROUP - 1, 0);
+        self.slot_of.resize((clusters + MAX_GROUP - 1) * CLUSTER, 0);
+        self.count.resize(clusters + MAX_GROUP - 1, 0);
         self.padded_of.resize(n, 0);
         // Each column's clusters, as their own slices, filled on the pool's threads.
         let mut pieces = Vec::with_capacity(columns);

@@ -1,4 +1,4 @@
-//! The cluster-pair list: for each i-cluster, runs of `GROUP` consecutive clusters that cover
+//! The cluster-pair list: for each i-cluster, runs of consecutive clusters (`group_of(D)`) that cover
 //! every j-cluster at or after it whose box comes within the list radius of its own. The
 //! clusters of a column are sorted along the last axis, so in each column the j-clusters within
 //! reach are consecutive: the window of the column is found by two binary searches on the
@@ -13,7 +13,7 @@
 //! lower cluster; between a cluster and its own images, for the shifts of code above the
 //! unshifted one only.
 
-use super::layout::{CLUSTER, GROUP, Layout};
+use super::layout::{CLUSTER, Layout, group_of};
 use crate::kernels::images::{Images, code_of, no_shift};
 use crate::real::Real;
 use std::ops::Range;
@@ -24,7 +24,7 @@ use std::ops::Range;
 pub(crate) struct Part {
     pub clusters: Range<usize>,
     /// i-cluster `clusters.start + k` has the runs `first[k]..first[k + 1]`: run `r` is the
-    /// clusters `start[r]..start[r] + GROUP`, met through the image of code `shift[r]`.
+    /// clusters `start[r]..start[r] + group_of(D)`, met through the image of code `shift[r]`.
     pub first: Vec<u32>,
     pub start: Vec<u32>,
     pub shift: Vec<u8>,
@@ -48,15 +48,16 @@ impl Part {
 /// The lanes of a run from cluster `j0` that act for particle `a` of i-cluster `c` (with
 /// `count[c]` particles): clusters below `end`, their real particles, and where the run holds
 /// the i-cluster itself unshifted (`diagonal`), only the particles after `a`.
-pub(crate) fn run_masks(
+pub(crate) fn run_masks<const D: usize>(
     count: &[u8],
     c: usize,
     j0: usize,
     end: usize,
     diagonal: bool,
 ) -> [u16; CLUSTER] {
+    let group = group_of(D);
     let mut valid = 0u16;
-    for q in 0..GROUP {
+    for q in 0..group {
         let j = j0 + q;
         if j < end {
             valid |= ((1u16 << count[j]) - 1) << (CLUSTER * q);
@@ -66,7 +67,7 @@ pub(crate) fn run_masks(
         if a >= count[c] as usize {
             return 0;
         }
-        if diagonal && (j0..j0 + GROUP).contains(&c) {
+        if diagonal && (j0..j0 + group).contains(&c) {
             // In the i-cluster's own lanes, particles `b <= a` do not act.
             let upto_a = (2u16 << a) - 1;
             valid & !(upto_a << (CLUSTER * (c - j0)))
@@ -139,25 +140,45 @@ pub fn build<T: Real, const D: usize>(
             part.start.push(j0 as u32);
             part.shift.push(code);
             part.masks
-                .push(run_masks(&layout.count, c, j0, end, diagonal));
+                .push(run_masks::<D>(&layout.count, c, j0, end, diagonal));
             if far {
                 part.far.start = part.far.start.min(j0);
-                part.far.end = part.far.end.max(j0 + GROUP);
+                part.far.end = part.far.end.max(j0 + group_of(D));
             } else {
-                part.end = part.end.max(j0 + GROUP);
+                part.end = part.end.max(j0 + group_of(D));
             }
-            j0 += GROUP;
+            j0 += group_of(D);
         }
     };
     // The column of the first i-cluster, then stepped along with it.
     let mut own = starts.partition_point(|&s| s as usize <= clusters.start) - 1;
     // Per column and image searched from the current column: its window for the last
-    // i-cluster.
-    let mut cursors: Vec<(usize, u8, usize, usize)> = Vec::new();
+    // i-cluster, at the column's offset from the current one (within `around` columns along
+    // each axis) and shift along the last axis.
+    let around = (0..last)
+        .map(|d| (radius / layout.width[d]).ceil() as i64 + 2)
+        .max()
+        .unwrap_or(0);
+    let across = (2 * around + 1) as usize;
+    let unset = (usize::MAX, usize::MAX);
+    let mut cursors = vec![unset; across * across * along_last.len()];
+    let stride = layout.columns[0];
+    let cursor_of = |own: usize, k: [(usize, i8); 2], w_last: usize| {
+        let offset = |d: usize| {
+            let n = layout.columns[d.min(last)] as i64;
+            let at = (own / [1, stride][d] % n as usize) as i64;
+            (k[d].0 as i64 + i64::from(k[d].1) * n - at + around) as usize
+        };
+        let (o0, o1) = (
+            offset(0),
+            if last > 1 { offset(1) } else { around as usize },
+        );
+        (o0 < across && o1 < across).then(|| (o1 * across + o0) * along_last.len() + w_last)
+    };
     for c in clusters {
         while starts[own + 1] as usize <= c {
             own += 1;
-            cursors.clear();
+            cursors.fill(unset);
         }
         let lo_i: [f64; D] = std::array::from_fn(|d| lo[d][c]);
         let hi_i: [f64; D] = std::array::from_fn(|d| hi[d][c]);
@@ -169,7 +190,6 @@ pub fn build<T: Real, const D: usize>(
             };
             axis_columns(layout, images.is_some(), d, a, b)
         };
-        let stride = layout.columns[0];
         for (k1, w1) in span(1) {
             for (k0, w0) in span(0) {
                 let column = k1 * stride + k0;
@@ -193,7 +213,7 @@ pub fn build<T: Real, const D: usize>(
                 let (s, e) = (starts[column] as usize, starts[column + 1] as usize);
                 // Crossing the faces of the slowest column axis reaches the far layers.
                 let far = D >= 2 && wraps[D.saturating_sub(2).min(1)] != 0;
-                for &w_last in along_last {
+                for (z, &w_last) in along_last.iter().enumerate() {
                     let wrap: [i8; D] = std::array::from_fn(|d| match d {
                         d if d == last => w_last,
                         d => wraps[d],
@@ -204,10 +224,10 @@ pub fn build<T: Real, const D: usize>(
                     // The window of the last i-cluster of this column in `column`, moved to
                     // this one's: the i-clusters of a column come in order along the last
                     // axis, so the windows move a few clusters at a time.
-                    let at = cursors.iter().position(|w| (w.0, w.1) == (column, code));
-                    let (mut from, mut end) = match at {
-                        Some(k) => (cursors[k].2, cursors[k].3),
-                        None => {
+                    let at = cursor_of(own, [(k0, w0), (k1, w1)], z);
+                    let (mut from, mut end) = match at.map(|k| cursors[k]) {
+                        Some(w) if w != unset => w,
+                        _ => {
                             let from = s + hi[last][s..e].partition_point(|&h| h < below);
                             (from, from)
                         }
@@ -225,9 +245,8 @@ pub fn build<T: Real, const D: usize>(
                     while end < e && lo[last][end] <= above {
                         end += 1;
                     }
-                    match at {
-                        Some(k) => cursors[k] = (column, code, from, end),
-                        None => cursors.push((column, code, from, end)),
+                    if let Some(k) = at {
+                        cursors[k] = (from, end);
                     }
                     if column == own {
                         // The i-cluster meets itself unshifted (each pair once, by the
@@ -263,7 +282,7 @@ mod tests {
         // Clusters 0..6 with 4, 4, 3, 4, 1, 4 particles.
         let count = [4, 4, 3, 4, 1, 4];
         // i-cluster 0 with itself and the next three: the diagonal keeps b > a.
-        let m = run_masks(&count, 0, 0, 4, true);
+        let m = run_masks::<2>(&count, 0, 0, 4, true);
         for a in 0..CLUSTER {
             for l in 0..LANES {
                 let (j, b) = (l / CLUSTER, l % CLUSTER);
@@ -272,14 +291,14 @@ mod tests {
             }
         }
         // A window ending at cluster 2: clusters 2.. do not act.
-        let m = run_masks(&count, 4, 1, 2, true);
+        let m = run_masks::<2>(&count, 4, 1, 2, true);
         assert_eq!(
             m[0], 0b1111,
             "only cluster 1 acts, for particle 0 of cluster 4"
         );
         assert_eq!(m[1], 0, "cluster 4 has one particle");
         // Padding of cluster 2 (3 particles) does not act.
-        let m = run_masks(&count, 5, 2, 6, true);
+        let m = run_masks::<2>(&count, 5, 2, 6, true);
         assert_eq!(m[0] & 0b1111, 0b0111);
     }
 }

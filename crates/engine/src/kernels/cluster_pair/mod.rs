@@ -50,15 +50,14 @@ use crate::par::team::SharedSlice;
 use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
-use crate::simd::LANES;
 use crate::state::{Field, State};
 use layout::Layout;
-use layout::{CLUSTER, Region};
+use layout::{CLUSTER, Region, group_of};
 use list::Part;
 use plan::{Plan, add_part};
 use rayon::prelude::*;
 use std::time::Instant;
-use tile::{Clusters, Out, TileSum, part_forces};
+use tile::{Clusters, Out, TileSum, run_forces};
 
 /// Relative margin of the list radius (as the `verlet` list's): boxes are compared in f64 at
 /// the build and pairs rounded in `T` at every step.
@@ -70,9 +69,11 @@ const LIST_MARGIN: f64 = 1e-5;
 const PARTS: usize = 16;
 const MIN_PART_CLUSTERS: usize = 128;
 
-/// Cost of one run (`CLUSTER × LANES` pair evaluations and the reactions) in naive pair
-/// evaluations, the unit of `worth_parallel`.
-const RUN_COST: u64 = (CLUSTER * LANES) as u64;
+/// Cost of one run (`CLUSTER` times its lanes of pair evaluations and the reactions) in `D`
+/// dimensions, in naive pair evaluations, the unit of `worth_parallel`.
+const fn run_cost(d: usize) -> u64 {
+    (CLUSTER * CLUSTER * group_of(d)) as u64
+}
 
 /// The positions of a build: the state's, or in a periodic box wrapped into it (written to
 /// `into`).
@@ -222,7 +223,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         } else {
             4 * m as u64
         };
-        let work = runs * RUN_COST + state.len() as u64;
+        let work = runs * run_cost(D) + state.len() as u64;
         // Never a function of the threads: the parts fix the order in which forces are added.
         let mut count = if work >= MIN_PARALLEL_PAIRS {
             (m / MIN_PART_CLUSTERS).clamp(1, PARTS)
@@ -295,11 +296,11 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
             // Probe steps are not timed: their loop is compiled once, for the baseline
             // instruction set, rather than once per set (less to compile).
             let s = if PROBE {
-                part_forces::<T, L, D, true>(law, &clusters, part, images, &mut out)
+                run_forces::<T, L, D, true>(law, &clusters, part, images, &mut out)
             } else {
                 simd::dispatch(
                     #[inline(always)]
-                    || part_forces::<T, L, D, false>(law, &clusters, part, images, &mut out),
+                    || run_forces::<T, L, D, false>(law, &clusters, part, images, &mut out),
                 )
             };
             sum.energy += s.energy;
@@ -372,7 +373,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
             energy: probe.then_some(sum.energy),
             build_s,
             work: WorkCounters {
-                pair_checks: runs * RUN_COST + compared.unwrap_or(0),
+                pair_checks: runs * run_cost(D) + compared.unwrap_or(0),
                 pairs_interacting: sum.interacting,
                 rebuilds: u64::from(compared.is_some()),
                 list_entries: runs,
@@ -430,7 +431,8 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for ClusterPair<L
     fn set_periodic(&mut self, lo: [T; D], hi: [T; D]) -> Result<(), KernelError> {
         let images = Images::new(lo, hi);
         let least = 2.0 * self.radius;
-        if let Some(d) = (0..D).find(|&d| images.side64()[d] < least || images.side64()[d].is_nan()) {
+        if let Some(d) = (0..D).find(|&d| images.side64()[d] < least || images.side64()[d].is_nan())
+        {
             return Err(KernelError::PeriodicBoxTooSmall(format!(
                 "cluster-pair in a periodic box needs a side of at least twice the cutoff plus \
                  the skin ({least:.6}); side {d} is {:.6}: use more particles, a smaller skin, \

@@ -1,10 +1,10 @@
 //! The cluster list's step in a team region, and a part's forces added into shared padded
 //! slots (the step's and the rayon pool's).
 
-use super::RUN_COST;
 use super::layout::CLUSTER;
 use super::list::Part;
-use super::tile::{Clusters, Out, part_forces};
+use super::run_cost;
+use super::tile::{Clusters, Out, run_forces};
 use crate::kernels::WorkCounters;
 use crate::kernels::images::Images;
 use crate::kernels::teamed::{Colors, StateView, TeamPlan};
@@ -44,7 +44,7 @@ pub(super) unsafe fn add_part<T: Real, L: PairLaw<T>, const D: usize>(
     };
     simd::dispatch(
         #[inline(always)]
-        || part_forces::<T, L, D, false>(law, clusters, part, images, &mut out),
+        || run_forces::<T, L, D, false>(law, clusters, part, images, &mut out),
     );
 }
 
@@ -165,7 +165,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D
 
     fn work(&self) -> WorkCounters {
         WorkCounters {
-            pair_checks: self.runs * RUN_COST,
+            pair_checks: self.runs * run_cost(D),
             list_entries: self.runs,
             ..Default::default()
         }

@@ -1,5 +1,5 @@
-//! The force loop: each i-cluster against runs of `GROUP` consecutive clusters, whose
-//! `LANES` particles are one contiguous block of every array (no gather). Each particle of the
+//! The force loop: each i-cluster against runs of consecutive clusters (`group_of(D)`), whose
+//! particles (the `R` lanes of a block) are one contiguous block of every array (no gather). Each particle of the
 //! i-cluster, broadcast, meets the whole run in one block; its force stays in registers across
 //! the i-cluster's list, and the reactions of the four i-particles add up lane by lane into
 //! one contiguous update of the run. Lanes that must not act (outside the run's window,
@@ -7,10 +7,9 @@
 //! are zeroed with a select, never a branch. In a periodic box a run met through an image
 //! shifts the i-cluster instead: `CLUSTER · D` subtractions per run, none per pair.
 
-use super::layout::{CLUSTER, Layout};
+use super::layout::{CLUSTER, Layout, group_of};
 use super::list::Part;
 use crate::kernels::images::{Images, no_shift};
-use crate::kernels::rows::lane_sum;
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
 use crate::simd::LANES;
@@ -59,23 +58,42 @@ impl<'a, T, const D: usize> Out<'a, T, D> {
         }
     }
 
-    /// The `LANES` forces along axis `d` of the run from padded slot `js`.
+    /// The `R` forces along axis `d` of the run from padded slot `js`.
     #[inline(always)]
-    fn run(&mut self, d: usize, js: usize) -> &mut [T; LANES] {
+    fn run<const R: usize>(&mut self, d: usize, js: usize) -> &mut [T; R] {
         let (out, at) = match js >= self.far_base {
             true => (&mut self.far[d], js - self.far_base),
             false => (&mut self.near[d], js - self.near_base),
         };
-        (&mut out[at..at + LANES])
-            .try_into()
-            .expect("runs are whole")
+        (&mut out[at..at + R]).try_into().expect("runs are whole")
+    }
+}
+
+/// [`part_forces`] with the runs of `D` dimensions.
+#[inline(always)]
+pub(crate) fn run_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+    law: &L,
+    clusters: &Clusters<'_, T, D>,
+    part: &Part,
+    images: Option<&Images<T, D>>,
+    out: &mut Out<'_, T, D>,
+) -> TileSum {
+    match group_of(D) * CLUSTER {
+        8 => part_forces::<T, L, D, PROBE, 8>(law, clusters, part, images, out),
+        _ => part_forces::<T, L, D, PROBE, LANES>(law, clusters, part, images, out),
     }
 }
 
 /// Adds the forces of the runs of `part` to `out`, each run through its image of `images` in
 /// a periodic box: both ends of every pair, each pair once.
 #[inline(always)]
-pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bool>(
+pub(crate) fn part_forces<
+    T: Real,
+    L: PairLaw<T>,
+    const D: usize,
+    const PROBE: bool,
+    const R: usize,
+>(
     law: &L,
     clusters: &Clusters<'_, T, D>,
     part: &Part,
@@ -84,8 +102,8 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
 ) -> TileSum {
     let (pos, src) = (&clusters.pos, clusters.src);
     let unshifted = no_shift::<D>();
-    let mut energy = [T::zero(); LANES];
-    let mut interacting = [0u32; LANES];
+    let mut energy = [T::zero(); R];
+    let mut interacting = [0u32; R];
     for (k, c) in part.clusters.clone().enumerate() {
         let ic = c * CLUSTER;
         let xi: [[T; CLUSTER]; D] = std::array::from_fn(|d| {
@@ -96,13 +114,13 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
         let si: &[T; CLUSTER] = src[ic..ic + CLUSTER]
             .try_into()
             .expect("clusters are whole");
-        let mut fi = [[[T::zero(); LANES]; D]; CLUSTER];
+        let mut fi = [[[T::zero(); R]; D]; CLUSTER];
         for r in part.first[k] as usize..part.first[k + 1] as usize {
             let js = part.start[r] as usize * CLUSTER;
             let masks = &part.masks[r];
-            let xj: [&[T; LANES]; D] =
-                std::array::from_fn(|d| pos[d][js..js + LANES].try_into().expect("runs are whole"));
-            let sj: &[T; LANES] = src[js..js + LANES].try_into().expect("runs are whole");
+            let xj: [&[T; R]; D] =
+                std::array::from_fn(|d| pos[d][js..js + R].try_into().expect("runs are whole"));
+            let sj: &[T; R] = src[js..js + R].try_into().expect("runs are whole");
             // The i-cluster moved by minus the run's shift: each pair's difference is then
             // the partner's image's.
             let xs: [[T; CLUSTER]; D] = match images {
@@ -112,30 +130,30 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
                 }
                 _ => xi,
             };
-            let mut fj = [[T::zero(); LANES]; D];
+            let mut fj = [[T::zero(); R]; D];
             for a in 0..CLUSTER {
-                let mut dx = [[T::zero(); LANES]; D];
-                let mut r2 = [T::zero(); LANES];
+                let mut dx = [[T::zero(); R]; D];
+                let mut r2 = [T::zero(); R];
                 for d in 0..D {
-                    for l in 0..LANES {
+                    for l in 0..R {
                         dx[d][l] = xj[d][l] - xs[d][a];
                         r2[l] += dx[d][l] * dx[d][l];
                     }
                 }
-                let mut coeff = [T::zero(); LANES];
-                for l in 0..LANES {
+                let mut coeff = [T::zero(); R];
+                for l in 0..R {
                     let keep = (masks[a] >> l) & 1 != 0;
                     coeff[l] = select(keep, law.coeff(r2[l], si[a], sj[l]), T::zero());
                 }
                 for d in 0..D {
-                    for l in 0..LANES {
+                    for l in 0..R {
                         let f = coeff[l] * dx[d][l];
                         fi[a][d][l] += f;
                         fj[d][l] += f;
                     }
                 }
                 if PROBE {
-                    for l in 0..LANES {
+                    for l in 0..R {
                         let keep = (masks[a] >> l) & 1 != 0;
                         energy[l] += select(keep, law.energy(r2[l], si[a], sj[l]), T::zero());
                         interacting[l] += u32::from(keep && law.interacts(r2[l]));
@@ -143,8 +161,8 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
                 }
             }
             for d in 0..D {
-                let dst = out.run(d, js);
-                for l in 0..LANES {
+                let dst = out.run::<R>(d, js);
+                for l in 0..R {
                     dst[l] -= fj[d][l];
                 }
             }
@@ -159,4 +177,17 @@ pub(crate) fn part_forces<T: Real, L: PairLaw<T>, const D: usize, const PROBE: b
         energy: energy.iter().map(|e| e.as_f64()).sum(),
         interacting: interacting.iter().map(|&c| c as u64).sum(),
     }
+}
+
+/// The sum of a run's lanes, pairwise.
+#[inline(always)]
+fn lane_sum<T: Real, const R: usize>(mut v: [T; R]) -> T {
+    let mut width = R / 2;
+    while width > 0 {
+        for l in 0..width {
+            v[l] += v[l + width];
+        }
+        width /= 2;
+    }
+    v[0]
 }
