@@ -82,13 +82,14 @@ pub(crate) fn cut_at_layers<const D: usize>(periodic: bool) -> bool {
 
 /// `count` parts cut at the `layers` layers of a grid: at most one per layer; in a periodic box,
 /// whose first part reaches across the faces into the last layer, an even number (those two
-/// parts of two colours), and a multiple of four beyond four (two workers then share a
-/// colour's parts evenly). A function of the grid only, never of the threads.
+/// parts of two colours), and a multiple of four from four on (two workers then share each
+/// colour's parts evenly: six parts would leave one worker a part idle per colour). A
+/// function of the grid only, never of the threads.
 pub(crate) fn parts_at_layers(count: usize, layers: usize, periodic: bool) -> usize {
     let count = count.min(layers).max(1);
     match (periodic, count) {
         (false, _) | (true, 0..=1) => count,
-        (true, 2..=7) => count - count % 2,
+        (true, 2..=3) => 2,
         (true, _) => count - count % 4,
     }
 }
@@ -175,6 +176,15 @@ mod tests {
         // Empty parts touch nothing.
         let c = Colors::of([0..10, 5..5, 10..20, 15..15].into_iter());
         assert!(c.disjoint());
+    }
+
+    #[test]
+    fn periodic_parts_come_in_pairs_and_then_in_fours() {
+        let periodic = |count| parts_at_layers(count, 40, true);
+        let counts: Vec<usize> = (1..=9).map(periodic).collect();
+        assert_eq!(counts, [1, 2, 2, 4, 4, 4, 4, 8, 8]);
+        assert_eq!(parts_at_layers(16, 12, true), 12, "at most one per layer");
+        assert_eq!(parts_at_layers(6, 40, false), 6, "an open box takes the count");
     }
 
     #[test]
