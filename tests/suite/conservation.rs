@@ -10,9 +10,21 @@ use nbody_engine::scenario::{Precision, ScenarioKind, Setup, System, SystemInfo}
 use nbody_engine::state::State;
 
 fn drift(scenario: ScenarioKind, kernel: KernelKind, n: usize, steps: u64, dt: Option<f64>) -> f64 {
+    drift_in(scenario, kernel, n, steps, dt, None)
+}
+
+fn drift_in(
+    scenario: ScenarioKind,
+    kernel: KernelKind,
+    n: usize,
+    steps: u64,
+    dt: Option<f64>,
+    precision: Option<Precision>,
+) -> f64 {
     let mut setup = Setup::new(scenario);
     setup.n = Some(n);
     setup.dt = dt;
+    setup.precision = precision;
     let spec = RunSpec {
         kernel,
         params: KernelParams::default(),
@@ -99,6 +111,44 @@ fn energy_drift_is_bounded_for_every_scenario() {
         assert!(
             d.abs() < bound,
             "{scenario:?}/{kernel:?}: relative drift {d:e} exceeds {bound:e}"
+        );
+    }
+}
+
+/// The largest relative energy drift of LAMMPS's runs of `n` melt atoms in the committed
+/// energy study (configs/melt-energy.toml: 1000 steps of its own, on the state we export).
+fn lammps_melt_drift(n: usize) -> f64 {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/results/melt-energy/results.json");
+    let text = std::fs::read_to_string(path).expect("the committed melt energy study");
+    let results: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let drifts: Vec<f64> = results["cases"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["case"]["kernel"] == "lammps" && c["n"] == n)
+        .flat_map(|c| c["rounds"].as_array().unwrap())
+        .map(|r| r["energy_drift"].as_f64().expect("LAMMPS printed its energy twice"))
+        .collect();
+    assert!(!drifts.is_empty(), "no LAMMPS run of {n} atoms in {path}");
+    drifts.iter().fold(0.0, |m: f64, d| m.max(d.abs()))
+}
+
+#[test]
+fn the_melt_conserves_energy_within_lammps_drift_on_the_same_state() {
+    // 1000 steps of in.lj's time step from the 4000 atoms LAMMPS ran, in f64 as it computes.
+    let bound = lammps_melt_drift(4000);
+    for kernel in [KernelKind::Verlet, KernelKind::ClusterPair] {
+        let d = drift_in(
+            ScenarioKind::LjMelt,
+            kernel,
+            4000,
+            1000,
+            None,
+            Some(Precision::F64),
+        );
+        assert!(
+            d.abs() <= bound,
+            "{kernel:?}: relative drift {d:e} over 1000 steps, LAMMPS's {bound:e}"
         );
     }
 }
