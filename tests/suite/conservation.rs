@@ -118,7 +118,10 @@ fn energy_drift_is_bounded_for_every_scenario() {
 /// The largest relative energy drift of LAMMPS's runs of `n` melt atoms in the committed
 /// energy study (configs/melt-energy.toml: 1000 steps of its own, on the state we export).
 fn lammps_melt_drift(n: usize) -> f64 {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/results/melt-energy/results.json");
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/results/melt-energy/results.json"
+    );
     let text = std::fs::read_to_string(path).expect("the committed melt energy study");
     let results: serde_json::Value = serde_json::from_str(&text).unwrap();
     let drifts: Vec<f64> = results["cases"]
@@ -127,7 +130,11 @@ fn lammps_melt_drift(n: usize) -> f64 {
         .iter()
         .filter(|c| c["case"]["kernel"] == "lammps" && c["n"] == n)
         .flat_map(|c| c["rounds"].as_array().unwrap())
-        .map(|r| r["energy_drift"].as_f64().expect("LAMMPS printed its energy twice"))
+        .map(|r| {
+            r["energy_drift"]
+                .as_f64()
+                .expect("LAMMPS printed its energy twice")
+        })
         .collect();
     assert!(!drifts.is_empty(), "no LAMMPS run of {n} atoms in {path}");
     drifts.iter().fold(0.0, |m: f64, d| m.max(d.abs()))

@@ -184,7 +184,11 @@ mod tests {
         let counts: Vec<usize> = (1..=9).map(periodic).collect();
         assert_eq!(counts, [1, 2, 2, 4, 4, 4, 4, 8, 8]);
         assert_eq!(parts_at_layers(16, 12, true), 12, "at most one per layer");
-        assert_eq!(parts_at_layers(6, 40, false), 6, "an open box takes the count");
+        assert_eq!(
+            parts_at_layers(6, 40, false),
+            6,
+            "an open box takes the count"
+        );
     }
 
     #[test]

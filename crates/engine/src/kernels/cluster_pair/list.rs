@@ -255,6 +255,25 @@ pub fn build<T: Real, const D: usize>(
                         from = from.max(first);
                         end = end.max(from);
                     }
+                    // The window's ends whose own boxes lie beyond the radius: the column's
+                    // extent bounded them only along the other axes, and loosely.
+                    let offset: [f64; D] = std::array::from_fn(|d| f64::from(wrap[d]) * side[d]);
+                    let beyond = |j: usize| {
+                        let mut g2 = 0.0;
+                        for d in 0..D {
+                            let g = (lo[d][j] + offset[d] - hi_i[d])
+                                .max(lo_i[d] - hi[d][j] - offset[d])
+                                .max(0.0);
+                            g2 += g * g;
+                        }
+                        g2 > radius2
+                    };
+                    while from < end && beyond(from) {
+                        from += 1;
+                    }
+                    while end > from && beyond(end - 1) {
+                        end -= 1;
+                    }
                     searched += 1;
                     emit(c, from, end, code, far, part);
                 }
