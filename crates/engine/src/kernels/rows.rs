@@ -102,10 +102,11 @@ impl Exclude {
     }
 }
 
-/// Sum of the lanes, as a tree (four dependent additions, not sixteen).
+/// Sum of the lanes, as a tree (four dependent additions for sixteen lanes, not sixteen);
+/// `N` a power of two.
 #[inline(always)]
-pub(crate) fn lane_sum<T: Real>(mut v: [T; LANES]) -> T {
-    let mut width = LANES / 2;
+pub(crate) fn lane_sum<T: Real, const N: usize>(mut v: [T; N]) -> T {
+    let mut width = N / 2;
     while width > 0 {
         for l in 0..width {
             v[l] += v[l + width];

@@ -106,3 +106,48 @@ pub(crate) fn shove<const D: usize>(state: &mut State<f64, D>, side: [f64; D], s
     }
     wrapped
 }
+
+/// Two atoms a pair at exactly the cutoff, then just inside it, through the corner image of a
+/// cube of side 9 (along the box's diagonal), forces of the kernel `make` builds for that box
+/// against the reference: none at the cutoff, equal and opposite inside it.
+pub(crate) fn a_pair_through_the_corner_meets_inside_the_cutoff_only(
+    make: impl Fn([f64; 3]) -> Box<dyn ForceKernel<f64, 3>>,
+) {
+    for (gap, meets) in [(RC, false), (RC - 0.1, true)] {
+        let side = [9.0; 3];
+        let mut state = State::<f64, 3>::new(2);
+        let h = gap / 3f64.sqrt();
+        for d in 0..3 {
+            state.pos[d][0] = 0.25 * h;
+            state.pos[d][1] = 9.0 - 0.75 * h;
+        }
+        let f = agrees(make(side).as_mut(), &state, side, 1e-12);
+        assert_eq!(f[0][0] != 0.0, meets, "gap {gap}");
+        assert_eq!(f[0][0], -f[0][1]);
+    }
+}
+
+/// A melt whose atoms all move up to a third of the skin after the build, those leaving the
+/// box wrapped as the integrator does: the kernel `make` builds keeps its list (a wrap is not
+/// a move) and meets every partner through the right image.
+pub(crate) fn slots_wrapped_after_the_build_keep_the_list_and_their_images(
+    make: impl Fn([f64; 3]) -> Box<dyn ForceKernel<f64, 3>>,
+) {
+    let (mut state, side) = melt(6, 0.2);
+    let mut k = make(side);
+    agrees(k.as_mut(), &state, side, 1e-10);
+    let wrapped = shove(&mut state, side, SKIN / 3.0);
+    assert!(wrapped > 10, "{wrapped} coordinates wrapped");
+    let (want, _, abs_sum) = periodic_reference_forces(&law::<f64>(), &state, side).unwrap();
+    let mut f = zero_field::<f64, 3>(state.len());
+    let report = k.compute(&state, &mut f, false);
+    assert_eq!(report.work.rebuilds, 0, "a wrap is not a move");
+    for i in 0..state.len() {
+        for d in 0..3 {
+            assert!(
+                (f[d][i] - want[d][i]).abs() <= 1e-10 * abs_sum[i],
+                "particle {i}"
+            );
+        }
+    }
+}

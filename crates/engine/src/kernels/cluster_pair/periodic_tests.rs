@@ -8,8 +8,10 @@ use super::*;
 use crate::physics::LennardJones;
 use crate::state::zero_field;
 use crate::testing::on_threads;
-use crate::testing::periodic::{RC, SKIN, agrees, law, melt, narrowed, shove, square};
-use crate::validate::periodic::periodic_reference_forces;
+use crate::testing::periodic::{
+    SKIN, a_pair_through_the_corner_meets_inside_the_cutoff_only, agrees, law, melt, narrowed,
+    slots_wrapped_after_the_build_keep_the_list_and_their_images, square,
+};
 
 fn kernel<T: Real, const D: usize>(side: [f64; D]) -> ClusterPair<LennardJones<T>, T, D> {
     let mut k = ClusterPair::new(law::<T>(), SKIN).unwrap();
@@ -53,18 +55,7 @@ fn a_box_twice_the_list_radius_wide_counts_each_image_once() {
 
 #[test]
 fn a_pair_at_exactly_the_cutoff_through_a_corner_does_not_interact() {
-    for (gap, meets) in [(RC, false), (RC - 0.1, true)] {
-        let side = [9.0; 3];
-        let mut state = State::<f64, 3>::new(2);
-        let h = gap / 3f64.sqrt();
-        for d in 0..3 {
-            state.pos[d][0] = 0.25 * h;
-            state.pos[d][1] = 9.0 - 0.75 * h;
-        }
-        let f = agrees(&mut kernel::<f64, 3>(side), &state, side, 1e-12);
-        assert_eq!(f[0][0] != 0.0, meets, "gap {gap}");
-        assert_eq!(f[0][0], -f[0][1]);
-    }
+    a_pair_through_the_corner_meets_inside_the_cutoff_only(|side| Box::new(kernel::<f64, 3>(side)));
 }
 
 #[test]
@@ -102,23 +93,9 @@ fn the_forces_are_the_same_bits_at_one_two_and_three_threads() {
 
 #[test]
 fn a_slot_wrapped_across_a_face_keeps_the_list_and_meets_the_right_image() {
-    let (mut state, side) = melt(6, 0.2);
-    let mut k = kernel::<f64, 3>(side);
-    agrees(&mut k, &state, side, 1e-10);
-    let wrapped = shove(&mut state, side, SKIN / 3.0);
-    assert!(wrapped > 10, "{wrapped} coordinates wrapped");
-    let (want, _, abs_sum) = periodic_reference_forces(&law::<f64>(), &state, side).unwrap();
-    let mut f = zero_field::<f64, 3>(state.len());
-    let report = k.compute(&state, &mut f, false);
-    assert_eq!(report.work.rebuilds, 0, "a wrap is not a move");
-    for i in 0..state.len() {
-        for d in 0..3 {
-            assert!(
-                (f[d][i] - want[d][i]).abs() <= 1e-10 * abs_sum[i],
-                "particle {i}"
-            );
-        }
-    }
+    slots_wrapped_after_the_build_keep_the_list_and_their_images(|side| {
+        Box::new(kernel::<f64, 3>(side))
+    });
 }
 
 #[test]

@@ -8,7 +8,7 @@ use super::tile::{Clusters, Out, run_forces};
 use crate::kernels::WorkCounters;
 use crate::kernels::images::Images;
 use crate::kernels::teamed::{Colors, StateView, TeamPlan};
-use crate::kernels::verlet::block_kept;
+use crate::kernels::verlet::block_kept_in;
 use crate::par::team::{SharedSlice, Worker, shared};
 use crate::physics::PairLaw;
 use crate::real::Real;
@@ -69,13 +69,7 @@ pub(super) struct Plan<'k, L, T, const D: usize> {
 
 impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
     fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
-        match self.images {
-            Some(images) => simd::dispatch(
-                #[inline(always)]
-                || images.block_kept(pos, self.at_build, block.clone(), self.skin, None),
-            ),
-            None => block_kept(pos, self.at_build, block, self.skin),
-        }
+        block_kept_in(self.images, pos, self.at_build, block, self.skin)
     }
 
     fn colors(&self) -> &Colors {

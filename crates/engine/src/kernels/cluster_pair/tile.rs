@@ -10,6 +10,7 @@
 use super::layout::{CLUSTER, Layout, group_of};
 use super::list::Part;
 use crate::kernels::images::{Images, no_shift};
+use crate::kernels::rows::lane_sum;
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
 use crate::simd::LANES;
@@ -177,17 +178,4 @@ pub(crate) fn part_forces<
         energy: energy.iter().map(|e| e.as_f64()).sum(),
         interacting: interacting.iter().map(|&c| c as u64).sum(),
     }
-}
-
-/// The sum of a run's lanes, pairwise.
-#[inline(always)]
-fn lane_sum<T: Real, const R: usize>(mut v: [T; R]) -> T {
-    let mut width = R / 2;
-    while width > 0 {
-        for l in 0..width {
-            v[l] += v[l + width];
-        }
-        width /= 2;
-    }
-    v[0]
 }

@@ -357,16 +357,8 @@ struct Plan<'k, L, T, const D: usize> {
 
 impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D> {
     fn keeps(&self, pos: [&[T]; D], block: Range<usize>) -> bool {
-        match &self.periodic {
-            Some(p) => simd::dispatch(
-                #[inline(always)]
-                || {
-                    p.images
-                        .block_kept(pos, self.at_build, block.clone(), self.skin, None)
-                },
-            ),
-            None => block_kept(pos, self.at_build, block, self.skin),
-        }
+        let images = self.periodic.as_ref().map(|p| &p.images);
+        block_kept_in(images, pos, self.at_build, block, self.skin)
     }
 
     fn colors(&self) -> &Colors {
@@ -661,6 +653,24 @@ pub(crate) fn block_kept<T: Real, const D: usize>(
         #[inline(always)]
         || work::moved_beyond(pos, then, 0.25 * skin * skin),
     )
+}
+
+/// The displacement test of one block in an open box, or with `images` in a periodic one
+/// (each slot continued from its place at the build).
+pub(crate) fn block_kept_in<T: Real, const D: usize>(
+    images: Option<&Images<T, D>>,
+    pos: [&[T]; D],
+    at_build: [&[T]; D],
+    block: Range<usize>,
+    skin: f64,
+) -> bool {
+    match images {
+        Some(images) => simd::dispatch(
+            #[inline(always)]
+            || images.block_kept(pos, at_build, block.clone(), skin, None),
+        ),
+        None => block_kept(pos, at_build, block, skin),
+    }
 }
 
 /// The report of one force computation: the list's entries are its pair checks, plus the
