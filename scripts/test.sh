@@ -44,7 +44,7 @@ chromium_install=$!
 cargo fmt --all -- --check
 
 step "the build, linted: tests, benches and binary, with the mpi feature"
-# One build of every test target of both crates (the engine's and the harness's unit tests, the
+# One build of every test target of the crates (the harness's and the records' unit tests, the
 # integration suite, the benches in test mode, the examples, the binary). The binary it makes is the one judged below: a `cargo build`
 # would compile the crate again (the tests' dev-dependencies change the features of shared
 # dependencies).
@@ -65,7 +65,23 @@ export RUSTC_WORKSPACE_WRAPPER="$clippy_driver" RUSTFLAGS="-D warnings"
 # `test-slowdown`: the knob the gate's tests slow a kernel with (never in a build users measure
 # with; the binary records its features in every results file).
 features=(--features mpi,test-slowdown)
-cargo test --release --workspace --all-targets "${features[@]}" --no-run
+# The engine's unit tests are the longest compilation of all (the whole engine again, with
+# cfg(test): over 3 minutes of one core). Cargo starts first the units that others wait on, so
+# in the workspace's build this one, which nothing waits on, started last and compiled alone
+# at the end. It builds in a target directory of its own (its few dependencies compiled there
+# again), beside the workspace's build from the start, with the engine features the workspace
+# gives it.
+engine_tests=(-p nbody-engine --lib --features clap,test-slowdown,testing --target-dir target/engine-tests)
+engine_log=$(mktemp)
+cargo test --release "${engine_tests[@]}" --no-run >"$engine_log" 2>&1 &
+engine_build=$!
+# Every other command names the same packages, so that none of them rebuilds (see below).
+workspace=(--workspace --exclude nbody-engine)
+cargo test --release "${workspace[@]}" --all-targets "${features[@]}" --no-run
+if ! wait "$engine_build"; then
+    cat "$engine_log" >&2
+    exit 1
+fi
 bin=target/release/nbody-bench
 if ! wait "$slurm_install"; then
     cat "$slurm_log" >&2
@@ -94,21 +110,22 @@ step "every test"
 # The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
 # without `lmp`: install it when missing (as root, with apt; scripts/install-lammps.sh).
 scripts/install-lammps.sh
-# The unit tests of both crates; the suite but its timing tests; those alone on one test thread
+# The unit tests of every crate; the suite but its timing tests; those alone on one test thread
 # (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
-# Every command names the whole workspace, as the build did: cargo resolves the shared
-# dependencies' features for the packages it is given, so a command for the root package
-# alone would compile the harness and the suite a second time (about 3 minutes).
-cargo test --release --workspace "${features[@]}" --lib --bins
-cargo test --release --workspace "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
-cargo test --release --workspace "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
-cargo test --release --workspace "${features[@]}" --bench kernels
+# Every command names the packages the build did: cargo resolves the shared dependencies'
+# features for the packages it is given, so a command for the root package alone would compile
+# the harness and the suite a second time (about 3 minutes).
+cargo test --release "${engine_tests[@]}"
+cargo test --release "${workspace[@]}" "${features[@]}" --lib --bins
+cargo test --release "${workspace[@]}" "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
+cargo test --release "${workspace[@]}" "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
+cargo test --release "${workspace[@]}" "${features[@]}" --bench kernels
 
 step "the MPI drivers under mpirun, and the Slurm path beside them"
 # Sweeps through a one-node Slurm and the weak-scaling job script under sbatch
 # (scripts/slurm-tests.sh), run alongside: they check what comes back, not how fast, and one of
 # them waits out a job's time limit (over a minute).
-NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh --workspace "${features[@]}" >"$slurm_log" 2>&1 &
+NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh "${workspace[@]}" "${features[@]}" >"$slurm_log" 2>&1 &
 slurm_tests=$!
 NBODY_BENCH_BIN="$bin" scripts/mpi-tests.sh
 # The course's C codes: warning-free builds, their energy conservation and agreement with each

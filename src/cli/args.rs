@@ -98,7 +98,8 @@ pub enum Command {
 #[derive(Debug, Args)]
 #[command(
     after_help = "Examples:\n  nbody-bench init --external mycode                # mycode.toml, for mycode.c\n  \
-    nbody-bench init --external mysim --lang python   # mysim.toml and the driver mysim.py"
+    nbody-bench init --external mysim --lang python   # mysim.toml and the driver mysim.py\n  \
+    nbody-bench init --external mymd --lang python --physics lj   # a periodic Lennard-Jones driver"
 )]
 pub struct InitArgs {
     /// Your program's name: the name of its cases and of the config file.
@@ -107,6 +108,9 @@ pub struct InitArgs {
     /// The language of the program, which sets how the config builds and runs it.
     #[arg(long, value_enum, default_value_t = InitLang::C)]
     pub lang: InitLang,
+    /// The physics of the Python driver and of the config's scenario (with `--lang python`).
+    #[arg(long, value_enum, default_value_t = InitPhysics::Gravity)]
+    pub physics: InitPhysics,
     /// Write the config here [default: NAME.toml in the current directory]; an existing file
     /// is never replaced. With `--lang python` the driver NAME.py is written beside it.
     #[arg(long, value_name = "FILE")]
@@ -121,6 +125,16 @@ pub enum InitLang {
     /// A Python program run by python3: also writes NAME.py, a standard-library direct-summation
     /// driver that prints its time, where your code's calls go (REBOUND's, for example).
     Python,
+}
+
+/// The physics an `init --lang python` driver simulates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum InitPhysics {
+    /// Direct-summation gravity on the `galaxy` scenario's bodies (`export --format text`).
+    Gravity,
+    /// Lennard-Jones molecular dynamics in a periodic box on the `lj-melt` scenario's atoms
+    /// (`export --format lammps-data`), passed the sweep's thread count.
+    Lj,
 }
 
 #[derive(Debug, Args)]

@@ -1,8 +1,9 @@
-//! `nbody-bench init --external NAME [--lang c|python]`: a commented sweep config for the user's
-//! own program, written from a template of configs/templates/ with the program's name in it;
-//! for Python also the driver NAME.py beside it, the program the config runs.
+//! `nbody-bench init --external NAME [--lang c|python] [--physics gravity|lj]`: a commented sweep
+//! config for the user's own program, written from a template of configs/templates/ with the
+//! program's name in it; for Python also the driver NAME.py beside it, the program the config
+//! runs (direct-summation gravity, or Lennard-Jones in a periodic box).
 
-use crate::cli::args::{InitArgs, InitLang};
+use crate::cli::args::{InitArgs, InitLang, InitPhysics};
 use anyhow::bail;
 use nbody_records::config::SweepConfig;
 use std::path::{Path, PathBuf};
@@ -18,17 +19,26 @@ struct Template {
 }
 
 impl Template {
-    fn of(lang: InitLang) -> Template {
-        match lang {
-            InitLang::C => Template {
+    /// The template for `lang` and `physics`; the C template is gravity's alone.
+    fn of(lang: InitLang, physics: InitPhysics) -> anyhow::Result<Template> {
+        Ok(match (lang, physics) {
+            (InitLang::C, InitPhysics::Gravity) => Template {
                 config: include_str!("../../configs/templates/external.toml"),
                 program: None,
             },
-            InitLang::Python => Template {
+            (InitLang::C, InitPhysics::Lj) => bail!(
+                "--physics lj comes with a Python driver: add --lang python (the C template \
+                 is a gravity code)"
+            ),
+            (InitLang::Python, InitPhysics::Gravity) => Template {
                 config: include_str!("../../configs/templates/external-python.toml"),
                 program: Some(("py", include_str!("../../configs/templates/external.py"))),
             },
-        }
+            (InitLang::Python, InitPhysics::Lj) => Template {
+                config: include_str!("../../configs/templates/external-lj-python.toml"),
+                program: Some(("py", include_str!("../../configs/templates/external-lj.py"))),
+            },
+        })
     }
 }
 
@@ -47,7 +57,7 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
     {
         bail!("--external `{name}` is a built-in kernel's name; choose another");
     }
-    let template = Template::of(args.lang);
+    let template = Template::of(args.lang, args.physics)?;
     let out = args
         .out
         .unwrap_or_else(|| PathBuf::from(format!("{name}.toml")));
@@ -95,24 +105,38 @@ pub fn init(args: InitArgs) -> anyhow::Result<i32> {
         }
         return Err(e.into());
     }
-    next_steps(&out, name, program.as_ref().map(|(path, _)| path.as_path()));
+    next_steps(
+        &out,
+        name,
+        program.as_ref().map(|(path, _)| path.as_path()),
+        args.physics,
+    );
     Ok(0)
 }
 
 /// What to do with the files just written.
-fn next_steps(out: &Path, name: &str, program: Option<&Path>) {
+fn next_steps(out: &Path, name: &str, program: Option<&Path>, physics: InitPhysics) {
     let out = super::hint::arg(out);
-    match program {
-        None => eprintln!(
+    let then = format!(
+        "put your code's calls in its `evolve`, then\n  nbody-bench sweep --config {out} \
+         --dry-run\n  nbody-bench sweep --config {out}"
+    );
+    match (program, physics) {
+        (None, _) => eprintln!(
             "wrote {out}: put your source beside it as {name}.c (or edit `setup` and `command`), \
              make it print `time total SECONDS`, then\n  nbody-bench sweep --config {out} \
              --dry-run\n  nbody-bench sweep --config {out}"
         ),
-        Some(program) => eprintln!(
+        (Some(program), InitPhysics::Gravity) => eprintln!(
             "wrote {out} and {program}, a direct-summation program that prints `time total \
-             SECONDS`: try it with\n  python3 {program} --n 200 --steps 10\nput your code's \
-             calls in its `evolve`, then\n  nbody-bench sweep --config {out} --dry-run\n  \
-             nbody-bench sweep --config {out}",
+             SECONDS`: try it with\n  python3 {program} --n 200 --steps 10\n{then}",
+            program = super::hint::arg(program)
+        ),
+        (Some(program), InitPhysics::Lj) => eprintln!(
+            "wrote {out} and {program}, a Lennard-Jones program in a periodic box that prints \
+             `time total SECONDS`: try it with\n  nbody-bench export --scenario lj-melt -n 4000 \
+             --format lammps-data --out state.data\n  python3 {program} --initial state.data \
+             --steps 2\n{then}",
             program = super::hint::arg(program)
         ),
     }

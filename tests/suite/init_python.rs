@@ -8,7 +8,7 @@ use nbody_records::config::SweepConfig;
 use nbody_records::results::ResultsFile;
 
 /// Whether `python3` runs here; the tests that need it say so and pass without it.
-fn python3() -> bool {
+pub(super) fn python3() -> bool {
     let ok = std::process::Command::new("python3")
         .arg("--version")
         .output()
@@ -21,13 +21,13 @@ fn python3() -> bool {
 
 /// `text` with `from` replaced by `to`, which must occur in it: a template that changes under
 /// the test fails here, not in a sweep of the full-size config.
-fn edit(text: &str, from: &str, to: &str) -> String {
+pub(super) fn edit(text: &str, from: &str, to: &str) -> String {
     assert!(text.contains(from), "`{from}` is not in the template");
     text.replacen(from, to, 1)
 }
 
 /// The total energy of a line `energy initial E0 final E1 ...` of the driver's output.
-fn driver_energies(stdout: &str) -> (f64, f64) {
+pub(super) fn driver_energies(stdout: &str) -> (f64, f64) {
     let line = stdout
         .lines()
         .find(|l| l.starts_with("energy initial "))

@@ -35,6 +35,7 @@ mod gate_refusals;
 mod history;
 mod history_lines;
 mod init;
+mod init_lj;
 mod init_python;
 mod initial;
 mod integrity;
