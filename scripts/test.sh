@@ -98,6 +98,14 @@ step "validation and the performance gate"
 # machine class without a baseline) is compiled as users compile it, without the lints.
 env -u RUSTC_WORKSPACE_WRAPPER -u RUSTFLAGS NBODY_BENCH_BIN="$bin" scripts/ci-gate.sh
 
+step "the Slurm path, beside every check that times nothing"
+# Sweeps through a one-node Slurm and the weak-scaling job script under sbatch
+# (scripts/slurm-tests.sh): they check what comes back, not how fast, and one of them waits out
+# a job's time limit (over a minute), so they run in the background from here to the timing
+# tests at the end, which run alone.
+NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh "${workspace[@]}" "${features[@]}" >"$slurm_log" 2>&1 &
+slurm_tests=$!
+
 step "FMM3D's driver against the naive kernel"
 # configs/vs-fmm3d.toml measures FMM3D through scripts/fmm3d-driver.py: a Python check (a few
 # seconds, plus about 10 s of pip on a fresh machine) that its forces are our naive kernel's to
@@ -106,27 +114,21 @@ step "FMM3D's driver against the naive kernel"
 scripts/install-fmm3d.sh
 .peers/venv/bin/python scripts/fmm3d-check.py "$bin"
 
-step "every test"
+step "every test but the timing ones"
 # The suite runs one small LAMMPS case through the harness (tests/suite/peers.rs), which fails
 # without `lmp`: install it when missing (as root, with apt; scripts/install-lammps.sh).
 scripts/install-lammps.sh
-# The unit tests of every crate; the suite but its timing tests; those alone on one test thread
-# (tests/suite/main.rs); each bench once (criterion's test mode, so that they cannot rot).
+# The unit tests of every crate; the suite but its timing tests; each bench once (criterion's
+# test mode, so that they cannot rot).
 # Every command names the packages the build did: cargo resolves the shared dependencies'
 # features for the packages it is given, so a command for the root package alone would compile
 # the harness and the suite a second time (about 3 minutes).
 cargo test --release "${engine_tests[@]}"
 cargo test --release "${workspace[@]}" "${features[@]}" --lib --bins
 cargo test --release "${workspace[@]}" "${features[@]}" --test suite -- --skip gate:: --skip dry_run::
-cargo test --release "${workspace[@]}" "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
 cargo test --release "${workspace[@]}" "${features[@]}" --bench kernels
 
-step "the MPI drivers under mpirun, and the Slurm path beside them"
-# Sweeps through a one-node Slurm and the weak-scaling job script under sbatch
-# (scripts/slurm-tests.sh), run alongside: they check what comes back, not how fast, and one of
-# them waits out a job's time limit (over a minute).
-NBODY_BENCH_BIN="$bin" scripts/slurm-tests.sh "${workspace[@]}" "${features[@]}" >"$slurm_log" 2>&1 &
-slurm_tests=$!
+step "the MPI drivers under mpirun"
 NBODY_BENCH_BIN="$bin" scripts/mpi-tests.sh
 # The course's C codes: warning-free builds, their energy conservation and agreement with each
 # other over threads and ranks (their runs under the harness are in the suite).
@@ -137,4 +139,9 @@ if ! wait "$slurm_tests"; then
     exit 1
 fi
 tail -n 3 "$slurm_log" >&2
+
+step "the timing tests, alone"
+# The gate's and the dry run's tests time kernels: one at a time, nothing else running
+# (tests/suite/main.rs).
+cargo test --release "${workspace[@]}" "${features[@]}" --test suite -- --test-threads=1 gate:: dry_run::
 step "all checks passed"

@@ -68,7 +68,7 @@ pub enum KernelKind {
     /// some particle has moved more than half the skin (O(n)).
     Verlet,
     /// Verlet list of 4-particle clusters (GROMACS nbnxm style), each against runs of 16
-    /// particles in one SIMD block, for dense systems (O(n)).
+    /// particles (8 in 3-D) in one SIMD block, for dense systems (O(n)).
     ClusterPair,
     /// Fast multipole method (falcON style): mutual cell–cell interactions of Cartesian
     /// order p between cells that pass the opening test with θ, near leaves directly (O(n)).

@@ -6,6 +6,7 @@
 
 pub mod comm_model;
 pub mod crossover;
+pub(crate) mod each_program;
 pub mod family;
 pub mod forking;
 pub mod groups;

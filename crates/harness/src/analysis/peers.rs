@@ -376,7 +376,7 @@ pub(crate) fn equal_error(theta: &[ThetaAnalysis]) -> Vec<EqualErrorCost> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use nbody_engine::kernels::Multipole;
     use nbody_engine::scenario::ScenarioKind;
@@ -384,7 +384,7 @@ mod tests {
     use nbody_records::plan::Case;
 
     /// A complete case of `code` on `scenario` whose samples are `median_s` per step ± 1%.
-    fn point(
+    pub(in crate::analysis) fn point(
         scenario: ScenarioKind,
         code: &str,
         n: usize,

@@ -9,6 +9,7 @@
 mod comm_section;
 mod family_section;
 pub mod keep;
+mod melt_section;
 mod sections;
 mod sources_section;
 mod tree_section;

@@ -40,6 +40,7 @@ pub fn document(
     super::comm_section::section(&mut md, sweeps, comm, NO_NOTES);
     super::tree_section::section(&mut md, tree, NO_NOTES);
     octree(&mut md, sweeps);
+    super::melt_section::section(&mut md, sweeps, NO_NOTES);
     peers(&mut md, sweeps);
     sanity(&mut md, sweeps);
     super::sources_section::section(&mut md, sweeps, NO_NOTES);
