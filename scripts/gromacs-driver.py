@@ -30,46 +30,13 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib"))
+from lammps_data import InputError, read as read_lammps_data  # noqa: E402
+
 CUTOFF = 2.5
 SKIN = 0.3
 DT = 0.005
 NSTLIST = 20
-
-
-class InputError(Exception):
-    """Bad input: printed as the message, exit status 2."""
-
-
-def read_lammps_data(path):
-    """The box sides, positions and velocities of a LAMMPS data file (atom style atomic)."""
-    try:
-        with open(path) as f:
-            lines = f.read().splitlines()
-    except OSError as e:
-        raise InputError(f"cannot read {path}: {e.strerror}")
-    sides, section, atoms, velocities = {}, None, {}, {}
-    for line in lines[1:]:
-        words = line.split("#")[0].split()
-        if not words:
-            continue
-        if len(words) == 4 and words[2].endswith("lo") and words[3].endswith("hi"):
-            sides[words[2][0]] = (float(words[0]), float(words[1]))
-        elif words[0] in ("Atoms", "Velocities", "Masses"):
-            section = words[0]
-        elif section == "Atoms" and len(words) >= 5:
-            atoms[int(words[0])] = tuple(float(w) for w in words[2:5])
-        elif section == "Velocities" and len(words) >= 4:
-            velocities[int(words[0])] = tuple(float(w) for w in words[1:4])
-        elif section == "Masses" and len(words) >= 2 and float(words[1]) != 1.0:
-            raise InputError(f"{path}: atom mass {words[1]}; this driver runs LJ's unit mass")
-    if sorted(sides) != ["x", "y", "z"]:
-        raise InputError(f"{path}: no 3-D box (xlo xhi, ylo yhi, zlo zhi); export a 3-D scenario")
-    if not atoms or sorted(atoms) != sorted(velocities):
-        raise InputError(f"{path}: every atom needs a position and a velocity")
-    ids = sorted(atoms)
-    lo = [sides[a][0] for a in "xyz"]
-    positions = [tuple(p[d] - lo[d] for d in range(3)) for p in (atoms[i] for i in ids)]
-    return [sides[a][1] - sides[a][0] for a in "xyz"], positions, [velocities[i] for i in ids]
 
 
 def write_inputs(directory, sides, positions, velocities, steps):
@@ -142,7 +109,9 @@ def main(argv):
         raise InputError(f"STEPS and THREADS are integers (got {argv[2]!r}, {argv[3]!r})")
     if steps < 2 or threads < 1:
         raise InputError(f"STEPS is at least 2 and THREADS at least 1 (got {steps}, {threads})")
-    sides, positions, velocities = read_lammps_data(path)
+    lo, sides, positions, velocities = read_lammps_data(path)
+    # A .gro box starts at the origin.
+    positions = [tuple(p[d] - lo[d] for d in range(3)) for p in positions]
     if min(sides) < 2 * (CUTOFF + SKIN):
         raise InputError(f"{path}: a box side of {min(sides)} is under twice the list radius "
                          f"{CUTOFF + SKIN}")

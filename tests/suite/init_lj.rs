@@ -3,9 +3,8 @@
 //! same exported atoms), refuses a 2-D state with what to export, and its config, cut down to
 //! one small n, sweeps it through the binary with the sweep's thread count passed on.
 
-use super::init_python::{driver_energies, edit, python3};
+use super::init_python::{driver_energies, python3, run_energies, sweep_cut_down};
 use super::{bin, refused, text};
-use nbody_records::results::ResultsFile;
 
 #[test]
 fn the_lj_driver_computes_our_melt_and_its_config_sweeps() {
@@ -66,36 +65,26 @@ fn the_lj_driver_computes_our_melt_and_its_config_sweeps() {
     let out = driver("melt.data");
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let (e0, e1) = driver_energies(&text(&out.stdout));
-    let out = run(&[
-        "run",
-        "--scenario",
-        "lj-melt",
-        "--kernel",
-        "naive",
-        "-n",
-        "256",
-        "--steps",
-        "10",
-        "--precision",
-        "f64",
-        "--json",
-        "run.json",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("run.json")).unwrap())
-            .unwrap();
-    let total = |at: &str| -> f64 {
-        let e = &json["energy"][at];
-        ["kinetic", "potential", "external"]
-            .iter()
-            .map(|k| e[k].as_f64().unwrap())
-            .sum()
-    };
+    let (initial, last) = run_energies(
+        dir.path(),
+        &[
+            "run",
+            "--scenario",
+            "lj-melt",
+            "--kernel",
+            "naive",
+            "-n",
+            "256",
+            "--steps",
+            "10",
+            "--precision",
+            "f64",
+        ],
+    );
     // The energies differ from the start by more than rounding when a pair, an image or the
     // step were wrong; 10 steps of the melt move each atom about 0.06 sigma.
-    assert!((total("initial") - e0).abs() <= 1e-9 * e0.abs(), "{e0}");
-    assert!((total("final") - e1).abs() <= 1e-8 * e1.abs(), "{e1}");
+    assert!((initial - e0).abs() <= 1e-9 * e0.abs(), "{initial} vs {e0}");
+    assert!((last - e1).abs() <= 1e-8 * e1.abs(), "{last} vs {e1}");
     assert!(
         (e1 - e0).abs() > 1e-6 * e0.abs(),
         "the atoms moved: {e0} {e1}"
@@ -130,37 +119,25 @@ fn the_lj_driver_computes_our_melt_and_its_config_sweeps() {
 
     // The driver told two threads (the config's line for a code that uses them), one small n,
     // our naive kernel beside it: a real sweep in about a second.
-    let config = dir.path().join("md.toml");
-    let mut small = std::fs::read_to_string(&config).unwrap();
-    for (from, to) in [
-        ("\nn = [4000]\n", "\nn = [256]\n"),
-        ("\nthreads = [1, 2]\n", "\nthreads = [2]\n"),
-        (
-            "\nkernels = [\"verlet\", \"cluster-pair\"]\n",
-            "\nkernels = [\"naive\"]\n",
-        ),
-        ("\nthreads = [1]\n", "\nthreads = [2]\n"),
-        (
-            "\nsteps = { work = 12000, grows = \"n\" }\n",
-            "\nsteps = 2\n",
-        ),
-        ("\nsamples = 4\n", "\nsamples = 2\n"),
-        ("\nrounds = 2\n", "\nrounds = 1\n"),
-    ] {
-        small = edit(&small, from, to);
-    }
-    std::fs::write(&config, small).unwrap();
-    let out = run(&[
-        "sweep",
-        "--config",
-        "md.toml",
-        "--out",
-        "out",
-        "--no-calibration",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let results = ResultsFile::load(&dir.path().join("out/md/results.json")).unwrap();
-    let keys: Vec<&str> = results.cases.iter().map(|c| c.key.as_str()).collect();
+    let (results, keys) = sweep_cut_down(
+        dir.path(),
+        "md",
+        &[
+            ("\nn = [4000]\n", "\nn = [256]\n"),
+            ("\nthreads = [1, 2]\n", "\nthreads = [2]\n"),
+            (
+                "\nkernels = [\"verlet\", \"cluster-pair\"]\n",
+                "\nkernels = [\"naive\"]\n",
+            ),
+            ("\nthreads = [1]\n", "\nthreads = [2]\n"),
+            (
+                "\nsteps = { work = 12000, grows = \"n\" }\n",
+                "\nsteps = 2\n",
+            ),
+            ("\nsamples = 4\n", "\nsamples = 2\n"),
+            ("\nrounds = 2\n", "\nrounds = 1\n"),
+        ],
+    );
     assert_eq!(
         keys,
         [

@@ -6,6 +6,7 @@
 use super::{bin, refused, text};
 use nbody_records::config::SweepConfig;
 use nbody_records::results::ResultsFile;
+use std::path::Path;
 
 /// Whether `python3` runs here; the tests that need it say so and pass without it.
 pub(super) fn python3() -> bool {
@@ -34,6 +35,53 @@ pub(super) fn driver_energies(stdout: &str) -> (f64, f64) {
         .unwrap_or_else(|| panic!("no energy line in {stdout}"));
     let words: Vec<&str> = line.split_whitespace().collect();
     (words[2].parse().unwrap(), words[4].parse().unwrap())
+}
+
+/// The total energy at the start and at the end of `nbody-bench run ARGS --json run.json`,
+/// run in `dir`.
+pub(super) fn run_energies(dir: &Path, args: &[&str]) -> (f64, f64) {
+    let out = bin()
+        .current_dir(dir)
+        .args(args)
+        .args(["--json", "run.json"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("run.json")).unwrap()).unwrap();
+    let total = |at: &str| -> f64 {
+        let e = &json["energy"][at];
+        ["kinetic", "potential", "external"]
+            .iter()
+            .map(|k| e[k].as_f64().unwrap())
+            .sum()
+    };
+    (total("initial"), total("final"))
+}
+
+/// The config `NAME.toml` in `dir` cut down by `edits` (each `(from, to)` must occur in it),
+/// swept into `dir/out` without a calibration: its results, with the keys of its cases.
+pub(super) fn sweep_cut_down(
+    dir: &Path,
+    name: &str,
+    edits: &[(&str, &str)],
+) -> (ResultsFile, Vec<String>) {
+    let config = dir.join(format!("{name}.toml"));
+    let mut small = std::fs::read_to_string(&config).unwrap();
+    for (from, to) in edits {
+        small = edit(&small, from, to);
+    }
+    std::fs::write(&config, small).unwrap();
+    let out = bin()
+        .current_dir(dir)
+        .args(["sweep", "--config", &format!("{name}.toml"), "--out", "out"])
+        .arg("--no-calibration")
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
+    let results = ResultsFile::load(&dir.join(format!("out/{name}/results.json"))).unwrap();
+    let keys = results.cases.iter().map(|c| c.key.clone()).collect();
+    (results, keys)
 }
 
 #[test]
@@ -125,31 +173,21 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
     let out = driver("galaxy", "s.txt", "10");
     assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
     let (e0, e1) = driver_energies(&text(&out.stdout));
-    let out = run(&[
-        "run",
-        "--scenario",
-        "galaxy",
-        "--kernel",
-        "symmetric",
-        "-n",
-        "40",
-        "--steps",
-        "10",
-        "--json",
-        "run.json",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.path().join("run.json")).unwrap())
-            .unwrap();
-    let total = |at: &str| -> f64 {
-        let e = &json["energy"][at];
-        ["kinetic", "potential", "external"]
-            .iter()
-            .map(|k| e[k].as_f64().unwrap())
-            .sum()
-    };
-    for (ours, theirs) in [(total("initial"), e0), (total("final"), e1)] {
+    let (initial, last) = run_energies(
+        dir.path(),
+        &[
+            "run",
+            "--scenario",
+            "galaxy",
+            "--kernel",
+            "symmetric",
+            "-n",
+            "40",
+            "--steps",
+            "10",
+        ],
+    );
+    for (ours, theirs) in [(initial, e0), (last, e1)] {
         assert!(
             (ours - theirs).abs() <= 1e-8 * ours.abs(),
             "{ours} vs {theirs}"
@@ -172,37 +210,25 @@ fn the_python_driver_computes_our_galaxy_and_its_config_sweeps() {
     );
 
     // One small n, one kernel, two samples in one round: a real sweep in about a second.
-    let config = dir.path().join("pysim.toml");
-    let mut small = std::fs::read_to_string(&config).unwrap();
-    for (from, to) in [
-        ("\nn = [250, 500, 1000]\n", "\nn = [40]\n"),
-        ("\nthreads = [1, 2]\n", "\nthreads = [1]\n"),
-        (
-            "\nkernels = [\"symmetric\", \"naive\", \"octree\"]\n",
-            "\nkernels = [\"symmetric\"]\n",
-        ),
-        // 16000 / 40² = 10 steps a run.
-        (
-            "\nsteps = { work = 2.5e6, grows = \"n^2\" }\n",
-            "\nsteps = { work = 16000, grows = \"n^2\" }\n",
-        ),
-        ("\nsamples = 5\n", "\nsamples = 2\n"),
-        ("\nrounds = 2\n", "\nrounds = 1\n"),
-    ] {
-        small = edit(&small, from, to);
-    }
-    std::fs::write(&config, small).unwrap();
-    let out = run(&[
-        "sweep",
-        "--config",
-        "pysim.toml",
-        "--out",
-        "out",
-        "--no-calibration",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", text(&out.stderr));
-    let results = ResultsFile::load(&dir.path().join("out/pysim/results.json")).unwrap();
-    let keys: Vec<&str> = results.cases.iter().map(|c| c.key.as_str()).collect();
+    let (results, keys) = sweep_cut_down(
+        dir.path(),
+        "pysim",
+        &[
+            ("\nn = [250, 500, 1000]\n", "\nn = [40]\n"),
+            ("\nthreads = [1, 2]\n", "\nthreads = [1]\n"),
+            (
+                "\nkernels = [\"symmetric\", \"naive\", \"octree\"]\n",
+                "\nkernels = [\"symmetric\"]\n",
+            ),
+            // 16000 / 40² = 10 steps a run.
+            (
+                "\nsteps = { work = 2.5e6, grows = \"n^2\" }\n",
+                "\nsteps = { work = 16000, grows = \"n^2\" }\n",
+            ),
+            ("\nsamples = 5\n", "\nsamples = 2\n"),
+            ("\nrounds = 2\n", "\nrounds = 1\n"),
+        ],
+    );
     assert_eq!(
         keys,
         [
