@@ -130,8 +130,10 @@ def main(argv):
         print("gromacs-driver.py: no `Time:` line in mdrun's log", file=sys.stderr)
         return 1
     timed = steps - steps // 2
-    print(f"gromacs {version.group(1) if version else '?'} simd {simd.group(1) if simd else '?'} "
-          f"threads {threads} atoms {len(positions)} steps {steps} (timed {timed})")
+    named = [f"gromacs {version.group(1)}" if version else "gromacs (its log names no version)",
+             f"simd {simd.group(1)}" if simd else "simd (not in its log)"]
+    print(f"{' '.join(named)} threads {threads} atoms {len(positions)} steps {steps} "
+          f"(timed {timed})")
     print(f"time total {float(wall.group(2)) * steps / timed:.9f}")
     print("gromacs done")
     return 0

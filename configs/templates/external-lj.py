@@ -91,9 +91,9 @@ def read_state(path):
         elif section == "Masses" and numbers(words[1:2], where) != [1.0]:
             raise InputError(f"{where}: mass {words[1]}: this program runs LJ's unit mass")
         elif section == "Atoms":
-            rows[section][int(words[0])] = numbers(words[2:5], where)
+            rows[section][atom_id(words, 5, where)] = numbers(words[2:5], where)
         elif section == "Velocities":
-            rows[section][int(words[0])] = numbers(words[1:4], where)
+            rows[section][atom_id(words, 4, where)] = numbers(words[1:4], where)
     if sorted(sides) != ["x", "y", "z"]:
         raise InputError(f"--initial {path}: no box (xlo xhi, ylo yhi, zlo zhi lines)")
     atoms = Atoms([sides["x"], sides["y"], sides["z"]])
@@ -109,6 +109,15 @@ def read_state(path):
                          f"the cutoff {params['cutoff']:g}: an atom would meet two images of "
                          "another; export more atoms")
     return atoms, params
+
+
+def atom_id(words, fields, where):
+    """The id that starts a line of at least `fields` words of the Atoms or Velocities
+    section."""
+    if len(words) < fields or not words[0].isdigit():
+        raise InputError(f"{where}: expected an atom id and {fields - 1} values, got "
+                         f"{' '.join(words)!r}")
+    return int(words[0])
 
 
 def numbers(words, where):

@@ -17,20 +17,24 @@ def read(path):
     except OSError as e:
         raise InputError(f"cannot read {path}: {e.strerror}")
     bounds, section, atoms, velocities = {}, None, {}, {}
-    for line in lines[1:]:
+    for number, line in enumerate(lines[1:], 2):
         words = line.split("#")[0].split()
         if not words:
             continue
-        if len(words) == 4 and words[2].endswith("lo") and words[3].endswith("hi"):
-            bounds[words[2][0]] = (float(words[0]), float(words[1]))
-        elif words[0] in ("Atoms", "Velocities", "Masses"):
-            section = words[0]
-        elif section == "Atoms" and len(words) >= 5:
-            atoms[int(words[0])] = tuple(float(w) for w in words[2:5])
-        elif section == "Velocities" and len(words) >= 4:
-            velocities[int(words[0])] = tuple(float(w) for w in words[1:4])
-        elif section == "Masses" and len(words) >= 2 and float(words[1]) != 1.0:
-            raise InputError(f"{path}: atom mass {words[1]}; the drivers run LJ's unit mass")
+        try:
+            if len(words) == 4 and words[2].endswith("lo") and words[3].endswith("hi"):
+                bounds[words[2][0]] = (float(words[0]), float(words[1]))
+            elif words[0] in ("Atoms", "Velocities", "Masses"):
+                section = words[0]
+            elif section == "Atoms" and len(words) >= 5:
+                atoms[int(words[0])] = tuple(float(w) for w in words[2:5])
+            elif section == "Velocities" and len(words) >= 4:
+                velocities[int(words[0])] = tuple(float(w) for w in words[1:4])
+            elif section == "Masses" and len(words) >= 2 and float(words[1]) != 1.0:
+                raise InputError(f"{path}: atom mass {words[1]}; the drivers run LJ's unit mass")
+        except ValueError as e:
+            raise InputError(f"{path} line {number}: {e}; is this a file of `nbody-bench export "
+                             "--format lammps-data`?")
     if sorted(bounds) != ["x", "y", "z"]:
         raise InputError(f"{path}: no 3-D box (xlo xhi, ylo yhi, zlo zhi); export a 3-D scenario")
     if not atoms or sorted(atoms) != sorted(velocities):

@@ -109,6 +109,17 @@ fn the_lj_driver_computes_our_melt_and_its_config_sweeps() {
     let out = driver("tiny.data");
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("under twice the cutoff"));
+    // And a line that is not an atom's, at its line number.
+    let broken = melt.replacen("\n1 1 ", "\nx 1 ", 1);
+    assert_ne!(broken, melt);
+    std::fs::write(dir.path().join("broken.data"), broken).unwrap();
+    let out = driver("broken.data");
+    assert_eq!(out.status.code(), Some(2));
+    assert!(
+        text(&out.stderr).contains("expected an atom id"),
+        "{}",
+        text(&out.stderr)
+    );
 
     let out = run(&["sweep", "--config", "md.toml", "--dry-run"]);
     let said = format!("{}{}", text(&out.stdout), text(&out.stderr));
