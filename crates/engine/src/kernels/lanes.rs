@@ -6,7 +6,13 @@
 //! [`crate::simd::run_avx2`]), where the intrinsics inline into straight vector code. A batched
 //! kernel is written once, generic over [`Lanes`], and run through [`isa`] and [`same`].
 
+#[cfg(target_arch = "x86_64")]
+use crate::physics::LennardJonesTerms;
+#[cfg(target_arch = "x86_64")]
+use crate::real::Real;
 use crate::simd::{SimdLevel, level};
+#[cfg(target_arch = "x86_64")]
+use num_traits::One;
 use std::any::TypeId;
 #[cfg(target_arch = "x86_64")]
 use std::arch::x86_64::*;
@@ -106,6 +112,54 @@ pub(super) unsafe trait Lanes: Copy {
     unsafe fn rsqrt_cubed_scaled(self, scale: Self) -> Self;
 }
 
+/// Truncated Lennard-Jones over the lanes of `V`: `24ε u (1 − 2u) / r²` with `u = (σ²/r²)³`,
+/// zero from the cutoff on (and where `r²` is NaN).
+#[cfg(target_arch = "x86_64")]
+pub(super) struct LennardJonesLanes<V> {
+    epsilon24: V,
+    sigma2: V,
+    rc2: V,
+    one: V,
+}
+
+#[cfg(target_arch = "x86_64")]
+impl<V: Lanes> LennardJonesLanes<V>
+where
+    V::Elem: Real,
+{
+    /// # Safety
+    /// The caller must have `V`'s features.
+    #[inline(always)]
+    pub(super) unsafe fn new(t: &LennardJonesTerms<V::Elem>) -> Self {
+        // SAFETY: the caller's features.
+        unsafe {
+            LennardJonesLanes {
+                epsilon24: V::splat(t.epsilon24),
+                sigma2: V::splat(t.sigma2),
+                rc2: V::splat(t.rc2),
+                one: V::splat(V::Elem::one()),
+            }
+        }
+    }
+
+    /// The coefficients at squared distances `r2`: the operations of `LennardJones::coeff`,
+    /// in its order, the division correctly rounded.
+    ///
+    /// # Safety
+    /// The caller must have `V`'s features.
+    #[inline(always)]
+    pub(super) unsafe fn at(&self, r2: V) -> V {
+        // SAFETY: the caller's features.
+        unsafe {
+            let ir2 = self.one.div(r2);
+            let s = self.sigma2.mul(ir2);
+            let u = s.mul(s).mul(s);
+            let c = self.epsilon24.mul(ir2).mul(u).mul(self.one.sub(u.add(u)));
+            c.keep_where_less(r2, self.rc2)
+        }
+    }
+}
+
 /// Coefficients of `(1 − e)^{−3/2} = Σ_k C_k e^k`: `C_k = C_{k−1} (2k + 1) / (2k)`.
 const CUBE_SERIES: [f64; 6] = [1.0, 1.5, 1.875, 2.1875, 2.4609375, 2.70703125];
 
@@ -142,7 +196,7 @@ macro_rules! lanes {
      cube_terms $terms:expr) => {
         #[cfg(target_arch = "x86_64")]
         #[derive(Clone, Copy)]
-        pub(super) struct $name($reg);
+        pub(super) struct $name(pub(super) $reg);
 
         // SAFETY: every method is an intrinsic of the features named in the entry point that
         // instantiates this type.

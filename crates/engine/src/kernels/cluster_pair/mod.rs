@@ -2,7 +2,8 @@
 //! than of particles (the scheme of GROMACS's nbnxm). Particles are sorted into clusters of
 //! neighbours ([`layout`]); the list holds, for each cluster, runs of four consecutive clusters
 //! that cover those whose bounding boxes come within the cutoff plus a skin ([`list`]); each
-//! particle of the cluster meets a run's 16 particles in one SIMD block ([`tile`]). It is kept,
+//! particle of the cluster meets a run's particles (16 in 2-D, 8 in 3-D) in one SIMD block
+//! ([`tile`]; in 3-D for Lennard-Jones, the intrinsics loop of [`batched`]). It is kept,
 //! like the `verlet` list, until some particle has moved more than half the skin since the
 //! build, so the forces are exact at every step.
 //!
@@ -32,6 +33,10 @@
 //! slot (and in a periodic box its continued position); per cluster its box; per run 13 bytes
 //! (its first cluster, shift and four lane masks).
 
+#[cfg_attr(not(target_arch = "x86_64"), allow(unused))]
+mod batched;
+#[cfg(all(test, target_arch = "x86_64"))]
+mod batched_tests;
 mod layout;
 mod list;
 #[cfg(test)]
@@ -57,7 +62,7 @@ use list::Part;
 use plan::{Plan, add_part};
 use rayon::prelude::*;
 use std::time::Instant;
-use tile::{Clusters, Out, TileSum, run_forces};
+use tile::{Clusters, Out, TileSum, add_forces, run_forces};
 
 /// Relative margin of the list radius (as the `verlet` list's): boxes are compared in f64 at
 /// the build and pairs rounded in `T` at every step.
@@ -279,7 +284,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         compared
     }
 
-    /// The forces per padded slot, from every part on this thread.
+    /// The forces per padded slot, from every part on this thread; with `PROBE`, also the
+    /// energy and the pairs inside the cutoff.
     fn serial<const PROBE: bool>(&mut self) -> TileSum {
         let slots = self.layout.clusters() * CLUSTER;
         let mut force = std::mem::replace(&mut self.force, std::array::from_fn(|_| Vec::new()));
@@ -290,23 +296,25 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         let mut out = Out::whole(force.each_mut().map(|f| f.as_mut_slice()));
         let (law, clusters) = (&self.law, Clusters::of(&self.layout));
         let images = self.periodic.as_ref();
-        let mut sum = TileSum::default();
         for k in self.colors.order() {
-            let part = &self.parts[k];
-            // Probe steps are not timed: their loop is compiled once, for the baseline
-            // instruction set, rather than once per set (less to compile).
-            let s = if PROBE {
-                run_forces::<T, L, D, true>(law, &clusters, part, images, &mut out)
-            } else {
-                simd::dispatch(
-                    #[inline(always)]
-                    || run_forces::<T, L, D, false>(law, &clusters, part, images, &mut out),
-                )
-            };
-            sum.energy += s.energy;
-            sum.interacting += s.interacting;
+            add_forces(law, &clusters, &self.parts[k], images, &mut out);
         }
         self.force = force;
+        let mut sum = TileSum::default();
+        if PROBE {
+            // The energy in a second pass, whose forces are dropped: a probe step moves the
+            // particles by the same forces as any other (the batched loop's, where it runs,
+            // differ in the last bits from this one's). Probe steps are not timed: this loop is
+            // compiled once, for the baseline instruction set.
+            let mut scratch: [Vec<T>; D] = std::array::from_fn(|_| vec![T::zero(); slots]);
+            let mut out = Out::whole(scratch.each_mut().map(|f| f.as_mut_slice()));
+            for k in self.colors.order() {
+                let s =
+                    run_forces::<T, L, D, true>(law, &clusters, &self.parts[k], images, &mut out);
+                sum.energy += s.energy;
+                sum.interacting += s.interacting;
+            }
+        }
         sum
     }
 

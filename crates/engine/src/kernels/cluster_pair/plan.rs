@@ -4,7 +4,7 @@
 use super::layout::CLUSTER;
 use super::list::Part;
 use super::run_cost;
-use super::tile::{Clusters, Out, run_forces};
+use super::tile::{Clusters, Out, add_forces};
 use crate::kernels::WorkCounters;
 use crate::kernels::images::Images;
 use crate::kernels::teamed::{Colors, StateView, TeamPlan};
@@ -12,7 +12,7 @@ use crate::kernels::verlet::block_kept_in;
 use crate::par::team::{SharedSlice, Worker, shared};
 use crate::physics::PairLaw;
 use crate::real::Real;
-use crate::simd;
+
 use std::ops::Range;
 
 /// Adds the forces of `part` to the padded slots of `out` its runs touch (near it, and across
@@ -42,10 +42,7 @@ pub(super) unsafe fn add_part<T: Real, L: PairLaw<T>, const D: usize>(
             far: shared::ranges_mut(out, far),
         }
     };
-    simd::dispatch(
-        #[inline(always)]
-        || run_forces::<T, L, D, false>(law, clusters, part, images, &mut out),
-    );
+    add_forces(law, clusters, part, images, &mut out);
 }
 
 /// The cluster list's step in a team region: the displacement test on each worker's block,

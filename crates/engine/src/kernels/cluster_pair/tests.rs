@@ -41,6 +41,11 @@ fn random_2d_f64() {
 }
 
 #[test]
+fn random_3d_f32() {
+    random_states::<f32, 3>();
+}
+
+#[test]
 fn random_3d_f64() {
     random_states::<f64, 3>();
 }

@@ -17,14 +17,14 @@
 
 #[cfg(target_arch = "x86_64")]
 use crate::kernels::lanes::{
-    Avx2F32, Avx2F64, Avx512F32, Avx512F64, Isa, Lanes, is, isa, same, same_mut,
+    Avx2F32, Avx2F64, Avx512F32, Avx512F64, Isa, Lanes, LennardJonesLanes, is, isa, same, same_mut,
 };
 use crate::physics::{InverseSquare, LennardJonesTerms, PairLaw};
 use crate::real::Real;
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{run_avx2, run_avx512};
 use crate::state::State;
-use num_traits::{One, Zero};
+use num_traits::Zero;
 use std::ops::Range;
 
 /// Adds the force of every pair (i, j) with i in `targets` and j > i to both ends in `out`, as
@@ -220,36 +220,6 @@ where
     }
 }
 
-/// `24ε u (1 − 2u) / r²` with `u = (σ²/r²)³`, zero from the cutoff on.
-#[cfg(target_arch = "x86_64")]
-struct LennardJonesLanes<V> {
-    epsilon24: V,
-    sigma2: V,
-    rc2: V,
-    one: V,
-}
-
-#[cfg(target_arch = "x86_64")]
-impl<V: Lanes> LennardJonesLanes<V>
-where
-    V::Elem: Real,
-{
-    /// # Safety
-    /// The caller must have `V`'s features.
-    #[inline(always)]
-    unsafe fn new(t: &LennardJonesTerms<V::Elem>) -> Self {
-        // SAFETY: the caller's features.
-        unsafe {
-            LennardJonesLanes {
-                epsilon24: V::splat(t.epsilon24),
-                sigma2: V::splat(t.sigma2),
-                rc2: V::splat(t.rc2),
-                one: V::splat(V::Elem::one()),
-            }
-        }
-    }
-}
-
 // SAFETY: each method is intrinsics of `V`, run under the caller's features.
 #[cfg(target_arch = "x86_64")]
 unsafe impl<V: Lanes> Coefficient<V> for LennardJonesLanes<V>
@@ -266,14 +236,7 @@ where
     }
     #[inline(always)]
     unsafe fn coeff(&self, r2: V, _sj: V, _ti: V) -> V {
-        // The operations of `LennardJones::coeff`, in its order.
-        unsafe {
-            let ir2 = self.one.div(r2);
-            let s = self.sigma2.mul(ir2);
-            let u = s.mul(s).mul(s);
-            let c = self.epsilon24.mul(ir2).mul(u).mul(self.one.sub(u.add(u)));
-            c.keep_where_less(r2, self.rc2)
-        }
+        unsafe { self.at(r2) }
     }
 }
 
