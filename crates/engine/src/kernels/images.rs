@@ -99,10 +99,11 @@ impl<T: Real, const D: usize> Images<T, D> {
     }
 
     /// `x` (on axis `d`) moved by whole sides to the image nearest `then`: itself when it is
-    /// nearest already.
+    /// nearest already. (Rounded as `⌊v + ½⌋`, one vector instruction, where `round` is a call
+    /// per element; they differ only at exactly half a side, far beyond any list's skin.)
     #[inline(always)]
     pub fn continued(&self, x: T, then: T, d: usize) -> T {
-        x + self.side[d] * ((then - x) * self.inverse[d]).round()
+        x + self.side[d] * ((then - x) * self.inverse[d] + T::of(0.5)).floor()
     }
 
     /// Writes every slot's position wrapped into the box into `out` (the positions of a build).

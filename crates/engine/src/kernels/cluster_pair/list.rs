@@ -221,6 +221,11 @@ pub fn build<T: Real, const D: usize>(
                     let code = code_of(wrap);
                     let shift = f64::from(w_last) * side[last];
                     let (below, above) = (lo_i[last] - reach - shift, hi_i[last] + reach - shift);
+                    if w_last != 0 && (s == e || above < lo[last][s] || below > hi[last][e - 1]) {
+                        // An image along the last axis that the column's clusters do not
+                        // reach: most i-clusters, away from the two faces.
+                        continue;
+                    }
                     // The window of the last i-cluster of this column in `column`, moved to
                     // this one's: the i-clusters of a column come in order along the last
                     // axis, so the windows move a few clusters at a time.

@@ -90,21 +90,28 @@ impl<T: Real, L: PairLaw<T>, const D: usize> TeamPlan<T, D> for Plan<'_, L, T, D
                 shared::ranges_mut(&self.force, block),
             )
         };
-        for (d, x) in pos.into_iter().enumerate() {
-            let (now, then) = (state.pos[d], self.at_build[d]);
-            match self.images {
-                Some(images) => {
-                    for (x, &i) in x.iter_mut().zip(from) {
-                        *x = images.continued(now[i as usize], then[i as usize], d);
+        // Compiled for the instruction set: the rounding of `continued` is one instruction
+        // there and a call per element at the baseline.
+        crate::simd::dispatch(
+            #[inline(always)]
+            || {
+                for (d, x) in pos.into_iter().enumerate() {
+                    let (now, then) = (state.pos[d], self.at_build[d]);
+                    match self.images {
+                        Some(images) => {
+                            for (x, &i) in x.iter_mut().zip(from) {
+                                *x = images.continued(now[i as usize], then[i as usize], d);
+                            }
+                        }
+                        None => {
+                            for (x, &i) in x.iter_mut().zip(from) {
+                                *x = now[i as usize];
+                            }
+                        }
                     }
                 }
-                None => {
-                    for (x, &i) in x.iter_mut().zip(from) {
-                        *x = now[i as usize];
-                    }
-                }
-            }
-        }
+            },
+        );
         for (s, &i) in src.iter_mut().zip(from) {
             *s = state.source[i as usize];
         }
