@@ -1,11 +1,11 @@
 //! `cluster-pair`: the Verlet list of a dense system, made of clusters of four particles rather
 //! than of particles (the scheme of GROMACS's nbnxm). Particles are sorted into clusters of
-//! neighbours ([`layout`]); the list holds, for each cluster, runs of four consecutive clusters
-//! that cover those whose bounding boxes come within the cutoff plus a skin ([`list`]); each
-//! particle of the cluster meets a run's particles (16 in 2-D, 8 in 3-D) in one SIMD block
-//! ([`tile`]; in 3-D for Lennard-Jones, the intrinsics loop of [`batched`]). It is kept,
-//! like the `verlet` list, until some particle has moved more than half the skin since the
-//! build, so the forces are exact at every step.
+//! neighbours ([`layout`]); the list holds, for each cluster, runs of consecutive clusters (four
+//! in 2-D, two in 3-D) that cover those whose bounding boxes come within the cutoff plus a skin
+//! ([`list`]); each particle of the cluster meets a run's particles (16 in 2-D, 8 in 3-D) in one
+//! SIMD block ([`tile`]; in 3-D for Lennard-Jones, the intrinsics loop of [`batched`]). It is
+//! kept, like the `verlet` list, until some particle has moved more than half the skin since
+//! the build, so the forces are exact at every step.
 //!
 //! Against a list of particle pairs it computes more pairs (those of a run beyond the cutoff)
 //! but each far more cheaply: one contiguous load per array instead of gathers, the i-cluster's forces
