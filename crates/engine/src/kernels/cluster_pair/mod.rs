@@ -251,8 +251,14 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ClusterPair<L, T, D> {
         self.parts.resize_with(count, Part::default);
         let (layout, radius, radius2) = (&self.layout, self.radius, self.radius2);
         let images = self.periodic.as_ref();
+        // Equal parts where the last is long enough (2 · reach layers) that the first's reach
+        // back across the faces misses the part before it; else the last one longer.
+        let spread = match layers / count.max(1) >= 2 * reach {
+            true => layers,
+            false => layers.saturating_sub(extra),
+        };
         let cut = |k: usize| match (by_layers, k == count) {
-            (true, false) => layout.layer_start(k * layers.saturating_sub(extra) / count),
+            (true, false) => layout.layer_start(k * spread / count),
             (true, true) => layout.layer_start(layers),
             (false, _) => k * m / count,
         };
