@@ -17,7 +17,7 @@
 
 use super::layout::CLUSTER;
 use super::list::Part;
-use super::tile::{Clusters, Out};
+use super::tile::{Clusters, Out, run_forces};
 use crate::kernels::images::Images;
 #[cfg(target_arch = "x86_64")]
 use crate::kernels::images::no_shift;
@@ -31,6 +31,7 @@ use crate::kernels::rows::lane_sum;
 use crate::physics::LennardJonesTerms;
 use crate::physics::PairLaw;
 use crate::real::Real;
+use crate::simd;
 #[cfg(target_arch = "x86_64")]
 use crate::simd::{run_avx2, run_avx512};
 #[cfg(target_arch = "x86_64")]
@@ -41,6 +42,25 @@ use std::arch::x86_64::*;
 /// Particles of a run in 3-D (two clusters).
 #[cfg(target_arch = "x86_64")]
 const RUN: usize = 8;
+
+/// Adds the forces of `part` to `out` by the fastest loop here: the batched one
+/// ([`add`]) where there is one, else the portable loop compiled for the
+/// instruction set.
+#[inline(always)]
+pub(crate) fn add_forces<T: Real, L: PairLaw<T>, const D: usize>(
+    law: &L,
+    clusters: &Clusters<'_, T, D>,
+    part: &Part,
+    images: Option<&Images<T, D>>,
+    out: &mut Out<'_, T, D>,
+) {
+    if !add(law, clusters, part, images, out) {
+        simd::dispatch(
+            #[inline(always)]
+            || run_forces::<T, L, D, false>(law, clusters, part, images, out),
+        );
+    }
+}
 
 /// Adds the forces of `part` to `out` as the portable loop does, by this machine's batched
 /// loop; `false`, with nothing done, where there is none (another dimension or law, the

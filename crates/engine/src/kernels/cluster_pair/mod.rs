@@ -56,13 +56,14 @@ use crate::physics::PairLaw;
 use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
+use batched::add_forces;
 use layout::Layout;
 use layout::{CLUSTER, Region, group_of};
 use list::Part;
 use plan::{Plan, add_part};
 use rayon::prelude::*;
 use std::time::Instant;
-use tile::{Clusters, Out, TileSum, add_forces, run_forces};
+use tile::{Clusters, Out, TileSum, run_forces};
 
 /// Relative margin of the list radius (as the `verlet` list's): boxes are compared in f64 at
 /// the build and pairs rounded in `T` at every step.

@@ -1,10 +1,11 @@
 //! The cluster list's step in a team region, and a part's forces added into shared padded
 //! slots (the step's and the rayon pool's).
 
+use super::batched::add_forces;
 use super::layout::CLUSTER;
 use super::list::Part;
 use super::run_cost;
-use super::tile::{Clusters, Out, add_forces};
+use super::tile::{Clusters, Out};
 use crate::kernels::WorkCounters;
 use crate::kernels::images::Images;
 use crate::kernels::teamed::{Colors, StateView, TeamPlan};

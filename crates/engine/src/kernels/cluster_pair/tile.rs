@@ -13,7 +13,7 @@ use crate::kernels::images::{Images, no_shift};
 use crate::kernels::rows::lane_sum;
 use crate::physics::PairLaw;
 use crate::real::{Real, select};
-use crate::simd::{self, LANES};
+use crate::simd::LANES;
 
 /// What the tiles of a part add up when probing: energy and pairs inside the cutoff.
 #[derive(Clone, Copy, Debug, Default)]
@@ -67,25 +67,6 @@ impl<'a, T, const D: usize> Out<'a, T, D> {
             false => (&mut self.near[d], js - self.near_base),
         };
         (&mut out[at..at + R]).try_into().expect("runs are whole")
-    }
-}
-
-/// Adds the forces of `part` to `out` by the fastest loop here: the batched one
-/// ([`super::batched`]) where there is one, else the portable loop compiled for the
-/// instruction set.
-#[inline(always)]
-pub(crate) fn add_forces<T: Real, L: PairLaw<T>, const D: usize>(
-    law: &L,
-    clusters: &Clusters<'_, T, D>,
-    part: &Part,
-    images: Option<&Images<T, D>>,
-    out: &mut Out<'_, T, D>,
-) {
-    if !super::batched::add(law, clusters, part, images, out) {
-        simd::dispatch(
-            #[inline(always)]
-            || run_forces::<T, L, D, false>(law, clusters, part, images, out),
-        );
     }
 }
 
