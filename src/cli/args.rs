@@ -20,8 +20,8 @@ use std::path::PathBuf;
     about = "Characterize the performance of particle (N-body) simulation codes",
     long_about = "Characterize the performance of particle (N-body) simulation codes.\n\n\
         An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, \
-        octree, verlet, cluster-pair, fmm) over physical scenarios (lj-box, lj-liquid, coulomb, galaxy), with timers, \
-        work counters and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
+        octree, verlet, cluster-pair, fmm) over physical scenarios (lj-box, lj-liquid, lj-gas, \
+        lj-melt, coulomb, galaxy), with timers, work counters and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
     after_help = "Examples:\n  nbody-bench list\n  nbody-bench sweep --config configs/quick.toml\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
 )]
 pub struct Cli {
@@ -193,7 +193,7 @@ pub struct SystemArgs {
     /// Time step [default: the scenario's].
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     pub dt: Option<f64>,
-    /// Particles per unit area (lj-box, lj-liquid): the box side becomes sqrt(n / density).
+    /// Particles per unit area (per unit volume for lj-melt): the box side becomes (n / density)^(1/D).
     #[arg(long, value_parser = parse_positive, allow_hyphen_values = true)]
     pub density: Option<f64>,
     /// Floating-point precision [default: the scenario's: f32 for LJ, f64 otherwise].
@@ -217,7 +217,7 @@ pub struct StartArgs {
     pub lj: LjArgs,
 }
 
-const LJ_HEADING: &str = "Lennard-Jones (lj-box, lj-liquid)";
+const LJ_HEADING: &str = "Lennard-Jones (lj-box, lj-liquid, lj-gas, lj-melt)";
 
 /// The Lennard-Jones parameters; their help shows the scenario's own constants.
 #[derive(Debug, Args, Clone)]
@@ -235,13 +235,17 @@ pub struct LjArgs {
     pub sigma: Option<f64>,
     #[arg(long = "g", value_parser = parse_float, allow_hyphen_values = true, help_heading = LJ_HEADING, help = lj_help(
         "Downward acceleration of the external field (negative: upward)",
-        format!("{} for lj-box, 0 for lj-liquid", lj::LJ_GRAVITY),
+        format!("{} for lj-box, 0 for the others", lj::LJ_GRAVITY),
     ))]
     pub g: Option<f64>,
     #[arg(long, value_parser = parse_non_negative, allow_hyphen_values = true, help_heading = LJ_HEADING, help = lj_help(
         "Initial temperature: velocity components are drawn from N(0, sqrt(T0)); not with \
          --initial, whose bodies carry their velocities",
-        format!("{}", lj::LJ_T0),
+        format!(
+            "{}, {} for lj-melt",
+            lj::LJ_T0,
+            nbody_engine::scenario::melt::MELT_T0
+        ),
     ))]
     pub t0: Option<f64>,
 }

@@ -77,6 +77,31 @@ fn energy_drift_is_bounded_for_every_scenario() {
             None,
             1e-2,
         ),
+        // The gas in a periodic square: pairs through the faces, slots wrapped by the integrator.
+        (
+            ScenarioKind::LjGas,
+            KernelKind::CellList,
+            500,
+            300,
+            None,
+            2e-3,
+        ),
+        (
+            ScenarioKind::LjGas,
+            KernelKind::Verlet,
+            500,
+            300,
+            None,
+            2e-3,
+        ),
+        (
+            ScenarioKind::LjGas,
+            KernelKind::ClusterPair,
+            500,
+            300,
+            None,
+            2e-3,
+        ),
         (
             ScenarioKind::Galaxy,
             KernelKind::Symmetric,
@@ -144,7 +169,11 @@ fn lammps_melt_drift(n: usize) -> f64 {
 fn the_melt_conserves_energy_within_lammps_drift_on_the_same_state() {
     // 1000 steps of in.lj's time step from the 4000 atoms LAMMPS ran, in f64 as it computes.
     let bound = lammps_melt_drift(4000);
-    for kernel in [KernelKind::Verlet, KernelKind::ClusterPair] {
+    for kernel in [
+        KernelKind::Verlet,
+        KernelKind::ClusterPair,
+        KernelKind::CellList,
+    ] {
         let d = drift_in(
             ScenarioKind::LjMelt,
             kernel,

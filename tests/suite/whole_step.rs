@@ -69,10 +69,12 @@ impl SystemJob for Trajectory {
 
 #[test]
 fn a_cell_list_run_is_bitwise_the_same_at_any_thread_count() {
-    // Walls and the field (lj-box), walls alone (lj-liquid).
+    // Walls and the field (lj-box), walls alone (lj-liquid), periodic boxes (lj-gas, lj-melt).
     for (scenario, precision) in [
         (ScenarioKind::LjBox, Precision::F32),
         (ScenarioKind::LjLiquid, Precision::F64),
+        (ScenarioKind::LjGas, Precision::F32),
+        (ScenarioKind::LjMelt, Precision::F64),
     ] {
         let run = |threads| {
             setup(scenario, precision)
@@ -101,8 +103,10 @@ fn a_list_run_is_bitwise_the_same_on_one_two_and_three_workers() {
         // The periodic melt: slots wrapped across the faces between rebuilds, a list whose
         // first part reaches across them into the last.
         (KernelKind::Verlet, ScenarioKind::LjMelt),
+        (KernelKind::Verlet, ScenarioKind::LjGas),
         (KernelKind::ClusterPair, ScenarioKind::LjBox),
         (KernelKind::ClusterPair, ScenarioKind::LjLiquid),
+        (KernelKind::ClusterPair, ScenarioKind::LjGas),
         (KernelKind::ClusterPair, ScenarioKind::LjMelt),
     ];
     for (kernel, scenario) in cases {

@@ -163,7 +163,7 @@ impl KernelKind {
     pub fn periodic_form(self) -> bool {
         matches!(
             self,
-            KernelKind::Naive | KernelKind::Verlet | KernelKind::ClusterPair
+            KernelKind::Naive | KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair
         )
     }
 
@@ -402,7 +402,7 @@ pub enum KernelError {
     BadParam(String),
     /// The kernel has no periodic form (yet): the system's box is periodic.
     #[error(
-        "kernel `{kernel}` does not sum pairs through periodic boundaries; kernels that do: naive, verlet"
+        "kernel `{kernel}` does not sum pairs through periodic boundaries; kernels that do: naive, cell-list, verlet, cluster-pair"
     )]
     NotPeriodic {
         /// The kernel's name.

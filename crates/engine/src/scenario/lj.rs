@@ -1,4 +1,4 @@
-//! The Lennard-Jones scenarios (`lj-box`, `lj-liquid`): their constants, the parameters a run
+//! The 2-D Lennard-Jones scenarios (`lj-box`, `lj-liquid`, `lj-gas`): their constants, the parameters a run
 //! may change (`run --epsilon --sigma --g --t0`), and the system they build.
 //!
 //! The constants here are the defaults the command line shows: a change to one changes both the
@@ -122,7 +122,8 @@ pub fn default_gravity(scenario: ScenarioKind) -> f64 {
 }
 
 /// The Lennard-Jones system of `setup`: the bodies of its initial file, or a seeded placement at
-/// minimum spacing σ with velocities at temperature T0, in the walled box of side √(n/ρ).
+/// minimum spacing σ with velocities at temperature T0, in the box of side √(n/ρ): walled, or
+/// periodic for the gas.
 pub(super) fn build<T: Real>(setup: &Setup) -> Result<System<T, LennardJones<T>, 2>, SetupError> {
     let lj = setup.lj;
     let density = setup.density().expect("LJ scenarios have a density");
@@ -135,9 +136,16 @@ pub(super) fn build<T: Real>(setup: &Setup) -> Result<System<T, LennardJones<T>,
     Ok(System {
         state,
         law: LennardJones::new(lj.epsilon(), lj.sigma(), lj.cutoff()),
-        boundary: Boundary::Reflecting {
-            lo: [T::zero(); 2],
-            hi: [T::of(side); 2],
+        boundary: if setup.scenario.periodic() {
+            Boundary::Periodic {
+                lo: [T::zero(); 2],
+                hi: [T::of(side); 2],
+            }
+        } else {
+            Boundary::Reflecting {
+                lo: [T::zero(); 2],
+                hi: [T::of(side); 2],
+            }
         },
         external: [T::zero(), T::of(-lj.g(setup.scenario))],
         dt: T::of(setup.dt()),
@@ -153,7 +161,14 @@ fn generated<T: Real>(setup: &Setup, side: f64) -> Result<State<T, 2>, SetupErro
         // Random sequential placement jams near packing fraction 0.55; the liquid
         // (0.63) starts from a jittered lattice instead.
         ScenarioKind::LjLiquid => placement::jittered_lattice(setup.n(), side, sigma, &mut rng),
-        _ => placement::spaced_uniform(setup.n(), side, sigma, setup.allow_fewer, &mut rng)?,
+        kind => placement::spaced_uniform(
+            setup.n(),
+            side,
+            sigma,
+            setup.allow_fewer,
+            kind.periodic(),
+            &mut rng,
+        )?,
     };
     let mut state = State::<T, 2>::new(positions.len());
     let normal = Normal::new(0.0, setup.lj.t0().sqrt()).expect("T0 was validated");

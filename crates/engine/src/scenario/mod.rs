@@ -37,6 +37,9 @@ pub enum ScenarioKind {
     LjBox,
     /// 2-D Lennard-Jones liquid (reduced density 0.8) in a walled box, no field.
     LjLiquid,
+    /// 2-D Lennard-Jones gas at lj-box's density in a periodic square, no field: the gas as the
+    /// codes of the field run it (no walls).
+    LjGas,
     /// 3-D Lennard-Jones melt of LAMMPS's `bench/in.lj`: fcc lattice at reduced density
     /// 0.8442, T0 = 1.44, periodic cube, no field.
     LjMelt,
@@ -48,9 +51,10 @@ pub enum ScenarioKind {
 
 impl ScenarioKind {
     /// Every scenario, in the order `list` and `validate` go through them.
-    pub const ALL: [ScenarioKind; 5] = [
+    pub const ALL: [ScenarioKind; 6] = [
         ScenarioKind::LjBox,
         ScenarioKind::LjLiquid,
+        ScenarioKind::LjGas,
         ScenarioKind::LjMelt,
         ScenarioKind::Coulomb,
         ScenarioKind::Galaxy,
@@ -61,6 +65,7 @@ impl ScenarioKind {
         match self {
             ScenarioKind::LjBox => "lj-box",
             ScenarioKind::LjLiquid => "lj-liquid",
+            ScenarioKind::LjGas => "lj-gas",
             ScenarioKind::LjMelt => "lj-melt",
             ScenarioKind::Coulomb => "coulomb",
             ScenarioKind::Galaxy => "galaxy",
@@ -70,19 +75,20 @@ impl ScenarioKind {
     /// The pair law its particles interact by.
     pub fn law(self) -> LawKind {
         match self {
-            ScenarioKind::LjBox | ScenarioKind::LjLiquid | ScenarioKind::LjMelt => {
-                LawKind::LennardJones
-            }
+            ScenarioKind::LjBox
+            | ScenarioKind::LjLiquid
+            | ScenarioKind::LjGas
+            | ScenarioKind::LjMelt => LawKind::LennardJones,
             ScenarioKind::Coulomb => LawKind::Coulomb,
             ScenarioKind::Galaxy => LawKind::Gravity,
         }
     }
 
-    /// Spatial dimension: 2 for the walled Lennard-Jones boxes, 3 for the melt, coulomb and
-    /// galaxy.
+    /// Spatial dimension: 2 for the Lennard-Jones boxes and the gas, 3 for the melt, coulomb
+    /// and galaxy.
     pub fn dim(self) -> usize {
         match self {
-            ScenarioKind::LjBox | ScenarioKind::LjLiquid => 2,
+            ScenarioKind::LjBox | ScenarioKind::LjLiquid | ScenarioKind::LjGas => 2,
             ScenarioKind::LjMelt | ScenarioKind::Coulomb | ScenarioKind::Galaxy => 3,
         }
     }
@@ -90,7 +96,7 @@ impl ScenarioKind {
     /// Particle count, time step, precision and density used where the user gives none.
     pub fn defaults(self) -> Defaults {
         match self {
-            ScenarioKind::LjBox => Defaults {
+            ScenarioKind::LjBox | ScenarioKind::LjGas => Defaults {
                 n: 500,
                 dt: 1e-4,
                 precision: Precision::F32,
@@ -126,7 +132,7 @@ impl ScenarioKind {
 
     /// Whether the scenario's box is periodic (pairs meet through nearest images).
     pub fn periodic(self) -> bool {
-        self == ScenarioKind::LjMelt
+        matches!(self, ScenarioKind::LjGas | ScenarioKind::LjMelt)
     }
 
     /// The largest particle count of at most `n` the scenario builds (the melt's lattices hold
@@ -150,6 +156,9 @@ impl ScenarioKind {
                 "2-D LJ gas, sigma=0.01, rc=2.5 sigma, walls, g=1, T0=1 (the LJ-box assignment)"
             }
             ScenarioKind::LjLiquid => "2-D LJ liquid, reduced density 0.8, walls, no field",
+            ScenarioKind::LjGas => {
+                "2-D LJ gas at lj-box's density, sigma=0.01, rc=2.5 sigma, periodic, no field, T0=1"
+            }
             ScenarioKind::LjMelt => {
                 "3-D LJ melt, fcc at reduced density 0.8442, T0=1.44, periodic (LAMMPS's bench/in.lj); n = 4k^3"
             }
@@ -299,7 +308,8 @@ pub enum SetupError {
     /// A Lennard-Jones option was given to a scenario of another law: the flag and the scenario's
     /// name.
     #[error(
-        "{flag} applies to the Lennard-Jones scenarios (lj-box, lj-liquid) only; scenario `{1}` \
+        "{flag} applies to the Lennard-Jones scenarios (lj-box, lj-liquid, lj-gas, lj-melt) only; \
+         scenario `{1}` \
          has no such parameter: drop it", flag = .0
     )]
     NotLj(&'static str, &'static str),
@@ -445,7 +455,7 @@ impl Setup {
                 });
             }
         }
-        if let (ScenarioKind::LjMelt, Some(density)) = (self.scenario, self.density()) {
+        if let (true, Some(density)) = (self.scenario.periodic(), self.density()) {
             // Every pair meets through its nearest image only: no two images of a particle
             // may both lie within the cutoff.
             let (side, rc) = (self.box_side(density), self.lj.cutoff());
@@ -469,12 +479,14 @@ impl Setup {
     pub fn dispatch<J: SystemJob>(&self, job: J) -> Result<J::Output, SetupError> {
         self.validate()?;
         Ok(match (self.scenario, self.precision()) {
-            (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F32) => {
-                job.run(lj::build::<f32>(self)?)
-            }
-            (ScenarioKind::LjBox | ScenarioKind::LjLiquid, Precision::F64) => {
-                job.run(lj::build::<f64>(self)?)
-            }
+            (
+                ScenarioKind::LjBox | ScenarioKind::LjLiquid | ScenarioKind::LjGas,
+                Precision::F32,
+            ) => job.run(lj::build::<f32>(self)?),
+            (
+                ScenarioKind::LjBox | ScenarioKind::LjLiquid | ScenarioKind::LjGas,
+                Precision::F64,
+            ) => job.run(lj::build::<f64>(self)?),
             (ScenarioKind::LjMelt, Precision::F32) => job.run(melt::build::<f32>(self)?),
             (ScenarioKind::LjMelt, Precision::F64) => job.run(melt::build::<f64>(self)?),
             (ScenarioKind::Coulomb, Precision::F32) => job.run(self.coulomb::<f32>()),

@@ -22,7 +22,8 @@ pub struct PlacementError {
 /// Attempts per particle before giving up on random placement.
 const ATTEMPTS: usize = 200;
 
-/// Uniform random positions in `[0, side)²`, no two closer than `min_dist`.
+/// Uniform random positions in `[0, side)²`, no two closer than `min_dist` (in a periodic box,
+/// through the faces too: between nearest images).
 ///
 /// Rejection sampling against a grid of cells of side ≥ `min_dist` holding the particles placed
 /// so far, so each candidate is checked against its 3×3 neighbourhood only: O(n) overall.
@@ -31,6 +32,7 @@ pub(crate) fn spaced_uniform(
     side: f64,
     min_dist: f64,
     allow_fewer: bool,
+    periodic: bool,
     rng: &mut impl Rng,
 ) -> Result<Vec<[f64; 2]>, PlacementError> {
     let cells = ((side / min_dist).floor() as usize).clamp(1, 1 << 15);
@@ -49,8 +51,8 @@ pub(crate) fn spaced_uniform(
             let p = [rng.random::<f64>() * side, rng.random::<f64>() * side];
             let (cx, cy) = (cell_of(p[0]), cell_of(p[1]));
             let mut ok = true;
-            'check: for gy in cy.saturating_sub(1)..=(cy + 1).min(cells - 1) {
-                for gx in cx.saturating_sub(1)..=(cx + 1).min(cells - 1) {
+            'check: for gy in neighbours(cy, cells, periodic) {
+                for gx in neighbours(cx, cells, periodic) {
                     let Some(slots) = grid.get(&(gx, gy)) else {
                         continue;
                     };
@@ -59,7 +61,15 @@ pub(crate) fn spaced_uniform(
                             break;
                         }
                         let q = pts[k as usize];
-                        if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) < min2 {
+                        let gap = |d: usize| {
+                            let g = p[d] - q[d];
+                            if periodic {
+                                g - side * (g / side).round()
+                            } else {
+                                g
+                            }
+                        };
+                        if gap(0).powi(2) + gap(1).powi(2) < min2 {
                             ok = false;
                             break 'check;
                         }
@@ -87,6 +97,19 @@ pub(crate) fn spaced_uniform(
         });
     }
     Ok(pts)
+}
+
+/// The cells next to cell `c` of `cells` along an axis, and `c` itself: each once, through the
+/// faces when `periodic`.
+fn neighbours(c: usize, cells: usize, periodic: bool) -> impl Iterator<Item = usize> {
+    let (lo, hi) = if periodic && cells >= 3 {
+        (c + cells - 1, c + cells + 1)
+    } else if periodic {
+        (0, cells - 1)
+    } else {
+        (c.saturating_sub(1), (c + 1).min(cells - 1))
+    };
+    (lo..=hi).map(move |k| k % cells)
 }
 
 /// `n` positions on a square lattice filling `[0, side)²`, each displaced by up to ±5% of
@@ -137,20 +160,60 @@ mod tests {
     #[test]
     fn uniform_placement_respects_spacing_and_box() {
         let mut rng = Pcg64Mcg::seed_from_u64(3);
-        let p = spaced_uniform(2000, 2.0, 0.01, false, &mut rng).unwrap();
+        let p = spaced_uniform(2000, 2.0, 0.01, false, false, &mut rng).unwrap();
         assert_eq!(p.len(), 2000);
         assert!(min_distance(&p) >= 0.01);
         assert!(p.iter().all(|q| q.iter().all(|&x| (0.0..2.0).contains(&x))));
     }
 
     #[test]
+    fn periodic_placement_keeps_the_spacing_through_the_faces() {
+        let (side, min) = (1.0, 0.02);
+        let nearest = |p: &[[f64; 2]]| {
+            let mut m = f64::INFINITY;
+            for i in 0..p.len() {
+                for j in 0..i {
+                    let gap = |d: usize| {
+                        let g = p[i][d] - p[j][d];
+                        g - side * (g / side).round()
+                    };
+                    m = m.min((gap(0).powi(2) + gap(1).powi(2)).sqrt());
+                }
+            }
+            m
+        };
+        // Dense enough that the open placement puts pairs closer than `min` across a face.
+        let open = spaced_uniform(
+            1000,
+            side,
+            min,
+            false,
+            false,
+            &mut Pcg64Mcg::seed_from_u64(5),
+        );
+        assert!(nearest(&open.unwrap()) < min);
+        let p = spaced_uniform(
+            1000,
+            side,
+            min,
+            false,
+            true,
+            &mut Pcg64Mcg::seed_from_u64(5),
+        );
+        assert!(nearest(&p.unwrap()) >= min);
+        // Fewer than three cells along a side: each neighbour cell is checked once.
+        let p = spaced_uniform(3, 0.05, min, false, true, &mut Pcg64Mcg::seed_from_u64(5));
+        assert!(nearest(&p.unwrap()) >= min);
+    }
+
+    #[test]
     fn overfull_box_reports_how_many_were_placed() {
         let mut rng = Pcg64Mcg::seed_from_u64(3);
-        let err = spaced_uniform(20_000, 1.0, 0.01, false, &mut rng).unwrap_err();
+        let err = spaced_uniform(20_000, 1.0, 0.01, false, false, &mut rng).unwrap_err();
         assert!(err.placed > 3000 && err.placed < 20_000, "{}", err.placed);
         assert!(err.to_string().contains("--allow-fewer"));
         let mut rng = Pcg64Mcg::seed_from_u64(3);
-        let p = spaced_uniform(20_000, 1.0, 0.01, true, &mut rng).unwrap();
+        let p = spaced_uniform(20_000, 1.0, 0.01, true, false, &mut rng).unwrap();
         assert_eq!(p.len(), err.placed);
     }
 

@@ -8,7 +8,7 @@ use crate::real::Real;
 /// Relative margin of the bin side over the cutoff. The bin of a particle is computed in f64 and
 /// the pair distance in `T`; the margin keeps a pair that `T` rounding places just inside the
 /// cutoff from landing two bins apart (f32 rounds `r²` by a few parts in 1e7).
-const SIDE_MARGIN: f64 = 1e-5;
+pub(super) const SIDE_MARGIN: f64 = 1e-5;
 
 /// Most bins per particle (plus a constant for tiny systems). A dilute gas of side-`rc` bins
 /// needs ~3 per particle; a few far-flung particles must not make the grid huge, so beyond this

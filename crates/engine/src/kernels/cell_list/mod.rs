@@ -13,11 +13,18 @@
 //! SIMD pair loop per target matters: a call has a fixed cost (summing its SIMD lanes, ~10 ns)
 //! comparable to all the pairs of a dilute gas, where a particle has ~3 candidates.
 //!
+//! In a periodic box ([`ForceKernel::set_periodic`]) the particles near the faces are copied
+//! across them ([`ghosts`]) and the same bins and loop run over the particles and their copies.
+//!
 //! Memory, allocated on first use and reused: 3 copies of positions and strengths (plus
-//! padding), 16 bytes per particle and 8 bytes per bin (at most 4 bins per particle).
+//! padding), 16 bytes per particle and 8 bytes per bin (at most 4 bins per particle); in a
+//! periodic box, the ghosts' too.
 
 mod forces;
+mod ghosts;
 pub(super) mod grid;
+#[cfg(test)]
+mod periodic_tests;
 pub(super) mod strips;
 #[cfg(test)]
 mod tests;
@@ -29,17 +36,20 @@ use crate::real::Real;
 use crate::simd;
 use crate::state::{Field, State};
 use forces::targets as gather_targets;
+use ghosts::Ghosts;
 use std::ops::Range;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 use strips::Strips;
 
 /// The `cell-list` kernel for the short-range law `L` (see the module doc).
-pub struct CellList<L, T, const D: usize> {
+pub struct CellList<L, T: Real, const D: usize> {
     law: L,
     /// The cutoff, in f64 for the bin geometry.
     rc: f64,
     strips: Strips<T, D>,
+    /// The periodic box and the particles' copies across its faces, when periodic.
+    periodic: Option<Ghosts<T, D>>,
 }
 
 impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
@@ -68,6 +78,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
             law,
             rc,
             strips: Strips::new(),
+            periodic: None,
         })
     }
 
@@ -75,8 +86,32 @@ impl<L: PairLaw<T>, T: Real, const D: usize> CellList<L, T, D> {
     /// phase of [`ForceKernel::compute`] alone, for benchmarks. Per particle, in parallel over
     /// chunks of particles when they are many.
     pub fn build(&mut self, state: &State<T, D>) {
-        self.strips.sort(state, self.rc);
-        self.strips.fill(state);
+        self.built(state);
+    }
+
+    /// Builds the step's structure (in a periodic box, the ghosts first) and lends what the
+    /// force loop reads: the law, the strips and the sources, whose first slots are `state`'s
+    /// particles.
+    fn built<'a>(
+        &'a mut self,
+        state: &'a State<T, D>,
+    ) -> (&'a L, &'a Strips<T, D>, &'a State<T, D>) {
+        let CellList {
+            law,
+            rc,
+            strips,
+            periodic,
+        } = self;
+        let sources = match periodic {
+            Some(ghosts) => {
+                ghosts.fill(state);
+                &ghosts.sources
+            }
+            None => state,
+        };
+        strips.sort(sources, *rc);
+        strips.fill(sources);
+        (law, strips, sources)
     }
 }
 
@@ -118,12 +153,11 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
             };
         }
         let clock = Instant::now();
-        self.build(state);
+        let (law, strips, sources) = self.built(state);
         let build_s = clock.elapsed().as_secs_f64();
-        let (law, strips) = (&self.law, &self.strips);
         let (total, work) = simd::dispatch(
             #[inline(always)]
-            || gather_targets::<T, L, D, true>(law, strips, state, 0, out),
+            || gather_targets::<T, L, D, true>(law, strips, sources, 0, out),
         );
         ForceReport {
             // Each pair was seen from both ends.
@@ -149,11 +183,10 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
             return report;
         }
         let clock = Instant::now();
-        self.build(state);
+        let (law, strips, sources) = self.built(state);
         report.build_s = clock.elapsed().as_secs_f64();
 
-        let (law, strips) = (&self.law, &self.strips);
-        let candidates = strips.expected_candidates() / n as u64 * targets.len() as u64;
+        let candidates = strips.expected_candidates() / sources.len() as u64 * targets.len() as u64;
         if worth_parallel(step_work(targets.len(), candidates)) {
             let pair_checks = AtomicU64::new(0);
             let cells_visited = AtomicU64::new(0);
@@ -161,7 +194,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
             for_chunks(out, targets.start, chunk, &|offset, chunk| {
                 let (_, work) = simd::dispatch(
                     #[inline(always)]
-                    || gather_targets::<T, L, D, false>(law, strips, state, offset, chunk),
+                    || gather_targets::<T, L, D, false>(law, strips, sources, offset, chunk),
                 );
                 pair_checks.fetch_add(work.pair_checks, Ordering::Relaxed);
                 cells_visited.fetch_add(work.cells_visited, Ordering::Relaxed);
@@ -174,7 +207,7 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
         } else {
             let (_, work) = simd::dispatch(
                 #[inline(always)]
-                || gather_targets::<T, L, D, false>(law, strips, state, targets.start, out),
+                || gather_targets::<T, L, D, false>(law, strips, sources, targets.start, out),
             );
             report.work = work;
         }
@@ -184,5 +217,17 @@ impl<T: Real, L: PairLaw<T>, const D: usize> ForceKernel<T, D> for CellList<L, T
     fn spatial_order(&mut self, state: &State<T, D>) -> Option<Vec<u32>> {
         self.strips.sort(state, self.rc);
         Some(self.strips.order())
+    }
+
+    fn set_periodic(&mut self, lo: [T; D], hi: [T; D]) -> Result<(), KernelError> {
+        let ghosts = Ghosts::new(lo, hi, self.rc).map_err(|(d, least)| {
+            KernelError::PeriodicBoxTooSmall(format!(
+                "cell-list in a periodic box needs every side longer than twice the cutoff \
+                 ({least:.6}); side {d} is {:.6}: use more particles or a lower density",
+                (hi[d] - lo[d]).as_f64()
+            ))
+        })?;
+        self.periodic = Some(ghosts);
+        Ok(())
     }
 }

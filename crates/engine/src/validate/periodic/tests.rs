@@ -214,3 +214,49 @@ fn a_box_too_small_for_nearest_images_or_a_law_without_cutoff_is_refused() {
         PeriodicReferenceError::NoCutoff
     );
 }
+
+#[test]
+fn a_pair_through_a_face_of_a_wide_f32_box_differs_between_kernels_within_the_image_rounding() {
+    use crate::kernels::{KernelKind, KernelParams};
+    // A pair 0.9σ apart through the face of a box 400σ wide: in f32 the partner's image (near
+    // 400) keeps about 3e-5 of a σ; the steep repulsion turns that into a relative force change
+    // far above the summation's 1000 ε.
+    let (side, lo, hi) = ([400.0f64; 2], [0.0f32; 2], [400.0f32; 2]);
+    let law = LennardJones::<f32>::new(1.0, 1.0, 2.5);
+    let mut state = State::<f32, 2>::new(2);
+    state.pos[0] = vec![0.3137, 399.4137 + 0.0011];
+    state.pos[1] = vec![200.125, 200.125];
+    let forces = |kind: KernelKind| {
+        let mut k = kind
+            .build::<f32, _, 2>(law, &KernelParams::default())
+            .unwrap();
+        k.set_periodic(lo, hi).unwrap();
+        let mut f = zero_field::<f32, 2>(2);
+        k.compute(&state, &mut f, false);
+        f[0][0] as f64
+    };
+    let naive = forces(KernelKind::Naive);
+    let delta = image_rounding_delta(f32::EPSILON as f64, [0.0; 2], [400.0; 2]);
+    let wide = state.convert::<f64>();
+    let wide_law = LennardJones::<f64>::new(1.0, 1.0, 2.5);
+    let allowed = image_rounding(&wide_law, &wide, side, delta);
+    let (_, _, abs_sum) = periodic_reference_forces(&wide_law, &wide, side).unwrap();
+    assert!(allowed[0] > 1000.0 * f32::EPSILON as f64 * abs_sum[0]);
+    assert_eq!(allowed[0], allowed[1]);
+    for kind in [
+        KernelKind::CellList,
+        KernelKind::Verlet,
+        KernelKind::ClusterPair,
+    ] {
+        let got = forces(kind);
+        assert!(
+            (got - naive).abs() <= 2.0 * allowed[0],
+            "{kind:?}: {got} vs naive {naive}, allowed {}",
+            2.0 * allowed[0]
+        );
+    }
+    // Beyond the cutoff and the rounding, nothing.
+    state.pos[0] = vec![1.0, 396.0];
+    let far = image_rounding(&wide_law, &state.convert::<f64>(), side, delta);
+    assert_eq!(far, vec![0.0, 0.0]);
+}
