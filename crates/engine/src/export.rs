@@ -35,8 +35,8 @@ pub enum ExportFormat {
 pub enum ExportError {
     /// lammps-data for a scenario of another law: the scenario's name and its law's parameters.
     #[error(
-        "the lammps-data format is for the Lennard-Jones scenarios (lj-box, lj-liquid); scenario \
-         `{0}` has {1}: use --format text or npy"
+        "the lammps-data format is for the Lennard-Jones scenarios (lj-box, lj-liquid, lj-gas, \
+         lj-melt); scenario `{0}` has {1}: use --format text or npy"
     )]
     NotLj(&'static str, String),
     /// lammps-data with unequal masses, which one atom type cannot hold; holds a particle's index.
