@@ -570,8 +570,10 @@ pub struct FitArgs {
 #[command(
     long_about = "Compare this build's timings with a baseline, case by case; exit 1 if a case got \
         slower beyond the threshold (at a family-wise error of 2.5% over all the cases judged, \
-        Holm's step-down on bootstrap p-values), 2 for bad input or a comparison that cannot \
-        be made.\n\n\
+        Holm's step-down on one-sided t p-values), 2 for bad input or a comparison that cannot \
+        be made. Each case is regressed, improved, unchanged (its 90% interval within twice the \
+        threshold) or unknown (neither: named in the report, with how to measure more; not a \
+        failure).\n\n\
         The baseline is a results file or a folder of them, one per machine class (CPU model, \
         CPU signature, logical CPUs): from a folder the gate takes the file of the class it \
         compares with, else the newest.\n\n\
@@ -581,7 +583,10 @@ pub struct FitArgs {
         it was resolved when measured) with this build; if the baseline comes from this \
         machine class and this build reproduces it, it is compared with the baseline file (the \
         fast path), else (another class, or a stale baseline: the gate says why) the gate builds the baseline's revision (a git worktree, cached in \
-        target/gate-base/) and measures both builds here, interleaved case by case (A/B);\n\
+        target/gate-base/) and measures both builds here, interleaved case by case (A/B): each \
+        round of a case gives one paired log-ratio of the two builds, and the cases a first \
+        look of --rounds rounds leaves undecided get --rounds more at a time, up to \
+        --max-rounds;\n\
         - with --against REV: always A/B against REV.\n\n\
         --save-baseline RESULTS files a sweep of the baseline's config as this machine class's \
         baseline (scripts/refresh-baseline.sh does it from a fresh sweep). A baseline never \
@@ -632,10 +637,15 @@ pub struct GateArgs {
     /// The config to measure when the gate measures [default: the baseline's own config].
     #[arg(long, value_name = "FILE|NAME", conflicts_with = "current")]
     pub config: Option<PathBuf>,
-    /// Rounds of every case per build in an A/B run: even (each build goes first as often),
-    /// from 2 to 100.
+    /// Rounds of every case per build in an A/B run's first look: even (each build goes first
+    /// as often), from 2 to 100.
     #[arg(long, default_value_t = nbody_harness::gate::AB_ROUNDS, value_parser = parse_ab_rounds, conflicts_with = "current")]
     pub rounds: usize,
+    /// Most rounds per build a case still undecided after the first look is measured to, in
+    /// looks of --rounds more each (at least --rounds; equal to it judges once). The run's
+    /// family-wise error is split evenly over its looks.
+    #[arg(long, default_value_t = nbody_harness::gate::AB_MAX_ROUNDS, value_parser = parse_ab_rounds, conflicts_with = "current")]
+    pub max_rounds: usize,
     /// Longest one build's sweep of one case may take in an A/B run, seconds (also the limit
     /// of asking the base binary for its options) [default: 10 times the case's estimate, at
     /// least 120 s]; a child past its limit is stopped and the gate exits 2. The base build has
@@ -645,11 +655,11 @@ pub struct GateArgs {
     /// Where a measuring gate keeps what it measured [default: results/runs/gate/<UTC time>/].
     #[arg(long, value_name = "DIR", conflicts_with = "current")]
     pub out: Option<PathBuf>,
-    /// Relative slowdown a case must exceed to count as a regression (0.03 = 3%), at a
+    /// Relative slowdown a case must exceed to count as a regression (0.02 = 2%), at a
     /// family-wise error of 2.5% over all the cases judged (Holm); the same margin below 1
-    /// counts as an improvement [default: 0.03 for A/B runs, 0.10 when the gate compares with
-    /// a baseline file measured at another time (the fast path, and two files): the smallest
-    /// margins with no false alarm in the gate's noise study]; at most 1 (a doubling).
+    /// counts as an improvement [default: 0.02 for A/B runs, 0.10 when the gate compares with
+    /// a baseline file measured at another time (the fast path, and two files), chosen from
+    /// the gate's noise study, docs/explanation/gate.md]; at most 1 (a doubling).
     #[arg(long, value_parser = parse_threshold, allow_hyphen_values = true)]
     pub threshold: Option<f64>,
     /// Output format; markdown is made for a CI job summary.

@@ -13,6 +13,7 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
         against: args.against.clone(),
         config: args.config.clone(),
         rounds: args.rounds,
+        max_rounds: args.max_rounds,
         timeout: args.timeout,
         out: args.out.clone(),
         threshold: args.threshold,

@@ -266,101 +266,166 @@ pub fn samples_per_round(config: &SweepConfig, rounds: usize) -> usize {
         .max(2)
 }
 
-/// Measures every case of the plan with both builds, interleaved.
+/// Measures every case of the plan with both builds, interleaved, `plan.rounds` rounds each.
 pub fn measure(plan: &AbPlan<'_>, progress: &mut dyn FnMut(&str)) -> Result<AbResults, AbError> {
-    check_rounds(plan.rounds)?;
-    // A base that estimates a sweep's length before starting it (as this build does) is told
-    // not to, like this build, so that neither side does extra work before its samples.
-    let probe_limit = plan
-        .cases
-        .first()
-        .map_or(CHILD_FLOOR, |c| (plan.limit)(&c.case));
-    // Either side may be an older build (a bisection measures two of them): each is asked.
-    let yes = [
-        takes_yes(&plan.base.path, probe_limit)?,
-        takes_yes(plan.current, probe_limit)?,
-    ];
-    let planned: Vec<&Case> = plan.cases.iter().map(|c| &c.case).collect();
-    let logical = nbody_engine::run::logical_cpus();
-    let mut merged: [Vec<CaseRecord>; 2] = [Vec::new(), Vec::new()];
-    for side in &mut merged {
-        *side = planned
-            .iter()
-            .map(|c| CaseRecord::new((*c).clone(), plan.rounds, logical))
-            .collect();
+    let mut run = AbRun::start(plan)?;
+    let all: Vec<usize> = (0..plan.cases.len()).collect();
+    run.extend(plan, &all, plan.rounds, progress)?;
+    Ok(run.results(plan))
+}
+
+/// An A/B run in progress: both builds' rounds of every case so far, so that the cases a look
+/// left undecided can be measured further ([`super::sequential`]).
+pub struct AbRun {
+    merged: [Vec<CaseRecord>; 2],
+    metadata: [Option<nbody_records::results::Metadata>; 2],
+    takes_yes: [bool; 2],
+    started: std::time::Instant,
+}
+
+impl AbRun {
+    /// Asks both builds how their sweep is started; nothing is measured yet.
+    pub fn start(plan: &AbPlan<'_>) -> Result<AbRun, AbError> {
+        // A base that estimates a sweep's length before starting it (as this build does) is
+        // told not to, like this build, so that neither side does extra work before its samples.
+        let probe_limit = plan
+            .cases
+            .first()
+            .map_or(CHILD_FLOOR, |c| (plan.limit)(&c.case));
+        // Either side may be an older build (a bisection measures two of them): each is asked.
+        let takes_yes = [
+            takes_yes(&plan.base.path, probe_limit)?,
+            takes_yes(plan.current, probe_limit)?,
+        ];
+        let logical = nbody_engine::run::logical_cpus();
+        let records = || -> Vec<CaseRecord> {
+            plan.cases
+                .iter()
+                .map(|c| CaseRecord::new(c.case.clone(), 0, logical))
+                .collect()
+        };
+        Ok(AbRun {
+            merged: [records(), records()],
+            metadata: [None, None],
+            takes_yes,
+            started: std::time::Instant::now(),
+        })
     }
-    let mut metadata = [None, None];
-    let started = std::time::Instant::now();
-    for round in 0..plan.rounds {
-        progress(&format!(
-            "A/B round {}/{}: {} cases, {} then {} first in turn ({:.0} s so far)",
-            round + 1,
-            plan.rounds,
-            planned.len(),
-            Side::Base.name(),
-            Side::Current.name(),
-            started.elapsed().as_secs_f64()
-        ));
-        let mut indices: Vec<usize> = (0..planned.len()).collect();
-        if round % 2 == 1 {
-            indices.reverse();
-        }
-        for i in indices {
-            let text = &plan.cases[i].text;
-            for side in order(round, i) {
-                let dir = plan
-                    .work
-                    .join(side.name())
-                    .join(format!("case{i}-round{round}"));
-                let file = run_side(
-                    plan,
-                    side,
-                    text,
-                    &dir,
-                    planned[i],
-                    round,
-                    yes[side as usize],
-                )?;
-                let slot = side as usize;
-                metadata[slot].get_or_insert_with(|| file.metadata.clone());
-                let record = file
-                    .cases
-                    .into_iter()
-                    .find(|c| c.key == planned[i].key())
-                    .ok_or_else(|| AbError::Side {
-                        side: side.name(),
-                        key: planned[i].key(),
-                        round,
-                        tail: "its results file has no such case".to_string(),
-                    })?;
-                merged[slot][i].absorb(record, plan.config.measure.max_energy_drift);
-                // The one-case sweep's files have been merged; keep the scratch small.
-                let _ = std::fs::remove_dir_all(&dir);
+
+    /// Rounds per build measured so far of case `index`.
+    pub fn rounds_of(&self, index: usize) -> usize {
+        self.merged[0][index].rounds.len()
+    }
+
+    /// Measures the cases `open` (indices into the plan's cases) until each has `until`
+    /// rounds per build: round by round, every open case by both builds back to back, the
+    /// builds' order alternating and the cases' order reversed every round.
+    pub fn extend(
+        &mut self,
+        plan: &AbPlan<'_>,
+        open: &[usize],
+        until: usize,
+        progress: &mut dyn FnMut(&str),
+    ) -> Result<(), AbError> {
+        let from = open
+            .iter()
+            .map(|&i| self.rounds_of(i))
+            .min()
+            .unwrap_or(until);
+        for round in from..until {
+            let mut indices: Vec<usize> = open
+                .iter()
+                .copied()
+                .filter(|&i| self.rounds_of(i) == round)
+                .collect();
+            progress(&format!(
+                "A/B round {}/{until}: {} case(s), {} then {} first in turn ({:.0} s so far)",
+                round + 1,
+                indices.len(),
+                Side::Base.name(),
+                Side::Current.name(),
+                self.started.elapsed().as_secs_f64()
+            ));
+            if round % 2 == 1 {
+                indices.reverse();
+            }
+            for i in indices {
+                for side in order(round, i) {
+                    self.one_round(plan, side, i, round)?;
+                }
             }
         }
+        for &i in open {
+            for side in &mut self.merged {
+                side[i].rounds_planned = side[i].rounds_done;
+            }
+        }
+        Ok(())
     }
-    let measure_s = started.elapsed().as_secs_f64();
-    let [base_cases, current_cases] = merged;
-    let [base_meta, current_meta] = metadata;
-    let file = |cases: Vec<CaseRecord>, meta: Option<_>| ResultsFile {
-        schema: nbody_records::results::RESULTS_SCHEMA.to_string(),
-        metadata: meta.unwrap_or_else(|| {
-            nbody_records::results::Metadata::collect(&crate::experiment::cargo_features())
-        }),
-        config: plan.config.clone(),
-        config_text: plan.config_text.to_string(),
-        calibration: Default::default(),
-        cases,
-    };
-    let mut base = file(base_cases, base_meta);
-    // The base binary reads the commit from the checkout it runs in, which is this one.
-    base.metadata.git_commit = plan.base.commit.clone();
-    base.metadata.git_dirty = false;
-    Ok(AbResults {
-        base,
-        current: file(current_cases, current_meta),
-        measure_s,
-    })
+
+    fn one_round(
+        &mut self,
+        plan: &AbPlan<'_>,
+        side: Side,
+        i: usize,
+        round: usize,
+    ) -> Result<(), AbError> {
+        let case = &plan.cases[i].case;
+        let dir = plan
+            .work
+            .join(side.name())
+            .join(format!("case{i}-round{round}"));
+        let slot = side as usize;
+        let file = run_side(
+            plan,
+            side,
+            &plan.cases[i].text,
+            &dir,
+            case,
+            round,
+            self.takes_yes[slot],
+        )?;
+        self.metadata[slot].get_or_insert_with(|| file.metadata.clone());
+        let record = file
+            .cases
+            .into_iter()
+            .find(|c| c.key == case.key())
+            .ok_or_else(|| AbError::Side {
+                side: side.name(),
+                key: case.key(),
+                round,
+                tail: "its results file has no such case".to_string(),
+            })?;
+        self.merged[slot][i].absorb(record, plan.config.measure.max_energy_drift);
+        // The one-case sweep's files have been merged; keep the scratch small.
+        let _ = std::fs::remove_dir_all(&dir);
+        Ok(())
+    }
+
+    /// Both builds' rounds so far, each merged into one results file.
+    pub fn results(&self, plan: &AbPlan<'_>) -> AbResults {
+        let file = |cases: Vec<CaseRecord>, meta: Option<_>| ResultsFile {
+            schema: nbody_records::results::RESULTS_SCHEMA.to_string(),
+            metadata: meta.unwrap_or_else(|| {
+                nbody_records::results::Metadata::collect(&crate::experiment::cargo_features())
+            }),
+            config: plan.config.clone(),
+            config_text: plan.config_text.to_string(),
+            calibration: Default::default(),
+            cases,
+        };
+        let [base_cases, current_cases] = self.merged.clone();
+        let [base_meta, current_meta] = self.metadata.clone();
+        let mut base = file(base_cases, base_meta);
+        // The base binary reads the commit from the checkout it runs in, which is this one.
+        base.metadata.git_commit = plan.base.commit.clone();
+        base.metadata.git_dirty = false;
+        AbResults {
+            base,
+            current: file(current_cases, current_meta),
+            measure_s: self.started.elapsed().as_secs_f64(),
+        }
+    }
 }
 
 /// Whether a binary's `sweep` has the `--yes` flag; a binary that does not answer within

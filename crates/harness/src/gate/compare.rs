@@ -1,8 +1,11 @@
-//! Case-by-case comparison: normalisation, the bootstrap CI of the ratio of medians, the
-//! verdict, and the exact comparison of the work counters.
+//! Case-by-case comparison: normalisation, the estimate of the ratio from the runs' rounds
+//! ([`super::paired`]), the verdicts ([`super::sequential`]), and the exact comparison of the
+//! work counters.
 
 use super::checks::{calibrated_rate, check_comparable};
-use super::family::{FAMILY_ALPHA, Tails, holm};
+use super::family::{FAMILY_ALPHA, Tails};
+use super::paired::{LogRatio, Pairing, round_level};
+use super::sequential::{EQUIVALENCE, EQUIVALENCE_TAIL, decide};
 use super::{
     CaseComparison, GATE_SCHEMA, GateError, GateOptions, GateReport, Judged, MAX_THRESHOLD,
     MIN_CI_SAMPLES, MissingCase, Normalization, NormalizationChoice, RunInfo, Verdict, WorkChange,
@@ -31,12 +34,19 @@ pub fn compare(
         warnings,
         judged_on: options.judge,
         family_alpha: FAMILY_ALPHA,
+        pairing: options.pairing,
+        looks: options.look.count.max(1),
     };
     for base in &baseline.cases {
         let missing = |reason: &str| MissingCase {
             key: base.key.clone(),
             reason: reason.to_string(),
         };
+        // A case decided at an earlier look is kept as it was decided.
+        if let Some(closed) = options.closed.iter().find(|c| c.key == base.key) {
+            report.cases.push(closed.clone());
+            continue;
+        }
         let Some(cur) = current.cases.iter().find(|c| c.key == base.key) else {
             report.missing.push(missing("not in the current results"));
             continue;
@@ -55,7 +65,13 @@ pub fn compare(
                  CI of the ratio needs at least {MIN_CI_SAMPLES} per side, so no verdict"
             )));
         } else {
-            let case = compare_case(baseline, base, current, cur, options)?;
+            let Some(case) = compare_case(baseline, base, current, cur, options)? else {
+                report.missing.push(missing(
+                    "its rounds give no estimate (fewer than two usable rounds or samples on \
+                     a side), so no verdict",
+                ));
+                continue;
+            };
             if options.fail_on_work_change && !case.work_compared {
                 report.missing.push(missing(
                     "its work counters could not be compared (a file has no initial_work: \
@@ -65,7 +81,18 @@ pub fn compare(
             report.cases.push(case);
         }
     }
-    apply_family_rule(&mut report.cases);
+    let open: Vec<bool> = report
+        .cases
+        .iter()
+        .map(|c| !options.closed.iter().any(|d| d.key == c.key))
+        .collect();
+    let m = report.cases.len().max(1);
+    let tail = options.look.alpha(FAMILY_ALPHA) / m as f64;
+    for case in report.cases.iter_mut().zip(&open).filter(|(_, o)| **o) {
+        case.0.family_ci = case.0.estimates.0.interval(tail);
+        case.0.raw_family_ci = case.0.estimates.1.interval(tail);
+    }
+    decide(&mut report.cases, &open, options.look, FAMILY_ALPHA);
     report.extra = current
         .cases
         .iter()
@@ -90,24 +117,24 @@ fn compare_case(
     current: &ResultsFile,
     cur: &CaseRecord,
     options: &GateOptions,
-) -> Result<CaseComparison, GateError> {
+) -> Result<Option<CaseComparison>, GateError> {
     let normalization = choose_normalization(baseline, base, current, cur, options)?;
-    let b = normalized(baseline, base, normalization);
-    let c = normalized(current, cur, normalization);
-    let (b_raw, c_raw) = (samples(base), samples(cur));
-    let (bm, cm) = (median_of(&b_raw), median_of(&c_raw));
-    let ratio = median_of(&c) / median_of(&b);
-    // A seed per case that does not depend on the case's position.
-    let seed = options.seed ^ nbody_records::results::fnv1a(base.key.as_bytes());
-    let t = options.threshold;
-    // A side without a positive sample has no interval, and no change is claimed.
-    let (ci95, tails) = ratio_interval(&b, &c, options.resamples, seed, t);
-    let (raw_ci95, raw_tails) = ratio_interval(&b_raw, &c_raw, options.resamples, seed, t);
-    let p = match options.judge {
-        Judged::Normalized => tails,
-        Judged::Raw => raw_tails,
-        Judged::Both => tails.both(raw_tails),
+    let estimate = |how| {
+        let levels = |file, record| round_levels(file, record, how);
+        let (b, c) = (levels(baseline, base), levels(current, cur));
+        match options.pairing {
+            Pairing::Rounds if b.len() == c.len() => LogRatio::paired(&b, &c),
+            _ => unpaired(
+                &normalized(baseline, base, how),
+                &normalized(current, cur, how),
+            ),
+        }
     };
+    let (Some(norm), Some(raw)) = (estimate(normalization), estimate(Normalization::None)) else {
+        return Ok(None);
+    };
+    let (b_raw, c_raw) = (samples(base), samples(cur));
+    let mut case = judged_case(&base.key, normalization, norm, raw, options);
     let (work_changes, work_compared, mut notes) = compare_work(base, cur);
     for (record, which) in [(base, "baseline"), (cur, "current")] {
         if !record.is_complete() {
@@ -127,25 +154,95 @@ fn compare_case(
     if cur.oversubscribed {
         notes.push("oversubscribed".to_string());
     }
-    Ok(CaseComparison {
-        key: base.key.clone(),
+    case.baseline_median_s = median_of(&b_raw);
+    case.current_median_s = median_of(&c_raw);
+    case.samples = [b_raw.len(), c_raw.len()];
+    case.work_changes = work_changes;
+    case.work_compared = work_compared;
+    case.notes = notes;
+    Ok(Some(case))
+}
+
+/// A case's comparison from its normalised and raw estimates, before the verdict (which is
+/// set across the cases): ratios, intervals, p-values and whether it lies within the margin.
+/// Its medians, samples, work counters and notes are left for the caller.
+pub(crate) fn judged_case(
+    key: &str,
+    normalization: Normalization,
+    norm: LogRatio,
+    raw: LogRatio,
+    options: &GateOptions,
+) -> CaseComparison {
+    let t = options.threshold;
+    let (tails, raw_tails) = (norm.tails(t), raw.tails(t));
+    let p = match options.judge {
+        Judged::Normalized => tails,
+        Judged::Raw => raw_tails,
+        Judged::Both => tails.both(raw_tails),
+    };
+    // Unchanged: the judged ratio's 90% interval within the margin (for both ratios, either
+    // one suffices: a regression is claimed only when both show it).
+    let margin = [1.0 - EQUIVALENCE * t, 1.0 + EQUIVALENCE * t];
+    let within = |e: &LogRatio| {
+        let [lo, hi] = e.interval(EQUIVALENCE_TAIL);
+        margin[0] <= lo && hi <= margin[1]
+    };
+    let equivalent = match options.judge {
+        Judged::Normalized => within(&norm),
+        Judged::Raw => within(&raw),
+        Judged::Both => within(&norm) || within(&raw),
+    };
+    CaseComparison {
+        key: key.to_string(),
         normalization,
-        baseline_median_s: bm,
-        current_median_s: cm,
-        raw_ratio: cm / bm,
-        ratio,
-        ci95,
-        raw_ci95,
+        baseline_median_s: f64::NAN,
+        current_median_s: f64::NAN,
+        raw_ratio: raw.ratio(),
+        ratio: norm.ratio(),
+        ci95: norm.interval(0.025),
+        raw_ci95: raw.interval(0.025),
+        // Set across cases, once every case has its estimate.
+        family_ci: [f64::NAN; 2],
+        raw_family_ci: [f64::NAN; 2],
+        adjusted_p: 1.0,
+        units: norm.units,
+        look: options.look.index + 1,
+        equivalent,
+        estimates: (norm, raw),
         p,
         p_normalized: tails,
         p_raw: raw_tails,
         // Set across cases by the family-wise rule, once every case has its p-values.
-        verdict: Verdict::Unchanged,
-        samples: [b_raw.len(), c_raw.len()],
-        work_changes,
-        work_compared,
-        notes,
-    })
+        verdict: Verdict::Unknown,
+        samples: [0, 0],
+        work_changes: Vec::new(),
+        work_compared: false,
+        notes: Vec::new(),
+    }
+}
+
+/// The estimate of two runs measured apart: their samples' logs as two independent groups
+/// (each sample already paired with the reference workload timed beside it when normalised).
+fn unpaired(base: &[f64], current: &[f64]) -> Option<LogRatio> {
+    let logs = |v: &[f64]| v.iter().map(|x| x.ln()).collect::<Vec<f64>>();
+    LogRatio::independent(&logs(base), &logs(current))
+}
+
+/// Each round's level (log of its median sample, normalised as `how` says); `None` for a round
+/// without a usable sample, so that rounds stay aligned for pairing.
+fn round_levels(file: &ResultsFile, record: &CaseRecord, how: Normalization) -> Vec<Option<f64>> {
+    let rate = calibrated_rate(file).unwrap_or(1.0);
+    record
+        .rounds
+        .iter()
+        .map(|r| match how {
+            Normalization::None => round_level(r.samples_s.iter().copied()),
+            Normalization::Calibration => round_level(r.samples_s.iter().map(|s| s * rate)),
+            Normalization::Reference => {
+                round_level(r.samples_s.iter().zip(&r.reference_s).map(|(s, x)| s / x))
+            }
+        })
+        .collect()
 }
 
 /// One pair of sample sets judged alone, as the gate judges one case: the ratio of the medians
@@ -197,27 +294,6 @@ pub(super) fn ratio_interval(
         bootstrap_medians(&[baseline, current], resamples, seed, |m| Some(m[1] / m[0]));
     let ci = interval95(replicates.iter().copied()).unwrap_or([f64::NAN; 2]);
     (ci, Tails::of(&replicates, threshold))
-}
-
-/// Holm's step-down over the judged cases, for regressions and improvements separately, at
-/// [`FAMILY_ALPHA`] each: the gate run as a whole flags an unchanged case with at most that
-/// probability however many cases it judges.
-pub(super) fn apply_family_rule(cases: &mut [CaseComparison]) {
-    let regressed: Vec<f64> = cases.iter().map(|c| c.p.regressed).collect();
-    let improved: Vec<f64> = cases.iter().map(|c| c.p.improved).collect();
-    let (up, down) = (
-        holm(&regressed, FAMILY_ALPHA),
-        holm(&improved, FAMILY_ALPHA),
-    );
-    for (i, case) in cases.iter_mut().enumerate() {
-        case.verdict = if up[i] {
-            Verdict::Regressed
-        } else if down[i] {
-            Verdict::Improved
-        } else {
-            Verdict::Unchanged
-        };
-    }
 }
 
 /// Every raw sample of a case (seconds per step), in round order.

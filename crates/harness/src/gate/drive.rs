@@ -36,8 +36,12 @@ pub struct Request {
     pub against: Option<String>,
     /// Config to measure (a file or a config name); `None` sweeps the baseline's own config.
     pub config: Option<PathBuf>,
-    /// Rounds of every case per build in an A/B run: even, from 2 to [`ab::MAX_ROUNDS`].
+    /// Rounds of every case per build in an A/B run's first look: even, from 2 to
+    /// [`ab::MAX_ROUNDS`].
     pub rounds: usize,
+    /// Most rounds per build a case undecided after the first look is measured to, in looks of
+    /// `rounds` more each ([`super::sequential::schedule`]); `rounds` itself judges once.
+    pub max_rounds: usize,
     /// Longest one build's sweep of one case may take in an A/B run, seconds; `None`: from the
     /// case's estimate ([`ab::child_limit`]).
     pub timeout: Option<f64>,
@@ -303,6 +307,14 @@ fn prepare_a_b(
     say: &mut dyn FnMut(&str),
 ) -> anyhow::Result<PreparedAB> {
     let cases = ab::prepare(config, text, request.rounds)?;
+    if request.max_rounds < request.rounds {
+        anyhow::bail!(
+            "--max-rounds {} is below --rounds {}: the first look already takes --rounds \
+             rounds; give --max-rounds at least that (equal judges once)",
+            request.max_rounds,
+            request.rounds
+        );
+    }
     let repo = base_build::repository_root(&std::env::current_dir()?)?;
     let commit = base_build::resolve(&repo, rev)?;
     // The estimate of the interleaved run: the config with the A/B run's rounds and samples.
@@ -446,36 +458,16 @@ fn a_b(
         work: &work,
         limit: &limit,
     };
-    let measured = ab::measure(&plan, say);
+    let judged = judge_in_looks(request, &plan, &calibration, say);
     let _ = std::fs::remove_dir_all(&work);
-    let mut results = measured?;
-    for file in [&mut results.base, &mut results.current] {
-        file.calibration.start = Some(calibration.clone());
-    }
+    let (mut report, results, reference) = judged?;
     results.base.save(&out.join("base.json"))?;
     results.current.save(&out.join("current.json"))?;
-    let mut opts = options(request, AB_THRESHOLD, AB_JUDGE);
-    // Each build times its own copy of the reference workload. If that copy itself got faster
-    // or slower (another compiler, profile or SIMD dispatch), dividing by it would hide or
-    // invent a change of the kernels: then judge raw times, which interleaving keeps fair.
-    let (rb, rc) = (
-        ab::median_reference(&results.base),
-        ab::median_reference(&results.current),
-    );
-    let reference_moved = match (rb, rc) {
-        (Some(b), Some(c)) if b > 0.0 => ((c / b) - 1.0).abs() > REFERENCE_TOLERANCE,
-        _ => false,
-    };
-    if reference_moved && opts.normalization == NormalizationChoice::Auto {
-        opts.normalization = NormalizationChoice::None;
-    }
-    let mut report = compare(&results.base, &results.current, &opts)?;
-    if reference_moved {
+    if let Some(moved) = reference {
         report.warnings.push(format!(
-            "the reference workload itself takes {:.3}x as long in this build as in the base, \
-             so the builds differ in more than their kernels; the cases are judged on raw \
-             times (both builds measured interleaved)",
-            rc.unwrap_or(0.0) / rb.unwrap_or(1.0)
+            "the reference workload itself takes {moved:.3}x as long in this build as in the \
+             base, so the builds differ in more than their kernels; the cases are judged on raw \
+             times (both builds measured interleaved)"
         ));
     }
     for (file, which) in [(&results.base, "base"), (&results.current, "current")] {
@@ -501,14 +493,105 @@ fn a_b(
         ));
     }
     say(&format!(
-        "A/B against {} ({}): {} rounds per build, measured in {:.0} s, {:.0} s in all; \
-         results kept in {}",
+        "A/B against {} ({}): {} look(s), {} case-rounds per build, measured in {:.0} s, {:.0} s \
+         in all; results kept in {}",
         rev,
         short(commit),
-        request.rounds,
+        report.cases.iter().map(|c| c.look).max().unwrap_or(1),
+        results
+            .current
+            .cases
+            .iter()
+            .map(|c| c.rounds_done)
+            .sum::<usize>(),
         results.measure_s,
         started.elapsed().as_secs_f64(),
         out.display()
     ));
     Ok(report)
+}
+
+/// Measures both builds in looks ([`super::sequential`]): every case to `request.rounds`
+/// rounds, then only the undecided ones, `request.rounds` more at a time, up to
+/// `request.max_rounds`. The last look's report (the cases decided earlier kept as then), both
+/// builds' results, and how much longer this build's reference workload took when that stopped
+/// the normalisation.
+fn judge_in_looks(
+    request: &Request,
+    plan: &AbPlan<'_>,
+    calibration: &nbody_calibrate::Calibration,
+    say: &mut dyn FnMut(&str),
+) -> anyhow::Result<(GateReport, ab::AbResults, Option<f64>)> {
+    let schedule = super::sequential::schedule(request.rounds, request.max_rounds);
+    let mut run = ab::AbRun::start(plan)?;
+    let mut open: Vec<usize> = (0..plan.cases.len()).collect();
+    let mut opts = options(request, AB_THRESHOLD, AB_JUDGE);
+    opts.pairing = super::paired::Pairing::Rounds;
+    let mut last = None;
+    for (index, &until) in schedule.iter().enumerate() {
+        run.extend(plan, &open, until, say)?;
+        let mut results = run.results(plan);
+        for file in [&mut results.base, &mut results.current] {
+            file.calibration.start = Some(calibration.clone());
+        }
+        // Each build times its own copy of the reference workload. If that copy itself got
+        // faster or slower (another compiler, profile or SIMD dispatch), dividing by it would
+        // hide or invent a change of the kernels: then judge raw times, which interleaving
+        // keeps fair.
+        let moved = reference_moved(&results);
+        let mut look = opts.clone();
+        look.look = super::sequential::Look {
+            index,
+            count: schedule.len(),
+        };
+        if moved.is_some() && look.normalization == NormalizationChoice::Auto {
+            look.normalization = NormalizationChoice::None;
+        }
+        let report = compare(&results.base, &results.current, &look)?;
+        open = plan
+            .cases
+            .iter()
+            .enumerate()
+            .filter(|(_, c)| {
+                let key = c.case.key();
+                report
+                    .cases
+                    .iter()
+                    .any(|r| r.key == key && super::sequential::still_open(r))
+            })
+            .map(|(i, _)| i)
+            .collect();
+        opts.closed = report
+            .cases
+            .iter()
+            .filter(|c| !super::sequential::still_open(c))
+            .cloned()
+            .collect();
+        let done = open.is_empty() || index + 1 == schedule.len();
+        if !done {
+            say(&format!(
+                "look {}/{}: {} case(s) decided, {} undecided: measuring those to {} rounds",
+                index + 1,
+                schedule.len(),
+                report.cases.len() - open.len(),
+                open.len(),
+                schedule[index + 1]
+            ));
+        }
+        last = Some((report, results, moved));
+        if done {
+            break;
+        }
+    }
+    last.ok_or_else(|| anyhow::anyhow!("the A/B run planned no look"))
+}
+
+/// This build's reference workload time over the base's (medians over all samples), when it
+/// differs by more than [`REFERENCE_TOLERANCE`].
+fn reference_moved(results: &ab::AbResults) -> Option<f64> {
+    let (b, c) = (
+        ab::median_reference(&results.base)?,
+        ab::median_reference(&results.current)?,
+    );
+    (b > 0.0 && ((c / b) - 1.0).abs() > REFERENCE_TOLERANCE).then_some(c / b)
 }

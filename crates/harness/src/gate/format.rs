@@ -33,14 +33,15 @@ pub fn formatted(report: &GateReport, format: Format) -> String {
     }
 }
 
-/// "3 cases: 1 regressed, 0 improved, 2 unchanged (threshold ±10%)".
+/// "3 cases: 1 regressed, 0 improved, 2 unchanged, 0 unknown (threshold ±10%)".
 fn headline(report: &GateReport) -> String {
     let mut s = format!(
-        "{} cases: {} regressed, {} improved, {} unchanged (threshold ±{}%)",
+        "{} cases: {} regressed, {} improved, {} unchanged, {} unknown (threshold ±{}%)",
         report.cases.len(),
         report.count(Verdict::Regressed),
         report.count(Verdict::Improved),
         report.count(Verdict::Unchanged),
+        report.count(Verdict::Unknown),
         percent(report.threshold)
     );
     if !report.missing.is_empty() {
@@ -74,7 +75,7 @@ fn judged_on(judged: super::Judged) -> &'static str {
     match judged {
         super::Judged::Normalized => "the normalised ratio",
         super::Judged::Raw => "the raw ratio",
-        super::Judged::Both => "the normalised and the raw ratio both",
+        super::Judged::Both => "each of the normalised and the raw ratio",
     }
 }
 
@@ -106,18 +107,22 @@ fn text(report: &GateReport) -> String {
     let _ = writeln!(s, "baseline {}", origin(&report.baseline));
     let _ = writeln!(s, "current  {}", origin(&report.current));
     let _ = writeln!(s, "times normalised by {}", normalizations(report));
-    let _ = writeln!(
-        s,
-        "a case regresses above {:.2} ({}), family-wise error {}% over the cases (Holm)\n",
-        1.0 + report.threshold,
-        judged_on(report.judged_on),
-        percent(report.family_alpha)
-    );
+    let _ = writeln!(s, "{}\n", rule(report));
     let r = Align::Right;
     let header = [
-        "case", "baseline", "current", "ratio", "95% CI", "raw", "verdict",
+        "case",
+        "baseline",
+        "current",
+        "ratio",
+        "family CI",
+        "raw",
+        "raw family CI",
+        "adj. p",
+        "rounds",
+        "verdict",
     ];
-    let mut table = Table::new(header).aligned([Align::Default, r, r, r, r, r, Align::Default]);
+    let mut table =
+        Table::new(header).aligned([Align::Default, r, r, r, r, r, r, r, r, Align::Default]);
     for c in &report.cases {
         let verdict = match c.verdict {
             Verdict::Regressed => verdict_word(c).to_uppercase(),
@@ -128,8 +133,11 @@ fn text(report: &GateReport) -> String {
             Duration(c.baseline_median_s).to_string(),
             Duration(c.current_median_s).to_string(),
             format!("{:.3}", c.ratio),
-            format!("[{:.3}, {:.3}]", c.ci95[0], c.ci95[1]),
+            interval(c.family_ci),
             format!("{:.3}", c.raw_ratio),
+            interval(c.raw_family_ci),
+            adjusted(c.adjusted_p),
+            units(report, c),
             verdict + &notes(c).map(|n| format!("  ({n})")).unwrap_or_default(),
         ]);
     }
@@ -153,16 +161,11 @@ fn markdown(report: &GateReport) -> String {
     let _ = writeln!(s, "{}.\n", headline(report));
     let _ = writeln!(
         s,
-        "Baseline {}, current {}; times normalised by {}. A case regresses when its ratio \
-         current / baseline lies above {:.2} ({}), at a family-wise error of {}% over the {} \
-         cases (Holm's step-down on one-sided bootstrap p-values).\n",
+        "Baseline {}, current {}; times normalised by {}. {}\n",
         code(&origin(&report.baseline)),
         code(&origin(&report.current)),
         normalizations(report),
-        1.0 + report.threshold,
-        judged_on(report.judged_on),
-        percent(report.family_alpha),
-        report.cases.len()
+        markdown::text(&rule(report))
     );
     // Numbers line up on their last digit; the case and the verdict are words.
     let (word, number) = (Align::Default, Align::Right);
@@ -171,11 +174,16 @@ fn markdown(report: &GateReport) -> String {
         "baseline",
         "current",
         "ratio",
-        "95% CI",
+        "family CI",
         "raw ratio",
+        "raw family CI",
+        "adj. p",
+        "rounds",
         "verdict",
     ])
-    .aligned([word, number, number, number, number, number, word]);
+    .aligned([
+        word, number, number, number, number, number, number, number, number, word,
+    ]);
     for c in &report.cases {
         let word = verdict_word(c);
         let verdict = match c.verdict {
@@ -187,8 +195,11 @@ fn markdown(report: &GateReport) -> String {
             Duration(c.baseline_median_s).to_string(),
             Duration(c.current_median_s).to_string(),
             format!("{:.3}", c.ratio),
-            format!("{:.3} – {:.3}", c.ci95[0], c.ci95[1]),
+            interval(c.family_ci),
             format!("{:.3}", c.raw_ratio),
+            interval(c.raw_family_ci),
+            adjusted(c.adjusted_p),
+            units(report, c),
             format!(
                 "{verdict}{}",
                 notes(c)
@@ -207,6 +218,63 @@ fn markdown(report: &GateReport) -> String {
         }
     }
     s
+}
+
+/// How verdicts were reached, as one sentence for the report's head.
+fn rule(report: &GateReport) -> String {
+    let looks = if report.looks > 1 {
+        format!(
+            " in up to {} looks (each at {}%, undecided cases measured further)",
+            report.looks,
+            percent(report.family_alpha / report.looks as f64)
+        )
+    } else {
+        String::new()
+    };
+    format!(
+        "A case regresses when {} lies above {:.2}, at a family-wise error of {}% over the \
+         cases{looks} (Holm's step-down on one-sided t p-values from {}); it is unchanged when \
+         its 90% interval lies within ±{}%, unknown when neither. The family CI is the interval \
+         at the level the verdicts used: wholly past a margin, the case is flagged.",
+        judged_on(report.judged_on),
+        1.0 + report.threshold,
+        percent(report.family_alpha),
+        match report.pairing {
+            super::paired::Pairing::Rounds => "pairs of back-to-back rounds",
+            super::paired::Pairing::Independent => "the two runs' samples",
+        },
+        percent(super::sequential::EQUIVALENCE * report.threshold),
+    )
+}
+
+fn interval([lo, hi]: [f64; 2]) -> String {
+    if lo.is_finite() && hi.is_finite() {
+        format!("[{lo:.3}, {hi:.3}]")
+    } else {
+        "–".to_string()
+    }
+}
+
+fn adjusted(p: f64) -> String {
+    if p < 1e-4 {
+        "<0.0001".to_string()
+    } else {
+        format!("{p:.4}")
+    }
+}
+
+/// Rounds (or samples) per side the case was judged on, with its look when several.
+fn units(report: &GateReport, c: &CaseComparison) -> String {
+    let n = if c.units[0] == c.units[1] {
+        c.units[0].to_string()
+    } else {
+        format!("{}/{}", c.units[0], c.units[1])
+    };
+    if report.looks > 1 {
+        format!("{n} (look {})", c.look)
+    } else {
+        n
+    }
 }
 
 /// "regressed", or "unchanged, work changed" when the counters differ.
@@ -238,6 +306,29 @@ fn findings(report: &GateReport) -> Vec<String> {
                 c.key, w.counter, w.baseline, w.current
             ));
         }
+    }
+    let unknown: Vec<String> = report
+        .cases
+        .iter()
+        .filter(|c| c.verdict == Verdict::Unknown)
+        .map(|c| c.key.clone())
+        .collect();
+    if !unknown.is_empty() {
+        let how = match report.pairing {
+            super::paired::Pairing::Independent => format!(
+                "measure them side by side with the baseline's revision: `nbody-bench gate \
+                 --against {}`",
+                short(&report.baseline.git_commit)
+            ),
+            super::paired::Pairing::Rounds => {
+                "measure more rounds (`--max-rounds`) or on a quieter machine".to_string()
+            }
+        };
+        out.push(format!(
+            "unknown: {} case(s) neither shown changed nor shown unchanged ({}); {how}",
+            unknown.len(),
+            super::listed(&unknown)
+        ));
     }
     for w in &report.warnings {
         out.push(format!("warning: {w}"));

@@ -248,7 +248,8 @@ pub fn refusal(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::gate::{CaseComparison, Normalization, RunInfo, family::Tails};
+    use crate::gate::paired::LogRatio;
+    use crate::gate::{Normalization, RunInfo};
 
     fn info(commit: &str) -> RunInfo {
         RunInfo {
@@ -273,23 +274,29 @@ mod tests {
             current: info("fedcba9876543210"),
             cases: cases
                 .iter()
-                .map(|&(key, verdict, ratio)| CaseComparison {
-                    key: key.into(),
-                    verdict,
-                    normalization: Normalization::None,
-                    baseline_median_s: 1e-3,
-                    current_median_s: 1e-3 * ratio,
-                    raw_ratio: ratio,
-                    ratio: ratio + 7.0,
-                    ci95: [ratio + 6.9, ratio + 7.1],
-                    raw_ci95: [ratio * 0.97, ratio * 1.03],
-                    p: Tails::NONE,
-                    p_normalized: Tails::NONE,
-                    p_raw: Tails::NONE,
-                    samples: [8, 8],
-                    work_changes: vec![],
-                    work_compared: true,
-                    notes: vec![],
+                .map(|&(key, verdict, ratio)| {
+                    let estimate = |r: f64| LogRatio {
+                        mean: r.ln(),
+                        se: 0.01,
+                        df: 7.0,
+                        units: [8, 8],
+                    };
+                    let options = crate::gate::GateOptions::default();
+                    let mut c = crate::gate::judged_case(
+                        key,
+                        Normalization::None,
+                        estimate(ratio + 7.0),
+                        estimate(ratio),
+                        &options,
+                    );
+                    c.verdict = verdict;
+                    c.baseline_median_s = 1e-3;
+                    c.current_median_s = 1e-3 * ratio;
+                    c.raw_ci95 = [ratio * 0.97, ratio * 1.03];
+                    c.ci95 = [ratio + 6.9, ratio + 7.1];
+                    c.samples = [8, 8];
+                    c.work_compared = true;
+                    c
                 })
                 .collect(),
             missing: vec![],
@@ -297,6 +304,8 @@ mod tests {
             warnings: vec![],
             judged_on: Judged::Raw,
             family_alpha: 0.025,
+            pairing: crate::gate::paired::Pairing::Rounds,
+            looks: 1,
         }
     }
 

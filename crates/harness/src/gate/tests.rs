@@ -439,7 +439,7 @@ fn renderings() {
     let text = formatted(&report, Format::Text);
     assert!(
         text.starts_with(
-            "gate FAIL: 3 cases: 1 regressed, 0 improved, 2 unchanged (threshold ±10%)"
+            "gate FAIL: 3 cases: 1 regressed, 0 improved, 2 unchanged, 0 unknown (threshold ±10%)"
         ),
         "{text}"
     );
@@ -449,7 +449,9 @@ fn renderings() {
         md.starts_with("### Performance gate: regression found"),
         "{md}"
     );
-    assert!(md.contains("| case | baseline | current | ratio | 95% CI | raw ratio | verdict |"));
+    assert!(md.contains(
+        "| case | baseline | current | ratio | family CI | raw ratio | raw family CI | adj. p | rounds | verdict |"
+    ));
     assert!(md.contains("| **regressed** |"), "{md}");
     let json: serde_json::Value = serde_json::from_str(&formatted(&report, Format::Json)).unwrap();
     assert_eq!(json["schema"], GATE_SCHEMA);

@@ -149,6 +149,8 @@ pub fn backfill(job: &Backfill, say: &mut dyn FnMut(&str)) -> anyhow::Result<Vec
             against: Some(commit.clone()),
             config: Some(job.config.clone()),
             rounds: job.rounds,
+            // The history measures every commit alike: one look, no case measured further.
+            max_rounds: job.rounds,
             timeout: None,
             out: Some(out.clone()),
             threshold: None,

@@ -1,10 +1,18 @@
 //! The study's blocks judged as gate decisions, under each candidate rule and threshold, and
 //! the tallies the study file keeps: false alarms of unchanged code, and power against each
 //! slowdown, per mode, with exact binomial intervals.
+//!
+//! An A/B decision is replayed look by look as the gate takes it ([`crate::gate::sequential`]):
+//! at each look every case is cut to the rounds the gate would have measured by then, the
+//! cases decided earlier are kept as decided, and the decision ends when no case is open or at
+//! the last look. [`needs`] asks the same replays, during the measurement, which cases a
+//! decision would measure further, so that the study measures exactly those.
 
 use super::{Block, RawStudy, SLOWDOWNS};
-use crate::gate::family::{FAMILY_ALPHA, clopper_pearson, holm};
-use crate::gate::{CaseComparison, GateOptions, Judged, compare};
+use crate::gate::family::clopper_pearson;
+use crate::gate::paired::Pairing;
+use crate::gate::sequential::{Look, schedule, still_open};
+use crate::gate::{GateOptions, GateReport, Judged, Verdict, compare};
 use nbody_records::kernel_or_program::KernelOrProgram;
 use nbody_records::results::{CaseRecord, ResultsFile};
 use serde::{Deserialize, Serialize};
@@ -31,14 +39,29 @@ impl Mode {
     /// The thresholds the study judges each decision at.
     pub fn candidates(self) -> &'static [f64] {
         match self {
-            Mode::Ab => &[0.02, 0.03, 0.05, 0.10],
-            Mode::Fast => &[0.05, 0.10, 0.15, 0.25],
+            Mode::Ab => &[0.02, 0.03, 0.05],
+            Mode::Fast => &[0.05, 0.07, 0.10, 0.15],
+        }
+    }
+
+    /// The rules the study judges each decision under: every rule on the fast path (one look,
+    /// no extra measurement); in A/B the gate's own, since every rule and threshold replayed
+    /// there asks for rounds of its own undecided cases.
+    pub fn rules(self) -> &'static [Judged] {
+        match self {
+            Mode::Ab => &[crate::gate::AB_JUDGE],
+            Mode::Fast => &RULES,
         }
     }
 }
 
 /// The rules a case can be judged on.
 pub const RULES: [Judged; 3] = [Judged::Normalized, Judged::Raw, Judged::Both];
+
+/// The rounds per side after each look of the study's A/B decisions: the gate's defaults.
+pub fn looks() -> Vec<usize> {
+    schedule(crate::gate::AB_ROUNDS, crate::gate::AB_MAX_ROUNDS)
+}
 
 /// Decisions of one kind, counted.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -59,6 +82,12 @@ pub struct Tally {
     pub exactly_slowed: usize,
     /// Decisions that flagged a case of another kernel.
     pub other_flagged: usize,
+    /// Decisions that left some case unknown (neither flagged nor shown unchanged).
+    #[serde(default)]
+    pub undecided: usize,
+    /// Rounds per side summed over the decisions' cases: the measuring each decision took.
+    #[serde(default)]
+    pub case_rounds: usize,
 }
 
 impl Tally {
@@ -110,18 +139,11 @@ pub fn tally(
     let mut tallies: Vec<Tally> = Vec::new();
     let mut widths: Vec<(Mode, Vec<f64>, Vec<f64>)> = Vec::new();
     let mut steps: Vec<(Mode, f64, Vec<f64>, Vec<f64>)> = Vec::new();
-    let levels: Vec<f64> = std::iter::once(1.0)
-        .chain(if raw.duet {
-            Vec::new()
-        } else {
-            SLOWDOWNS.to_vec()
-        })
-        .collect();
     let judged: Vec<Vec<Outcome>> = {
         use rayon::prelude::*;
         raw.blocks
             .par_iter()
-            .map(|block| judge_block(raw, block, baseline, &levels))
+            .map(|block| judge_block(raw, block, baseline))
             .collect()
     };
     for outcome in judged.into_iter().flatten() {
@@ -144,27 +166,30 @@ pub fn tally(
                 None => widths.push((outcome.mode, outcome.widths.0, outcome.widths.1)),
             }
         }
-        for (rule, threshold, flags) in outcome.flags {
+        for judged in outcome.flags {
             let found = tallies.iter().position(|t| {
                 t.mode == outcome.mode
-                    && t.rule == rule
-                    && t.threshold == threshold
+                    && t.rule == judged.rule
+                    && t.threshold == judged.threshold
                     && t.slowdown == outcome.slowdown
             });
             let index = found.unwrap_or_else(|| {
                 tallies.push(Tally {
                     mode: outcome.mode,
-                    rule,
-                    threshold,
+                    rule: judged.rule,
+                    threshold: judged.threshold,
                     slowdown: outcome.slowdown,
                     decisions: 0,
                     any_flagged: 0,
                     exactly_slowed: 0,
                     other_flagged: 0,
+                    undecided: 0,
+                    case_rounds: 0,
                 });
                 tallies.len() - 1
             });
             let t = &mut tallies[index];
+            let flags = &judged.cases;
             t.decisions += 1;
             let flagged =
                 |target: bool| flags.iter().any(|&(is_target, f)| f && is_target == target);
@@ -172,6 +197,8 @@ pub fn tally(
             t.other_flagged += usize::from(flagged(false));
             let all_targets = flags.iter().filter(|f| f.0).all(|f| f.1);
             t.exactly_slowed += usize::from(all_targets && !flagged(false) && flagged(true));
+            t.undecided += usize::from(judged.undecided);
+            t.case_rounds += judged.case_rounds;
         }
     }
     let median = |v: &[f64]| nbody_engine::stats::median(v).unwrap_or(f64::NAN);
@@ -198,64 +225,101 @@ pub fn tally(
 /// Per case of a decision: (is the slowed kernel's, flagged as regressed).
 type CaseFlags = Vec<(bool, bool)>;
 
+/// One decision under one rule and threshold.
+struct Judgement {
+    rule: Judged,
+    threshold: f64,
+    cases: CaseFlags,
+    /// Some case ended unknown.
+    undecided: bool,
+    /// Rounds per side, summed over the cases, the decision measured.
+    case_rounds: usize,
+}
+
 /// One decision judged under every rule and threshold.
 struct Outcome {
     mode: Mode,
     slowdown: f64,
-    /// (rule, threshold, the cases' flags).
-    flags: Vec<(Judged, f64, CaseFlags)>,
+    flags: Vec<Judgement>,
     /// Per-case interval widths, normalised and raw (A/A decisions).
     widths: (Vec<f64>, Vec<f64>),
     /// The slowed kernel's cases' ratios, normalised and raw (slowdown decisions).
     slowed: (Vec<f64>, Vec<f64>),
 }
 
-fn judge_block(
-    raw: &RawStudy,
-    block: &Block,
-    baseline: Option<&ResultsFile>,
-    levels: &[f64],
-) -> Vec<Outcome> {
+/// The slowdowns a block can be judged at: 1 (A/A), and each of [`SLOWDOWNS`] unless the run
+/// measured both sides at once (duet: A/A only).
+fn levels(raw: &RawStudy) -> Vec<f64> {
+    std::iter::once(1.0)
+        .chain(if raw.duet {
+            Vec::new()
+        } else {
+            SLOWDOWNS.to_vec()
+        })
+        .collect()
+}
+
+fn options(rule: Judged, threshold: f64, pairing: Pairing) -> GateOptions {
+    GateOptions {
+        threshold,
+        judge: rule,
+        pairing,
+        ..GateOptions::default()
+    }
+}
+
+fn judge_block(raw: &RawStudy, block: &Block, baseline: Option<&ResultsFile>) -> Vec<Outcome> {
     let mut out = Vec::new();
-    for (level_index, &slowdown) in levels.iter().enumerate() {
+    for (level_index, &slowdown) in levels(raw).iter().enumerate() {
         let current = with_slowed(raw, block, level_index.checked_sub(1));
-        let a = file(raw, block.a.clone());
-        let b = file(raw, current);
-        let mut pairs = vec![(Mode::Ab, a)];
-        if let Some(base) = baseline {
-            pairs.push((Mode::Fast, base.clone()));
-        }
-        for (mode, base) in pairs {
+        let target = format!("/{}/", raw.slowed_kernel.name());
+        for mode in [Mode::Ab, Mode::Fast] {
             let mut flags = Vec::new();
             let mut widths = (Vec::new(), Vec::new());
             let mut slowed = (Vec::new(), Vec::new());
             for &threshold in mode.candidates() {
-                let options = GateOptions {
-                    threshold,
-                    ..GateOptions::default()
-                };
-                // A decision the gate could not make (another config, too few samples) is not
-                // counted at all: the study measures the decisions the gate makes.
-                let Ok(report) = compare(&base, &b, &options) else {
-                    continue;
-                };
-                if !report.missing.is_empty() {
-                    continue;
-                }
-                if widths.0.is_empty() && slowed.0.is_empty() {
-                    let target = format!("/{}/", raw.slowed_kernel.name());
-                    for c in &report.cases {
-                        if slowdown == 1.0 {
-                            widths.0.push((c.ci95[1] - c.ci95[0]) / c.ratio);
-                            widths.1.push((c.raw_ci95[1] - c.raw_ci95[0]) / c.raw_ratio);
-                        } else if c.key.contains(&target) {
-                            slowed.0.push(c.ratio);
-                            slowed.1.push(c.raw_ratio);
+                for &rule in mode.rules() {
+                    let report = match (mode, baseline) {
+                        (Mode::Ab, _) => replay(raw, &block.a, &current, rule, threshold).0,
+                        (Mode::Fast, Some(base)) => {
+                            // CI's sweep: the first look's rounds of this side alone.
+                            let first = truncated(&current, looks()[0], None);
+                            let options = options(rule, threshold, Pairing::Independent);
+                            compare(base, &file(raw, first), &options).ok()
+                        }
+                        (Mode::Fast, None) => None,
+                    };
+                    // A decision the gate could not make (another config, too few samples) is
+                    // not counted at all: the study measures the decisions the gate makes.
+                    let Some(report) = report.filter(|r| r.missing.is_empty()) else {
+                        continue;
+                    };
+                    if widths.0.is_empty() && slowed.0.is_empty() {
+                        for c in &report.cases {
+                            if slowdown == 1.0 {
+                                widths.0.push((c.ci95[1] - c.ci95[0]) / c.ratio);
+                                widths.1.push((c.raw_ci95[1] - c.raw_ci95[0]) / c.raw_ratio);
+                            } else if c.key.contains(&target) {
+                                slowed.0.push(c.ratio);
+                                slowed.1.push(c.raw_ratio);
+                            }
                         }
                     }
-                }
-                for rule in RULES {
-                    flags.push((rule, threshold, flagged(raw, &report.cases, rule)));
+                    flags.push(Judgement {
+                        rule,
+                        threshold,
+                        cases: report
+                            .cases
+                            .iter()
+                            .map(|c| (c.key.contains(&target), c.verdict == Verdict::Regressed))
+                            .collect(),
+                        undecided: report.cases.iter().any(|c| c.verdict == Verdict::Unknown),
+                        case_rounds: report
+                            .cases
+                            .iter()
+                            .map(|c| looks()[c.look.clamp(1, looks().len()) - 1])
+                            .sum(),
+                    });
                 }
             }
             if !flags.is_empty() {
@@ -272,23 +336,118 @@ fn judge_block(
     out
 }
 
-/// Holm's step-down over the cases' p-values of `rule`: (is the slowed kernel's case,
-/// regressed) per case.
-fn flagged(raw: &RawStudy, cases: &[CaseComparison], rule: Judged) -> CaseFlags {
-    let p: Vec<f64> = cases
+/// An A/B decision of `current` against `base` replayed look by look under `rule` and
+/// `threshold`: the report of its last look, and the keys of the cases it would measure
+/// further but whose rounds the records do not hold yet (none once the decision is complete).
+pub fn replay(
+    raw: &RawStudy,
+    base: &[CaseRecord],
+    current: &[CaseRecord],
+    rule: Judged,
+    threshold: f64,
+) -> (Option<GateReport>, Vec<String>) {
+    let looks = looks();
+    let mut options = options(rule, threshold, Pairing::Rounds);
+    let mut last = None;
+    for (index, &rounds) in looks.iter().enumerate() {
+        options.look = Look {
+            index,
+            count: looks.len(),
+        };
+        let measured = |records: &[CaseRecord], key: &str| {
+            records
+                .iter()
+                .find(|r| r.key == key)
+                .map_or(0, |r| r.rounds.len())
+        };
+        let open: Vec<String> = current
+            .iter()
+            .map(|c| c.key.clone())
+            .filter(|k| !options.closed.iter().any(|c| &c.key == k))
+            .collect();
+        let short: Vec<String> = open
+            .iter()
+            .filter(|k| measured(base, k).min(measured(current, k)) < rounds)
+            .cloned()
+            .collect();
+        if !short.is_empty() {
+            return (last, short);
+        }
+        let (b, c) = (
+            truncated(base, rounds, None),
+            truncated(current, rounds, None),
+        );
+        let Ok(report) = compare(&file(raw, b), &file(raw, c), &options) else {
+            return (None, Vec::new());
+        };
+        options.closed = report
+            .cases
+            .iter()
+            .filter(|c| !still_open(c))
+            .cloned()
+            .collect();
+        let done = report.cases.iter().all(|c| !still_open(c));
+        last = Some(report);
+        if done {
+            break;
+        }
+    }
+    (last, Vec::new())
+}
+
+/// The cases each side still needs rounds of, by key: what the A/B decisions of every
+/// slowdown, under each candidate threshold of the gate's rule, would measure next.
+pub fn needs(raw: &RawStudy, block: &Block) -> Vec<(String, Side)> {
+    let mut need: Vec<(String, Side)> = Vec::new();
+    for (level_index, _) in levels(raw).iter().enumerate() {
+        let slowed = level_index.checked_sub(1);
+        let current = with_slowed(raw, block, slowed);
+        for &threshold in Mode::Ab.candidates() {
+            for &rule in Mode::Ab.rules() {
+                for key in replay(raw, &block.a, &current, rule, threshold).1 {
+                    let is_slowed = block
+                        .slowed
+                        .first()
+                        .is_some_and(|s| s.iter().any(|r| r.key == key));
+                    let side = match slowed {
+                        Some(k) if is_slowed => Side::Slowed(k),
+                        _ => Side::B,
+                    };
+                    for s in [Side::A, side] {
+                        if !need.iter().any(|(k, x)| k == &key && *x == s) {
+                            need.push((key.clone(), s));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    need
+}
+
+/// Which measurement a round belongs to.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Side {
+    /// Side A (the base of every A/B decision).
+    A,
+    /// Side B, the same code as A.
+    B,
+    /// The slowed kernel at `SLOWDOWNS[i]`.
+    Slowed(usize),
+}
+
+/// The records with each case cut to its first `rounds` rounds (`keep`: only those keys).
+fn truncated(records: &[CaseRecord], rounds: usize, keep: Option<&[String]>) -> Vec<CaseRecord> {
+    records
         .iter()
-        .map(|c| match rule {
-            Judged::Normalized => c.p_normalized.regressed,
-            Judged::Raw => c.p_raw.regressed,
-            Judged::Both => c.p_normalized.both(c.p_raw).regressed,
+        .filter(|r| keep.is_none_or(|k| k.contains(&r.key)))
+        .map(|r| {
+            let mut r = r.clone();
+            r.rounds.truncate(rounds);
+            r.rounds_done = r.rounds.len();
+            r.rounds_planned = r.rounds.len();
+            r
         })
-        .collect();
-    let rejected = holm(&p, FAMILY_ALPHA);
-    let target = format!("/{}/", raw.slowed_kernel.name());
-    cases
-        .iter()
-        .zip(rejected)
-        .map(|(c, r)| (c.key.contains(&target), r))
         .collect()
 }
 

@@ -1,23 +1,15 @@
-//! Measuring the study's blocks: every case's rounds of each side, interleaved.
+//! Measuring the study's blocks: every case's rounds of each side, interleaved, and then, look
+//! by look, the rounds the gate's A/B decisions would measure further.
 
 use super::Load;
-use super::{Block, SLOWDOWNS};
+use super::decide::{self, Side};
+use super::{Block, RawStudy, SLOWDOWNS};
 use crate::experiment::measure::{RoundSpec, measure_round};
 use nbody_engine::clock::WallClock;
-use nbody_engine::kernels::KernelKind;
 use nbody_records::config::SweepConfig;
 use nbody_records::kernel_or_program::KernelOrProgram;
 use nbody_records::plan::Case;
 use nbody_records::results::CaseRecord;
-
-/// Which measurement a round belongs to.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Side {
-    A,
-    B,
-    /// The slowed kernel at `SLOWDOWNS[i]`.
-    Slowed(usize),
-}
 
 /// A spinning `sh` loop, stopped when dropped.
 struct Spinner(std::process::Child);
@@ -38,32 +30,28 @@ impl Drop for Spinner {
     }
 }
 
-/// Measures `blocks` blocks of `cases` (built-in kernels only), each case `rounds` rounds of
-/// `samples` samples per side; `progress` hears of each block.
-#[allow(clippy::too_many_arguments)]
+/// Measures `blocks` blocks (one decision each) of the cases of `raw.config` (built-in
+/// kernels only): every case's first look of each side, then the rounds the decisions leave
+/// undecided, look by look; `progress` hears of each block.
 pub fn measure_blocks(
-    config: &SweepConfig,
+    raw: &RawStudy,
     cases: &[Case],
     blocks: usize,
-    rounds: usize,
-    samples: usize,
-    slowed: KernelKind,
-    load: Load,
-    duet: bool,
     progress: &mut dyn FnMut(usize, &Block),
 ) -> Result<Vec<Block>, String> {
-    let _spinner = match load {
+    let _spinner = match raw.load {
         Load::Quiet => None,
         Load::Spin => Some(Spinner::start().map_err(|e| format!("cannot start `sh`: {e}"))?),
     };
     let logical = nbody_engine::run::logical_cpus();
+    let slowed = raw.slowed_kernel;
     let mut out = Vec::with_capacity(blocks);
     for b in 0..blocks {
         let started = std::time::Instant::now();
         let fresh = |cases: &[&Case]| -> Vec<CaseRecord> {
             cases
                 .iter()
-                .map(|c| CaseRecord::new((*c).clone(), rounds, logical))
+                .map(|c| CaseRecord::new((*c).clone(), 0, logical))
                 .collect()
         };
         let all: Vec<&Case> = cases.iter().collect();
@@ -75,55 +63,27 @@ pub fn measure_blocks(
             wall_s: 0.0,
             a: fresh(&all),
             b: fresh(&all),
-            slowed: if duet {
+            slowed: if raw.duet {
                 Vec::new()
             } else {
                 SLOWDOWNS.iter().map(|_| fresh(&slow_cases)).collect()
             },
         };
-        for round in 0..rounds {
-            let mut order: Vec<usize> = (0..cases.len()).collect();
-            if round % 2 == 1 {
-                order.reverse();
+        let looks = decide::looks();
+        // The first look: every side of every case.
+        let mut need: Vec<(String, Side)> = Vec::new();
+        for c in cases {
+            need.push((c.key(), Side::A));
+            need.push((c.key(), Side::B));
+            if c.kernel == KernelOrProgram::Kernel(slowed) && !raw.duet {
+                need.extend((0..SLOWDOWNS.len()).map(|k| (c.key(), Side::Slowed(k))));
             }
-            for i in order {
-                let case = &cases[i];
-                if duet {
-                    let (a, b) = std::thread::scope(|s| {
-                        let a = s.spawn(|| one_round(config, case, samples, 1.0));
-                        let b = s.spawn(|| one_round(config, case, samples, 1.0));
-                        (a.join(), b.join())
-                    });
-                    let joined = |r: std::thread::Result<Result<_, String>>| {
-                        r.map_err(|_| format!("{}: a measuring thread panicked", case.key()))?
-                    };
-                    block.a[i].add_round(joined(a)?, config.measure.max_energy_drift);
-                    block.b[i].add_round(joined(b)?, config.measure.max_energy_drift);
-                    continue;
-                }
-                let mut sides = vec![Side::A, Side::B];
-                let slot = slow_cases.iter().position(|c| c.key() == case.key());
-                if slot.is_some() {
-                    sides.extend((0..SLOWDOWNS.len()).map(Side::Slowed));
-                }
-                // Each side goes first as often as the others, over rounds and cases.
-                let shift = (round + i) % sides.len();
-                sides.rotate_left(shift);
-                for side in sides {
-                    let factor = match side {
-                        Side::Slowed(k) => SLOWDOWNS[k],
-                        _ => 1.0,
-                    };
-                    let outcome = one_round(config, case, samples, factor)?;
-                    let drift = config.measure.max_energy_drift;
-                    match (side, slot) {
-                        (Side::A, _) => block.a[i].add_round(outcome, drift),
-                        (Side::B, _) => block.b[i].add_round(outcome, drift),
-                        (Side::Slowed(k), Some(j)) => block.slowed[k][j].add_round(outcome, drift),
-                        // Slowed sides are only planned for the slowed kernel's cases.
-                        (Side::Slowed(_), None) => {}
-                    }
-                }
+        }
+        for &until in &looks {
+            measure_look(raw, cases, &mut block, &need, until)?;
+            need = decide::needs(raw, &block);
+            if need.is_empty() {
+                break;
             }
         }
         block.wall_s = started.elapsed().as_secs_f64();
@@ -131,6 +91,98 @@ pub fn measure_blocks(
         out.push(block);
     }
     Ok(out)
+}
+
+/// Rounds of the sides `need` names until each has `until`: round by round, the cases' order
+/// reversed every round, each case's sides in an order rotating over rounds and cases (duet:
+/// A and B at the same moment, one per CPU).
+fn measure_look(
+    raw: &RawStudy,
+    cases: &[Case],
+    block: &mut Block,
+    need: &[(String, Side)],
+    until: usize,
+) -> Result<(), String> {
+    let config = &raw.config;
+    let drift = config.measure.max_energy_drift;
+    let samples = raw.samples_per_round;
+    let slot = |block: &Block, key: &str| {
+        block
+            .slowed
+            .first()
+            .and_then(|s| s.iter().position(|r| r.key == key))
+    };
+    let from = need
+        .iter()
+        .map(|(k, s)| record(block, k, *s, slot(block, k)).map_or(0, |r| r.rounds.len()))
+        .min()
+        .unwrap_or(until);
+    for round in from..until {
+        let mut order: Vec<usize> = (0..cases.len()).collect();
+        if round % 2 == 1 {
+            order.reverse();
+        }
+        for i in order {
+            let case = &cases[i];
+            let key = case.key();
+            let j = slot(block, &key);
+            let mut sides: Vec<Side> = need
+                .iter()
+                .filter(|(k, s)| {
+                    k == &key && record(block, k, *s, j).is_some_and(|r| r.rounds.len() == round)
+                })
+                .map(|(_, s)| *s)
+                .collect();
+            if sides.is_empty() {
+                continue;
+            }
+            if raw.duet && sides.len() == 2 {
+                let (a, b) = std::thread::scope(|s| {
+                    let a = s.spawn(|| one_round(config, case, samples, 1.0));
+                    let b = s.spawn(|| one_round(config, case, samples, 1.0));
+                    (a.join(), b.join())
+                });
+                let joined = |r: std::thread::Result<Result<_, String>>| {
+                    r.map_err(|_| format!("{key}: a measuring thread panicked"))?
+                };
+                block.a[i].add_round(joined(a)?, drift);
+                block.b[i].add_round(joined(b)?, drift);
+                continue;
+            }
+            // Each side goes first as often as the others, over rounds and cases.
+            let shift = (round + i) % sides.len();
+            sides.rotate_left(shift);
+            for side in sides {
+                let factor = match side {
+                    Side::Slowed(k) => SLOWDOWNS[k],
+                    _ => 1.0,
+                };
+                let outcome = one_round(config, case, samples, factor)?;
+                match (side, j) {
+                    (Side::A, _) => block.a[i].add_round(outcome, drift),
+                    (Side::B, _) => block.b[i].add_round(outcome, drift),
+                    (Side::Slowed(k), Some(j)) => block.slowed[k][j].add_round(outcome, drift),
+                    // Slowed sides are only planned for the slowed kernel's cases.
+                    (Side::Slowed(_), None) => {}
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The record of case `key` on `side` (`slot`: its index among the slowed kernel's cases).
+fn record<'a>(
+    block: &'a Block,
+    key: &str,
+    side: Side,
+    slot: Option<usize>,
+) -> Option<&'a CaseRecord> {
+    match side {
+        Side::A => block.a.iter().find(|r| r.key == key),
+        Side::B => block.b.iter().find(|r| r.key == key),
+        Side::Slowed(k) => block.slowed.get(k)?.get(slot?),
+    }
 }
 
 /// One round of `case` in this process, its kernel's force computation made `factor` times as

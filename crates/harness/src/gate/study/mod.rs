@@ -42,6 +42,18 @@ pub enum Load {
     Spin,
 }
 
+/// How a run's decisions were judged.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Method {
+    /// The rule before paired decisions: a fixed 4 rounds, a bootstrap of all samples' medians.
+    #[default]
+    BootstrapMedians,
+    /// Paired rounds (A/B) or the samples' logs (fast path) with t intervals, A/B in looks
+    /// ([`crate::gate::sequential`]).
+    PairedSequential,
+}
+
 /// What one block measured: per case, the rounds of each side.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct Block {
@@ -120,15 +132,26 @@ pub struct StudyRun {
     pub duet: bool,
     /// The kernel made slower for the power decisions.
     pub slowed_kernel: KernelKind,
+    /// How the decisions were judged (runs before paired decisions: a bootstrap of medians).
+    #[serde(default)]
+    pub method: Method,
+    /// Most rounds per side of an A/B decision's case (= `rounds` for runs that judged once).
+    #[serde(default)]
+    pub max_rounds: usize,
     /// Blocks measured, each one decision per mode and slowdown.
     pub blocks: usize,
+    /// Cases of the config each decision judged.
+    #[serde(default)]
+    pub cases: usize,
     /// Rounds of every case per side in a block.
     pub rounds: usize,
     /// Samples of every case in each round.
     pub samples_per_round: usize,
     /// Median wall time of one block (all its sides), seconds.
     pub block_wall_s: f64,
-    /// Median wall time of measuring one decision's two sides (A and B), seconds.
+    /// Median wall time of measuring one decision's two sides (A and B), seconds: for paired
+    /// sequential runs, the block's time times the share of its rounds the gate's own A/A
+    /// decision took.
     pub decision_measure_s: f64,
     /// Decisions counted per mode, rule, threshold and slowdown.
     pub tallies: Vec<decide::Tally>,
@@ -145,14 +168,30 @@ impl StudyRun {
         let (tallies, widths, step_ratios) = decide::tally(raw, baseline);
         let walls: Vec<f64> = raw.blocks.iter().map(|b| b.wall_s).collect();
         let block_wall_s = nbody_engine::stats::median(&walls).unwrap_or(f64::NAN);
-        // The two sides' share of a block: A and B of every case against the slowed sides.
-        let sides = |b: &Block| {
-            let count = |records: &[CaseRecord]| records.len() as f64;
-            let slowed: f64 = b.slowed.iter().map(|s| count(s)).sum();
-            let ab = count(&b.a) + count(&b.b);
-            ab / (ab + slowed).max(1.0)
+        // A block also measures rounds for the slowed sides and for the candidate thresholds:
+        // the gate's own A/A decision takes the share of its rounds in the block's.
+        let share = |b: &Block| {
+            let rounds =
+                |records: &[CaseRecord]| -> usize { records.iter().map(|r| r.rounds.len()).sum() };
+            let all =
+                rounds(&b.a) + rounds(&b.b) + b.slowed.iter().map(|s| rounds(s)).sum::<usize>();
+            let (report, _) = decide::replay(
+                raw,
+                &b.a,
+                &b.b,
+                crate::gate::AB_JUDGE,
+                crate::gate::AB_THRESHOLD,
+            );
+            let looks = decide::looks();
+            let own: usize = report.map_or(0, |r| {
+                r.cases
+                    .iter()
+                    .map(|c| 2 * looks[c.look.clamp(1, looks.len()) - 1])
+                    .sum()
+            });
+            own as f64 / all.max(1) as f64
         };
-        let decision: Vec<f64> = raw.blocks.iter().map(|b| b.wall_s * sides(b)).collect();
+        let decision: Vec<f64> = raw.blocks.iter().map(|b| b.wall_s * share(b)).collect();
         StudyRun {
             started: raw.metadata.started.clone(),
             git_commit: raw.metadata.git_commit.clone(),
@@ -160,7 +199,10 @@ impl StudyRun {
             load: raw.load,
             duet: raw.duet,
             slowed_kernel: raw.slowed_kernel,
+            method: Method::PairedSequential,
+            max_rounds: crate::gate::AB_MAX_ROUNDS,
             blocks: raw.blocks.len(),
+            cases: raw.blocks.first().map_or(0, |b| b.a.len()),
             rounds: raw.rounds,
             samples_per_round: raw.samples_per_round,
             block_wall_s,

@@ -122,11 +122,12 @@ pub fn run(options: &StudyOptions, say: &mut dyn FnMut(&str)) -> anyhow::Result<
     let run_dir = nbody_records::locate::new_run_dir(&options.runs_root, "gate-study", &utc_now())?;
     let raw_path = run_dir.join("raw.json");
     say(&format!(
-        "{} blocks of {} cases x {} rounds x {} samples, sides A and B{}, load {:?}{}; fast-path \
-         decisions against {}; raw measurements in {}",
+        "{} blocks of {} cases x {} to {} rounds x {} samples, sides A and B{}, load {:?}{}; \
+         fast-path decisions against {}; raw measurements in {}",
         options.blocks,
         cases.len(),
         rounds,
+        crate::gate::AB_MAX_ROUNDS,
         samples,
         if options.duet {
             " at the same moment (duet)".to_string()
@@ -161,30 +162,21 @@ pub fn run(options: &StudyOptions, say: &mut dyn FnMut(&str)) -> anyhow::Result<
     let started = std::time::Instant::now();
     let total = options.blocks;
     let mut saved: anyhow::Result<()> = Ok(());
-    let blocks = super::measure_blocks(
-        &config,
-        &cases,
-        total,
-        rounds,
-        samples,
-        options.slowed,
-        options.load,
-        options.duet,
-        &mut |i, block| {
-            // Nothing measured is lost: the raw file holds every finished block.
-            raw.blocks.push(block.clone());
-            if saved.is_ok() {
-                saved = save_json(&raw_path, &raw);
-            }
-            let left = started.elapsed().as_secs_f64() / (i + 1) as f64 * (total - i - 1) as f64;
-            say(&format!(
-                "block {}/{total} measured in {:.1} s (about {:.0} min left)",
-                i + 1,
-                block.wall_s,
-                left / 60.0
-            ));
-        },
-    )
+    let template = raw.clone();
+    let blocks = super::measure_blocks(&template, &cases, total, &mut |i, block| {
+        // Nothing measured is lost: the raw file holds every finished block.
+        raw.blocks.push(block.clone());
+        if saved.is_ok() {
+            saved = save_json(&raw_path, &raw);
+        }
+        let left = started.elapsed().as_secs_f64() / (i + 1) as f64 * (total - i - 1) as f64;
+        say(&format!(
+            "block {}/{total} measured in {:.1} s (about {:.0} min left)",
+            i + 1,
+            block.wall_s,
+            left / 60.0
+        ));
+    })
     .map_err(|e| anyhow::anyhow!(e))?;
     saved?;
     raw.blocks = blocks;

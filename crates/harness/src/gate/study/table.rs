@@ -3,7 +3,7 @@
 //! thresholds and mode were chosen from.
 
 use super::decide::Mode;
-use super::{Load, SLOWDOWNS, StudyFile, StudyRun};
+use super::{Load, Method, SLOWDOWNS, StudyFile, StudyRun};
 use crate::gate::{AB_JUDGE, AB_THRESHOLD, FILE_JUDGE, FILE_THRESHOLD, Judged};
 use crate::render::tables::{Align, Table};
 
@@ -13,13 +13,18 @@ pub const BEGIN: &str =
 /// End mark of the generated region in docs/explanation/gate.md.
 pub const END: &str = "<!-- end of generated region -->";
 
-fn threshold(mode: Mode) -> f64 {
-    match mode {
-        Mode::Ab => AB_THRESHOLD,
-        Mode::Fast => FILE_THRESHOLD,
+/// The threshold a run's decisions were configured with: today's defaults, or for a run
+/// judged before paired decisions the defaults of that rule (A/B 3%, fast path 10%).
+fn threshold(run: &StudyRun, mode: Mode) -> f64 {
+    match (run.method, mode) {
+        (Method::PairedSequential, Mode::Ab) => AB_THRESHOLD,
+        (Method::PairedSequential, Mode::Fast) => FILE_THRESHOLD,
+        (Method::BootstrapMedians, Mode::Ab) => 0.03,
+        (Method::BootstrapMedians, Mode::Fast) => 0.10,
     }
 }
 
+/// The rule a mode judges on (the same before and since paired decisions).
 fn rule(mode: Mode) -> Judged {
     match mode {
         Mode::Ab => AB_JUDGE,
@@ -28,11 +33,28 @@ fn rule(mode: Mode) -> Judged {
 }
 
 fn condition(run: &StudyRun) -> String {
-    match (run.duet, run.load) {
-        (true, _) => "duet (both sides at once, one per CPU)".into(),
-        (false, Load::Quiet) => "quiet".into(),
-        (false, Load::Spin) => "a process spinning on one CPU".into(),
+    let load = match (run.duet, run.load) {
+        (true, _) => "duet (both sides at once, one per CPU)",
+        (false, Load::Quiet) => "quiet",
+        (false, Load::Spin) => "a process spinning on one CPU",
+    };
+    match run.method {
+        Method::PairedSequential => load.to_string(),
+        Method::BootstrapMedians => format!("{load}, before paired decisions"),
     }
+}
+
+/// The thresholds a run judged `mode` at under `rule`, in increasing order.
+fn thresholds(run: &StudyRun, mode: Mode, rule: Judged) -> Vec<f64> {
+    let mut t: Vec<f64> = run
+        .tallies
+        .iter()
+        .filter(|t| t.mode == mode && t.rule == rule && t.slowdown == 1.0)
+        .map(|t| t.threshold)
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t.dedup();
+    t
 }
 
 fn percent(x: f64) -> String {
@@ -86,12 +108,16 @@ pub fn markdown(files: &[StudyFile]) -> String {
                 ))
         );
         s += &format!(
-            "**The gate as configured** (A/B: the `{}` ratio above {}; fast path: `{}` above \
-             {}): decisions that flagged any case on unchanged code (false alarms), and that \
-             flagged exactly the slowed kernel's cases (power), with 95% Clopper–Pearson \
-             intervals.\n\n",
+            "**The gate as configured** (A/B: the `{}` ratio above {}, paired rounds in looks of \
+             {} up to {} rounds; fast path: `{}` above {}; runs before paired decisions at their \
+             own defaults, 1.03 and 1.1): decisions that flagged any case on unchanged code \
+             (false alarms), and that flagged exactly the slowed kernel's cases (power), with \
+             95% Clopper–Pearson intervals; decisions that left some case unknown, and the mean \
+             rounds per case of an A/A decision.\n\n",
             rule_name(AB_JUDGE),
             1.0 + AB_THRESHOLD,
+            crate::gate::AB_ROUNDS,
+            crate::gate::AB_MAX_ROUNDS,
             rule_name(FILE_JUDGE),
             1.0 + FILE_THRESHOLD
         );
@@ -100,6 +126,8 @@ pub fn markdown(files: &[StudyFile]) -> String {
             "mode".into(),
             "decisions measured in".into(),
             "false alarms (A/A)".into(),
+            "unknown (A/A)".into(),
+            "rounds per case (A/A)".into(),
         ];
         // The knob slows the force computation; the step the gate times also builds,
         // integrates and applies the walls, so its own ratio is shown beside.
@@ -119,19 +147,32 @@ pub fn markdown(files: &[StudyFile]) -> String {
         );
         for run in &file.runs {
             for mode in [Mode::Ab, Mode::Fast] {
-                if run.tally(mode, rule(mode), threshold(mode), 1.0).is_none() {
+                let th = threshold(run, mode);
+                let Some(aa) = run.tally(mode, rule(mode), th, 1.0) else {
                     continue;
-                }
+                };
+                let (unknown, rounds) = match run.method {
+                    Method::BootstrapMedians => ("–".to_string(), format!("{}", run.rounds)),
+                    Method::PairedSequential => (
+                        format!("{}/{}", aa.undecided, aa.decisions),
+                        format!(
+                            "{:.1}",
+                            aa.case_rounds as f64 / (aa.decisions * run.cases.max(1)).max(1) as f64
+                        ),
+                    ),
+                };
                 let mut row = vec![
                     condition(run),
                     mode.name().to_string(),
                     format!("{:.1} s", run.decision_measure_s),
-                    cell(run, mode, rule(mode), threshold(mode), 1.0),
+                    cell(run, mode, rule(mode), th, 1.0),
+                    unknown,
+                    rounds,
                 ];
                 row.extend(
                     SLOWDOWNS
                         .iter()
-                        .map(|&f| cell(run, mode, rule(mode), threshold(mode), f)),
+                        .map(|&f| cell(run, mode, rule(mode), th, f)),
                 );
                 t.row(row);
             }
@@ -141,12 +182,15 @@ pub fn markdown(files: &[StudyFile]) -> String {
         s += &thresholds_table(file);
         s += &widths_table(file);
         for run in &file.runs {
+            let rounds = match run.method {
+                Method::PairedSequential => format!("{} to {}", run.rounds, run.max_rounds),
+                Method::BootstrapMedians => run.rounds.to_string(),
+            };
             s += &format!(
-                "\n- {}: {} blocks of {} rounds x {} samples per side, slowed kernel `{}`, \
+                "\n- {}: {} blocks of {rounds} rounds x {} samples per side, slowed kernel `{}`, \
                  measured {} (commit {}{}), {:.0} s per block.\n",
                 condition(run),
                 run.blocks,
-                run.rounds,
                 run.samples_per_round,
                 run.slowed_kernel.name(),
                 run.started,
@@ -192,8 +236,9 @@ fn rules_table(file: &StudyFile) -> String {
     let mut any = false;
     for run in file.runs.iter().filter(|r| !r.duet) {
         for mode in [Mode::Ab, Mode::Fast] {
+            let th = threshold(run, mode);
             for rule in super::decide::RULES {
-                if run.tally(mode, rule, threshold(mode), 1.0).is_none() {
+                if run.tally(mode, rule, th, 1.0).is_none() {
                     continue;
                 }
                 any = true;
@@ -201,9 +246,9 @@ fn rules_table(file: &StudyFile) -> String {
                     condition(run),
                     mode.name().to_string(),
                     rule_name(rule).to_string(),
-                    cell(run, mode, rule, threshold(mode), 1.0),
-                    cell(run, mode, rule, threshold(mode), 1.10),
-                    cell(run, mode, rule, threshold(mode), 1.25),
+                    cell(run, mode, rule, th, 1.0),
+                    cell(run, mode, rule, th, 1.10),
+                    cell(run, mode, rule, th, 1.25),
                 ]);
             }
         }
@@ -244,7 +289,7 @@ fn thresholds_table(file: &StudyFile) -> String {
     for run in file.runs.iter().filter(|r| !r.duet) {
         for mode in [Mode::Ab, Mode::Fast] {
             let rule = rule(mode);
-            for &th in mode.candidates() {
+            for th in thresholds(run, mode, rule) {
                 if run.tally(mode, rule, th, 1.0).is_none() {
                     continue;
                 }
