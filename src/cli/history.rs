@@ -6,7 +6,7 @@ use clap::{Args, Subcommand};
 use nbody_engine::output::neutral::control::visible;
 use nbody_harness::gate::baselines::check_class_name;
 use nbody_harness::history::series::{Metric, Point, Series, series};
-use nbody_harness::history::steps::{Step, steps};
+use nbody_harness::history::steps::{Drift, Step, changes};
 use nbody_harness::history::store::{self, CommitFacts, History};
 use nbody_harness::history::verdicts::{self, GateRun};
 use nbody_harness::units::Duration;
@@ -328,17 +328,23 @@ fn show(args: &HistoryArgs) -> anyhow::Result<i32> {
     Ok(0)
 }
 
-/// A series and the steps found in it.
+/// A series and the steps and drifts found in it. The steps keep the key `changes` they have
+/// always had; `drifts` is beside them.
 #[derive(serde::Serialize)]
 struct Found<'a> {
     #[serde(flatten)]
     series: &'a Series,
     changes: Vec<Step>,
+    drifts: Vec<Drift>,
 }
 
 fn found(s: &Series) -> anyhow::Result<Found<'_>> {
-    let changes = steps(s).with_context(|| format!("the series of {}", s.case))?;
-    Ok(Found { series: s, changes })
+    let found = changes(s).with_context(|| format!("the series of {}", s.case))?;
+    Ok(Found {
+        series: s,
+        changes: found.steps,
+        drifts: found.drifts,
+    })
 }
 
 fn print_series(f: &Found) {
@@ -390,7 +396,11 @@ fn print_series(f: &Found) {
             100.0 * (c.ratio_ci95[1] - 1.0)
         );
     }
-    if f.changes.is_empty() && s.points.len() > 1 {
+    for d in &f.drifts {
+        let [a, b] = [d.start, d.end].map(|i| name(&s.points[i]));
+        println!("  {}", d.text(&a, &b));
+    }
+    if f.changes.is_empty() && f.drifts.is_empty() && s.points.len() > 1 {
         println!("  no step");
     }
 }

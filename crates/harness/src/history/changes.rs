@@ -18,7 +18,7 @@
 //!   first up to 2 points early, and moves to its commit as the new level grows.
 //! - *Penalized likelihood rather than a test per candidate*: Apache Otava's E-divisive means
 //!   with t-tests in sliding windows (p 0.001, window 50) was scored on the same corpus
-//!   (`corpus.rs`): its t-test on segment means turns isolated spikes into change points (24
+//!   (`corpus/`): its t-test on segment means turns isolated spikes into change points (24
 //!   on the spike-only series; Otava issue #150), and with a minimum segment of 5 added it
 //!   still reports some part-way through and finds fewer steps (F1 0.969 for steps of 5% or
 //!   more and 0.930 for 3–5%, where this detector has 1.000 and 1.000). The table is in
@@ -58,10 +58,10 @@ const MEDIAN_ABS_DIFF: f64 = 0.953_872_552_408_939_8;
 const MEAN_ABS_DIFF: f64 = std::f64::consts::FRAC_2_SQRT_PI;
 
 /// The standard error of the median of n normal values is this × σ/√n (for large n): √(π/2).
-const MEDIAN_SE: f64 = 1.253_314_137_315_500_1;
+pub(crate) const MEDIAN_SE: f64 = 1.253_314_137_315_500_1;
 
 /// The two-sided 95% quantile of the standard normal.
-const Z95: f64 = 1.959_963_984_540_054;
+pub(crate) const Z95: f64 = 1.959_963_984_540_054;
 
 /// Why a series or a detector is refused.
 #[derive(Clone, Debug, Error, PartialEq)]
@@ -221,7 +221,7 @@ impl Incremental {
     }
 }
 
-fn log_of(index: usize, value: f64) -> Result<f64, ChangeError> {
+pub(crate) fn log_of(index: usize, value: f64) -> Result<f64, ChangeError> {
     if value.is_finite() && value > 0.0 {
         Ok(value.ln())
     } else {
@@ -233,7 +233,7 @@ fn log_of(index: usize, value: f64) -> Result<f64, ChangeError> {
 /// its value for normal noise; their mean when more than half are zero (a coarse timer);
 /// never below [`MIN_SCALE`]. A step makes one large difference, a spike two: the median
 /// ignores both.
-fn scale_of(logs: &[f64]) -> f64 {
+pub(crate) fn scale_of(logs: &[f64]) -> f64 {
     let diffs: Vec<f64> = logs.windows(2).map(|w| (w[1] - w[0]).abs()).collect();
     let Some(mid) = median(&diffs) else {
         return MIN_SCALE;
@@ -247,7 +247,7 @@ fn scale_of(logs: &[f64]) -> f64 {
 }
 
 /// σ rounded to the nearest 1/16 octave, the value the penalty is made from.
-fn rounded(scale: f64) -> f64 {
+pub(crate) fn rounded(scale: f64) -> f64 {
     ((scale.log2() * SCALE_STEPS_PER_OCTAVE).round() / SCALE_STEPS_PER_OCTAVE).exp2()
 }
 
@@ -256,7 +256,7 @@ fn rounded(scale: f64) -> f64 {
 /// insertion costs O(log n) (the cost is the upper sum minus the lower, plus the middle value
 /// when the count is odd, which the lower half holds).
 #[derive(Default)]
-struct Halves {
+pub(crate) struct Halves {
     lower: BinaryHeap<Key>,
     upper: BinaryHeap<Reverse<Key>>,
     lower_sum: f64,
@@ -264,7 +264,7 @@ struct Halves {
 }
 
 impl Halves {
-    fn insert(&mut self, v: f64) {
+    pub(crate) fn insert(&mut self, v: f64) {
         if self.lower.peek().is_none_or(|m| v <= m.0) {
             self.lower.push(Key(v));
             self.lower_sum += v;
@@ -287,7 +287,7 @@ impl Halves {
         }
     }
 
-    fn cost(&self) -> f64 {
+    pub(crate) fn cost(&self) -> f64 {
         let middle = match self.lower.peek() {
             Some(m) if self.lower.len() > self.upper.len() => m.0,
             _ => 0.0,
@@ -429,7 +429,7 @@ impl Fit {
 }
 
 /// Each change point with its segments' levels and ratio (`scale`: σ, unrounded).
-fn describe(logs: &[f64], starts: &[usize], scale: f64) -> Vec<Change> {
+pub(crate) fn describe(logs: &[f64], starts: &[usize], scale: f64) -> Vec<Change> {
     let mut bounds = Vec::with_capacity(starts.len() + 2);
     bounds.push(0);
     bounds.extend_from_slice(starts);
@@ -441,17 +441,23 @@ fn describe(logs: &[f64], starts: &[usize], scale: f64) -> Vec<Change> {
     (1..bounds.len() - 1)
         .map(|i| {
             let (n_before, n_after) = (bounds[i] - bounds[i - 1], bounds[i + 1] - bounds[i]);
-            let step = levels[i] - levels[i - 1];
             let se = MEDIAN_SE * scale * (1.0 / n_before as f64 + 1.0 / n_after as f64).sqrt();
-            Change {
-                index: bounds[i],
-                before: levels[i - 1].exp(),
-                after: levels[i].exp(),
-                ratio: step.exp(),
-                ratio_ci95: [(step - Z95 * se).exp(), (step + Z95 * se).exp()],
-            }
+            change_of(bounds[i], [levels[i - 1], levels[i]], se)
         })
         .collect()
+}
+
+/// The change at `index` from the level `logs[0]` to `logs[1]` (logarithms), the log ratio's
+/// standard error being `se`.
+pub(crate) fn change_of(index: usize, logs: [f64; 2], se: f64) -> Change {
+    let step = logs[1] - logs[0];
+    Change {
+        index,
+        before: logs[0].exp(),
+        after: logs[1].exp(),
+        ratio: step.exp(),
+        ratio_ci95: [(step - Z95 * se).exp(), (step + Z95 * se).exp()],
+    }
 }
 
 #[cfg(test)]

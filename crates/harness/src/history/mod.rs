@@ -1,8 +1,9 @@
 //! The performance history: every measurement kept per commit and machine class
 //! (`results/history/<class>.jsonl`, [`store`], read by one line reader, `lines`, with
 //! dates compared as [`instant`]s), the steps found in each case's series
-//! ([`changes`], scored on a generated corpus in `corpus`), the series themselves
-//! ([`series`]) and their steps ([`steps`]), the gate's verdicts kept beside them
+//! ([`changes`]) and the drifts beside them ([`drifts`], lines fitted by [`trend`]), scored on a
+//! generated corpus in `corpus`, the series themselves ([`series`]) and their steps and drifts
+//! ([`steps`]), the gate's verdicts kept beside them
 //! ([`verdicts`]), the commit that made a case slower ([`bisect`]), a history as a tidy table
 //! ([`tidy`]) and as a page and a pull-request summary ([`publish`]), and older commits
 //! measured into it ([`backfill`]).
@@ -12,6 +13,7 @@ pub mod bisect;
 pub mod changes;
 #[cfg(test)]
 mod corpus;
+pub mod drifts;
 pub mod instant;
 mod lines;
 pub mod publish;
@@ -19,4 +21,5 @@ pub mod series;
 pub mod steps;
 pub mod store;
 pub mod tidy;
+pub mod trend;
 pub mod verdicts;

@@ -36,6 +36,16 @@ pub struct Point {
     pub ci95: [f64; 2],
     /// Records of the commit the point is made from (builds with uncommitted changes left out).
     pub records: usize,
+    /// The median of its records' times per step, seconds, whatever the series' metric: the
+    /// raw series the steps are placed on when the control is flat ([`super::steps`]).
+    #[serde(skip)]
+    pub seconds: f64,
+    /// The control: the time of the reference workload at this commit on this machine class
+    /// and config, the median over every case's records of the commit (each record's median
+    /// time over its normalised median); `None` when some record of the commit has no
+    /// reference timing. What divides the raw series into the normalised one.
+    #[serde(skip)]
+    pub control: Option<f64>,
 }
 
 /// A case's series on one machine class and config: one point per commit, in commit order.
@@ -76,18 +86,63 @@ pub fn series(records: &[Record]) -> Vec<Series> {
             keys.push(key);
         }
     }
+    let controls = controls(records);
     keys.into_iter()
         .map(|(class, config, case)| {
             let mine: Vec<&Record> = records
                 .iter()
                 .filter(|r| r.class == class && r.config == config && r.case == case)
                 .collect();
-            one(class, config, case, &mine)
+            let control = |r: &Record| {
+                let (commit, measured) = point_key(r);
+                controls
+                    .get(&(class, config, commit, measured))
+                    .copied()
+                    .flatten()
+            };
+            one(class, config, case, &mine, &control)
         })
         .collect()
 }
 
-fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
+/// A point's key within its class and config: (class, config, commit, measurement).
+type ControlKey<'a> = (&'a str, &'a str, &'a str, Option<&'a str>);
+
+/// The control of every (class, config, point): the median over the clean records of all
+/// cases of the reference workload's time (median seconds over normalised median); `None`
+/// when one of them has no reference timing. The reference workload is the same for every case
+/// of a config (its length is the config's `measure.reference_s`), so every case's records of
+/// a commit time it: the median over them is less noisy than any one case's.
+fn controls(records: &[Record]) -> std::collections::BTreeMap<ControlKey<'_>, Option<f64>> {
+    let mut times: std::collections::BTreeMap<ControlKey<'_>, Option<Vec<f64>>> =
+        std::collections::BTreeMap::new();
+    for r in records.iter().filter(|r| !r.dirty) {
+        let (commit, measured) = point_key(r);
+        let time = r
+            .normalized
+            .map(|n| r.median_s / n.median)
+            .filter(|t| t.is_finite() && *t > 0.0);
+        let entry = times
+            .entry((&r.class, &r.config, commit, measured))
+            .or_insert_with(|| Some(Vec::new()));
+        match (entry.as_mut(), time) {
+            (Some(v), Some(t)) => v.push(t),
+            _ => *entry = None,
+        }
+    }
+    times
+        .into_iter()
+        .map(|(k, v)| (k, v.and_then(|v| median(&v))))
+        .collect()
+}
+
+fn one(
+    class: &str,
+    config: &str,
+    case: &str,
+    records: &[&Record],
+    control: &dyn Fn(&Record) -> Option<f64>,
+) -> Series {
     let clean: Vec<&Record> = records.iter().copied().filter(|r| !r.dirty).collect();
     let metric = if !clean.is_empty() && clean.iter().all(|r| r.normalized.is_some()) {
         Metric::Normalized
@@ -118,6 +173,7 @@ fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
             .map(|o| value(o).1[0])
             .fold(f64::INFINITY, f64::min);
         let hi = same.iter().map(|o| value(o).1[1]).fold(0.0, f64::max);
+        let seconds: Vec<f64> = same.iter().map(|o| o.median_s).collect();
         points.push(Point {
             commit: r.commit.clone(),
             measured: key.1.map(str::to_string),
@@ -125,6 +181,8 @@ fn one(class: &str, config: &str, case: &str, records: &[&Record]) -> Series {
             value: median(&values).unwrap_or(f64::NAN),
             ci95: [lo, hi],
             records: same.len(),
+            seconds: median(&seconds).unwrap_or(f64::NAN),
+            control: control(r),
         });
     }
     Series {

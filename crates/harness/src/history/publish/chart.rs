@@ -219,12 +219,27 @@ fn interval_band(o: &mut String, f: &Frame, s: &Series) {
 }
 
 /// Each segment's level between the steps: the level after the step that opens it, or for
-/// the first segment the level before the first step (none without steps).
+/// the first segment the level before the first step (none without steps); no level across a
+/// drift (a stretch between two steps that holds one is not level), and each drift's fitted
+/// trend as a sloped line.
 fn segment_levels(o: &mut String, f: &Frame, chart: &Chart) {
     let mut bounds = vec![0];
     bounds.extend(chart.steps.iter().map(|st| st.index));
     bounds.push(f.n);
+    for d in &chart.drifts {
+        let _ = write!(
+            o,
+            r#"<line class="level drift" x1="{:.1}" x2="{:.1}" y1="{:.1}" y2="{:.1}"/>"#,
+            f.x(d.start),
+            f.x(d.end),
+            f.y(d.from),
+            f.y(d.to)
+        );
+    }
     for (k, w) in bounds.windows(2).enumerate() {
+        if chart.drifts.iter().any(|d| d.start < w[1] && w[0] <= d.end) {
+            continue;
+        }
         let level = match (
             k.checked_sub(1).map(|j| &chart.steps[j]),
             chart.steps.get(k),

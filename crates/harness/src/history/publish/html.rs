@@ -249,6 +249,7 @@ fn changes(o: &mut String, page: &Page) {
     let all: Vec<&Chart> = page.charts().filter(|c| !c.steps.is_empty()).collect();
     if all.is_empty() {
         o.push_str("<p>No step in any series.</p>\n");
+        drifts(o, page);
         return;
     }
     o.push_str(
@@ -273,6 +274,42 @@ fn changes(o: &mut String, page: &Page) {
                 t.size,
                 t.low,
                 t.high,
+            );
+        }
+    }
+    o.push_str("</table>\n");
+    drifts(o, page);
+}
+
+/// The drifts of every series, when any has one: a page of a history without drifts is what
+/// it was before drifts were looked for.
+fn drifts(o: &mut String, page: &Page) {
+    let all: Vec<&Chart> = page.charts().filter(|c| !c.drifts.is_empty()).collect();
+    if all.is_empty() {
+        return;
+    }
+    o.push_str(
+        "<h2 id=\"drifts\">Drifts found</h2>\n<table class=\"changes\"><tr><th>case</th>\
+         <th>class</th><th>from..to</th><th>change</th><th>95% interval</th><th>per commit</th>\
+         </tr>\n",
+    );
+    for c in all {
+        let s = &c.series;
+        for d in &c.drifts {
+            let _ = writeln!(
+                o,
+                "<tr><td class=\"key\">{}</td><td>{}</td><td><code>{}..{}</code></td>\
+                 <td class=\"num {}\">{}</td><td class=\"num\">[{}, {}]</td>\
+                 <td class=\"num\">{:+.2}%</td></tr>",
+                esc(&s.case),
+                esc(&s.class),
+                esc(short(&d.range[0])),
+                esc(short(&d.range[1])),
+                if d.ratio > 1.0 { "slower" } else { "faster" },
+                percent(d.ratio),
+                percent(d.ratio_ci95[0]),
+                percent(d.ratio_ci95[1]),
+                100.0 * (d.per_commit - 1.0),
             );
         }
     }
@@ -327,7 +364,7 @@ fn case(o: &mut String, c: &CaseView) {
         o.push_str("</figcaption>\n");
         o.push_str(&chart::svg(ch));
         o.push('\n');
-        if ch.steps.is_empty() {
+        if ch.steps.is_empty() && ch.drifts.is_empty() {
             o.push_str("<ul class=\"steps\"><li>no step</li></ul>\n");
         } else {
             o.push_str("<ul class=\"steps\">");
@@ -339,6 +376,13 @@ fn case(o: &mut String, c: &CaseView) {
                      (<span class=\"{}\">{}</span>, 95% interval [{}, {}])</li>",
                     t.from, t.to, t.before, t.after, t.way, t.size, t.low, t.high,
                 );
+            }
+            for d in &ch.drifts {
+                let [a, b] = d
+                    .range
+                    .each_ref()
+                    .map(|c| format!("<code>{}</code>", esc(short(c))));
+                let _ = write!(o, "<li>{}</li>", d.text(&a, &b));
             }
             o.push_str("</ul>\n");
         }

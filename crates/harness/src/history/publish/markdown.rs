@@ -7,7 +7,7 @@ use super::html::gate_commits;
 use super::{Chart, ClassView, Page, short};
 use crate::gate::Verdict;
 use crate::git::Rev;
-use crate::history::steps::Step;
+use crate::history::steps::{Drift, Step};
 use crate::render::tables::{Align, Table};
 use nbody_engine::output::neutral::markdown::{cell_code, code, text};
 use std::fmt::Write;
@@ -96,6 +96,17 @@ impl Base {
     /// commit of the new level is not in the base's past); a commit git does not know is
     /// listed.
     pub fn precedes(&self, chart: &Chart, step: &Step) -> bool {
+        self.precedes_at(chart, step.index, &step.between[1])
+    }
+
+    /// Whether `drift` of `chart` reached past the base: its last commit came after it, as
+    /// [`Base::precedes`] tells for a step's first commit of the new level.
+    pub fn precedes_drift(&self, chart: &Chart, drift: &Drift) -> bool {
+        self.precedes_at(chart, drift.end, &drift.range[1])
+    }
+
+    /// Whether the point `index` of `chart`, of commit `commit`, came after the base.
+    fn precedes_at(&self, chart: &Chart, index: usize, commit: &str) -> bool {
         if self.none.is_some() {
             return true;
         }
@@ -104,13 +115,13 @@ impl Base {
             None => commit.starts_with(&self.name),
         };
         if let Some(at) = chart.series.points.iter().position(|p| mine(&p.commit)) {
-            return step.index > at;
+            return index > at;
         }
         let Some(full) = self.commit.as_deref().and_then(Rev::recorded) else {
             return true;
         };
         // The step's commit comes from a history file: git hears of it only as a hash.
-        let Some(after) = Rev::recorded(&step.between[1]) else {
+        let Some(after) = Rev::recorded(commit) else {
             return true;
         };
         let status = crate::git::command(
@@ -133,7 +144,15 @@ pub fn summary(page: &Page, base: &Base) -> String {
         .charts()
         .map(|c| (c, c.steps.iter().filter(|s| base.precedes(c, s)).collect()))
         .collect();
-    let total: usize = found.iter().map(|(_, s)| s.len()).sum();
+    let drifts: Vec<(&Chart, Vec<&Drift>)> = page
+        .charts()
+        .map(|c| {
+            let mine = c.drifts.iter().filter(|d| base.precedes_drift(c, d));
+            (c, mine.collect())
+        })
+        .collect();
+    let total: usize = found.iter().map(|(_, s)| s.len()).sum::<usize>()
+        + drifts.iter().map(|(_, d)| d.len()).sum::<usize>();
     let _ = writeln!(o, "### Performance history since {}\n", code(&base.name));
     if let Some(why) = &base.none {
         let _ = writeln!(o, "_{why}._\n");
@@ -153,7 +172,12 @@ pub fn summary(page: &Page, base: &Base) -> String {
             .iter()
             .filter(|(c, _)| c.series.class == class.class)
             .collect();
-        let count: usize = mine.iter().map(|(_, s)| s.len()).sum();
+        let mine_drifts: Vec<&(&Chart, Vec<&Drift>)> = drifts
+            .iter()
+            .filter(|(c, d)| c.series.class == class.class && !d.is_empty())
+            .collect();
+        let count: usize = mine.iter().map(|(_, s)| s.len()).sum::<usize>()
+            + mine_drifts.iter().map(|(_, d)| d.len()).sum::<usize>();
         let _ = writeln!(
             o,
             "**{}** ({} commits, newest measurement {})",
@@ -165,8 +189,14 @@ pub fn summary(page: &Page, base: &Base) -> String {
         if count == 0 {
             let _ = writeln!(o, "No change since {}.\n", code(&base.name));
         } else {
-            o.push_str(&steps_table(&mine).markdown());
-            o.push('\n');
+            if mine.iter().any(|(_, s)| !s.is_empty()) {
+                o.push_str(&steps_table(&mine).markdown());
+                o.push('\n');
+            }
+            if !mine_drifts.is_empty() {
+                o.push_str(&drifts_table(&mine_drifts).markdown());
+                o.push('\n');
+            }
         }
         latest_gate(&mut o, class);
     }
@@ -215,6 +245,45 @@ fn steps_table(mine: &[&(&Chart, Vec<&Step>)]) -> Table {
                     percent(st.ratio_ci95[0]),
                     percent(st.ratio_ci95[1])
                 ),
+            ]);
+        }
+    }
+    t
+}
+
+/// One row per drift reaching past the base in a class's charts: the case, its first and last
+/// commits, its size with its interval, and its rate per commit.
+fn drifts_table(mine: &[&(&Chart, Vec<&Drift>)]) -> Table {
+    let mut t = Table::new([
+        "case",
+        "drift from..to",
+        "change",
+        "95% interval",
+        "per commit",
+    ])
+    .aligned([
+        Align::Default,
+        Align::Default,
+        Align::Right,
+        Align::Right,
+        Align::Right,
+    ]);
+    for (c, drifts) in mine {
+        for d in drifts {
+            t.row([
+                cell_code(&c.series.case),
+                cell_code(&format!("{}..{}", short(&d.range[0]), short(&d.range[1]))),
+                format!(
+                    "{} {}",
+                    percent(d.ratio),
+                    if d.ratio > 1.0 { "slower" } else { "faster" }
+                ),
+                format!(
+                    "[{}, {}]",
+                    percent(d.ratio_ci95[0]),
+                    percent(d.ratio_ci95[1])
+                ),
+                format!("{:+.2}%", 100.0 * (d.per_commit - 1.0)),
             ]);
         }
     }

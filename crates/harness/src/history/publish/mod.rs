@@ -1,7 +1,7 @@
 //! `publish`: the history as one self-contained HTML page (inline SVG, a small inline script
 //! that only adds a filter box and tooltips; no network) and as a Markdown summary for a
 //! pull-request comment. Both are made from one [`Page`], built from every history file of a
-//! folder with the same series ([`super::series`]) and steps ([`super::steps`]) the `history`
+//! folder with the same series ([`super::series`]) and steps and drifts ([`super::steps`]) the `history`
 //! command shows, and from the gate verdicts kept beside them ([`super::verdicts`]). Nothing
 //! in the page depends on when or where it was made: the same files give the same bytes.
 
@@ -12,7 +12,7 @@ pub mod report_figures;
 
 use super::changes::ChangeError;
 use super::series::{Series, series};
-use super::steps::{Step, steps};
+use super::steps::{Drift, Step, changes};
 use super::store::{self, HistoryError, Record};
 use super::verdicts::{self, CaseVerdict, GateRun, Verdicts};
 use report_figures::Figure;
@@ -153,6 +153,8 @@ pub struct Chart {
     pub series: Series,
     /// The steps found in it, oldest first.
     pub steps: Vec<Step>,
+    /// The drifts found in it, oldest first.
+    pub drifts: Vec<Drift>,
     /// The case's verdict in the class's latest gate run; `None` without one, or not judged there.
     pub verdict: Option<CaseVerdict>,
 }
@@ -244,7 +246,7 @@ pub fn page(loaded: &Loaded, figures: Vec<Figure>) -> Result<Page, PublishError>
             if s.points.is_empty() {
                 continue;
             }
-            let found = steps(&s).map_err(|source| PublishError::Series {
+            let found = changes(&s).map_err(|source| PublishError::Series {
                 case: s.case.clone(),
                 class: s.class.clone(),
                 source,
@@ -252,7 +254,8 @@ pub fn page(loaded: &Loaded, figures: Vec<Figure>) -> Result<Page, PublishError>
             let verdict = latest.as_ref().and_then(|g| g.case(&s.case)).cloned();
             charts.push(Chart {
                 series: s,
-                steps: found,
+                steps: found.steps,
+                drifts: found.drifts,
                 verdict,
             });
         }
