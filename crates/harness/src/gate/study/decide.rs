@@ -25,7 +25,13 @@ pub enum Mode {
     Ab,
     /// This run against the class's baseline file.
     Fast,
+    /// The A/B decision the earlier rule made of the same measurements: each side's first 4
+    /// rounds, all samples pooled, a bootstrap of the ratio of medians, Holm over the cases.
+    AbMedians,
 }
+
+/// The modes a study judges, in the order its tables show them.
+pub const MODES: [Mode; 3] = [Mode::Ab, Mode::AbMedians, Mode::Fast];
 
 impl Mode {
     /// The mode as the study's tables name it: "A/B" or "fast path".
@@ -33,13 +39,14 @@ impl Mode {
         match self {
             Mode::Ab => "A/B",
             Mode::Fast => "fast path",
+            Mode::AbMedians => "A/B, earlier rule (same rounds)",
         }
     }
 
     /// The thresholds the study judges each decision at.
     pub fn candidates(self) -> &'static [f64] {
         match self {
-            Mode::Ab => &[0.02, 0.03, 0.05],
+            Mode::Ab | Mode::AbMedians => &[0.02, 0.03, 0.05],
             Mode::Fast => &[0.05, 0.07, 0.10, 0.15],
         }
     }
@@ -49,7 +56,7 @@ impl Mode {
     /// there asks for rounds of its own undecided cases.
     pub fn rules(self) -> &'static [Judged] {
         match self {
-            Mode::Ab => &[crate::gate::AB_JUDGE],
+            Mode::Ab | Mode::AbMedians => &[crate::gate::AB_JUDGE],
             Mode::Fast => &RULES,
         }
     }
@@ -147,7 +154,7 @@ pub fn tally(
             .collect()
     };
     for outcome in judged.into_iter().flatten() {
-        if outcome.slowdown != 1.0 {
+        if outcome.slowdown != 1.0 && !outcome.slowed.0.is_empty() {
             let (mode, level) = (outcome.mode, outcome.slowdown);
             match steps.iter_mut().find(|s| s.0 == mode && s.1 == level) {
                 Some(s) => {
@@ -157,7 +164,7 @@ pub fn tally(
                 None => steps.push((mode, level, outcome.slowed.0, outcome.slowed.1)),
             }
         }
-        if outcome.slowdown == 1.0 {
+        if outcome.slowdown == 1.0 && !outcome.widths.0.is_empty() {
             match widths.iter_mut().find(|w| w.0 == outcome.mode) {
                 Some(w) => {
                     w.1.extend(&outcome.widths.0);
@@ -273,7 +280,7 @@ fn judge_block(raw: &RawStudy, block: &Block, baseline: Option<&ResultsFile>) ->
     for (level_index, &slowdown) in levels(raw).iter().enumerate() {
         let current = with_slowed(raw, block, level_index.checked_sub(1));
         let target = format!("/{}/", raw.slowed_kernel.name());
-        for mode in [Mode::Ab, Mode::Fast] {
+        for mode in MODES {
             let mut flags = Vec::new();
             let mut widths = (Vec::new(), Vec::new());
             let mut slowed = (Vec::new(), Vec::new());
@@ -281,6 +288,14 @@ fn judge_block(raw: &RawStudy, block: &Block, baseline: Option<&ResultsFile>) ->
                 for &rule in mode.rules() {
                     let report = match (mode, baseline) {
                         (Mode::Ab, _) => replay(raw, &block.a, &current, rule, threshold).0,
+                        (Mode::AbMedians, _) => {
+                            let first = looks()[0];
+                            let (a, b) = (
+                                truncated(&block.a, first, None),
+                                truncated(&current, first, None),
+                            );
+                            medians_rule(&file(raw, a), &file(raw, b), threshold)
+                        }
                         (Mode::Fast, Some(base)) => {
                             // CI's sweep: the first look's rounds of this side alone.
                             let first = truncated(&current, looks()[0], None);
@@ -294,7 +309,9 @@ fn judge_block(raw: &RawStudy, block: &Block, baseline: Option<&ResultsFile>) ->
                     let Some(report) = report.filter(|r| r.missing.is_empty()) else {
                         continue;
                     };
-                    if widths.0.is_empty() && slowed.0.is_empty() {
+                    // The earlier rule's intervals were bootstrap ones: its widths are the
+                    // study files' of that time, not these.
+                    if widths.0.is_empty() && slowed.0.is_empty() && mode != Mode::AbMedians {
                         for c in &report.cases {
                             if slowdown == 1.0 {
                                 widths.0.push((c.ci95[1] - c.ci95[0]) / c.ratio);
@@ -393,6 +410,43 @@ pub fn replay(
         }
     }
     (last, Vec::new())
+}
+
+/// The earlier rule's A/B decision: per case a seeded bootstrap of the ratio of the raw
+/// samples' medians, one-sided p-values against the threshold, Holm over the cases. Its
+/// verdicts only (regressed or unchanged), as a report.
+fn medians_rule(base: &ResultsFile, current: &ResultsFile, threshold: f64) -> Option<GateReport> {
+    let options = options(Judged::Raw, threshold, Pairing::Rounds);
+    let mut report = compare(base, current, &options).ok()?;
+    let samples = |file: &ResultsFile, key: &str| -> Vec<f64> {
+        file.cases
+            .iter()
+            .filter(|c| c.key == key)
+            .flat_map(|c| c.rounds.iter().flat_map(|r| r.samples_s.iter().copied()))
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .collect()
+    };
+    let p: Vec<f64> = report
+        .cases
+        .iter()
+        .map(|c| {
+            let seed = options.seed ^ nbody_records::results::fnv1a(c.key.as_bytes());
+            let (b, x) = (samples(base, &c.key), samples(current, &c.key));
+            crate::gate::compare::ratio_interval(&b, &x, options.resamples, seed, threshold)
+                .1
+                .regressed
+        })
+        .collect();
+    let flagged = crate::gate::family::holm(&p, crate::gate::family::FAMILY_ALPHA);
+    for (c, f) in report.cases.iter_mut().zip(flagged) {
+        c.verdict = if f {
+            Verdict::Regressed
+        } else {
+            Verdict::Unchanged
+        };
+        c.look = 1;
+    }
+    Some(report)
 }
 
 /// The cases each side still needs rounds of, by key: what the A/B decisions of every

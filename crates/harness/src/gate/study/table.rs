@@ -17,9 +17,9 @@ pub const END: &str = "<!-- end of generated region -->";
 /// judged before paired decisions the defaults of that rule (A/B 3%, fast path 10%).
 fn threshold(run: &StudyRun, mode: Mode) -> f64 {
     match (run.method, mode) {
-        (Method::PairedSequential, Mode::Ab) => AB_THRESHOLD,
+        (Method::PairedSequential, Mode::Ab | Mode::AbMedians) => AB_THRESHOLD,
         (Method::PairedSequential, Mode::Fast) => FILE_THRESHOLD,
-        (Method::BootstrapMedians, Mode::Ab) => 0.03,
+        (Method::BootstrapMedians, Mode::Ab | Mode::AbMedians) => 0.03,
         (Method::BootstrapMedians, Mode::Fast) => 0.10,
     }
 }
@@ -27,7 +27,7 @@ fn threshold(run: &StudyRun, mode: Mode) -> f64 {
 /// The rule a mode judges on (the same before and since paired decisions).
 fn rule(mode: Mode) -> Judged {
     match mode {
-        Mode::Ab => AB_JUDGE,
+        Mode::Ab | Mode::AbMedians => AB_JUDGE,
         Mode::Fast => FILE_JUDGE,
     }
 }
@@ -146,14 +146,16 @@ pub fn markdown(files: &[StudyFile]) -> String {
                 .chain(std::iter::repeat_n(Align::Right, columns - 2)),
         );
         for run in &file.runs {
-            for mode in [Mode::Ab, Mode::Fast] {
+            for mode in super::decide::MODES {
                 let th = threshold(run, mode);
                 let Some(aa) = run.tally(mode, rule(mode), th, 1.0) else {
                     continue;
                 };
-                let (unknown, rounds) = match run.method {
-                    Method::BootstrapMedians => ("–".to_string(), format!("{}", run.rounds)),
-                    Method::PairedSequential => (
+                let (unknown, rounds) = match (run.method, mode) {
+                    (Method::BootstrapMedians, _) | (_, Mode::AbMedians) => {
+                        ("–".to_string(), format!("{}", run.rounds))
+                    }
+                    (Method::PairedSequential, _) => (
                         format!("{}/{}", aa.undecided, aa.decisions),
                         format!(
                             "{:.1}",
@@ -164,7 +166,11 @@ pub fn markdown(files: &[StudyFile]) -> String {
                 let mut row = vec![
                     condition(run),
                     mode.name().to_string(),
-                    format!("{:.1} s", run.decision_measure_s),
+                    if mode == Mode::AbMedians {
+                        "(the A/B's first look)".to_string()
+                    } else {
+                        format!("{:.1} s", run.decision_measure_s)
+                    },
                     cell(run, mode, rule(mode), th, 1.0),
                     unknown,
                     rounds,
@@ -235,7 +241,7 @@ fn rules_table(file: &StudyFile) -> String {
     ]);
     let mut any = false;
     for run in file.runs.iter().filter(|r| !r.duet) {
-        for mode in [Mode::Ab, Mode::Fast] {
+        for mode in super::decide::MODES {
             let th = threshold(run, mode);
             for rule in super::decide::RULES {
                 if run.tally(mode, rule, th, 1.0).is_none() {
@@ -287,7 +293,7 @@ fn thresholds_table(file: &StudyFile) -> String {
     ]);
     let mut any = false;
     for run in file.runs.iter().filter(|r| !r.duet) {
-        for mode in [Mode::Ab, Mode::Fast] {
+        for mode in super::decide::MODES {
             let rule = rule(mode);
             for th in thresholds(run, mode, rule) {
                 if run.tally(mode, rule, th, 1.0).is_none() {
