@@ -315,11 +315,21 @@ fn findings(report: &GateReport) -> Vec<String> {
         .collect();
     if !unknown.is_empty() {
         let how = match report.pairing {
-            super::paired::Pairing::Independent => format!(
-                "measure them side by side with the baseline's revision: `nbody-bench gate \
-                 --against {}`",
-                short(&report.baseline.git_commit)
-            ),
+            super::paired::Pairing::Independent => {
+                // The commit comes from the baseline file: only a commit id is offered as part
+                // of a command to run.
+                let commit = short(&report.baseline.git_commit);
+                if !commit.is_empty() && commit.bytes().all(|b| b.is_ascii_hexdigit()) {
+                    format!(
+                        "measure them side by side with the baseline's revision: `nbody-bench \
+                         gate --against {commit}`"
+                    )
+                } else {
+                    "measure them side by side with the baseline's revision (`nbody-bench gate \
+                     --against REV`)"
+                        .to_string()
+                }
+            }
             super::paired::Pairing::Rounds => {
                 "measure more rounds (`--max-rounds`) or on a quieter machine".to_string()
             }

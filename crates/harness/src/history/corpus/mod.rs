@@ -224,16 +224,9 @@ fn generate(kind: Kind, n_steps: usize, rng: &mut Pcg64Mcg) -> Series {
             1.0 - rng.random_range(0.05..0.3)
         };
     }
-    let values = factor
-        .iter()
-        .map(|f| {
-            let z: f64 = rng.sample(StandardNormal);
-            base * f * (sigma * z).exp()
-        })
-        .collect();
     Series {
         kind,
-        values,
+        values: noisy(&factor, base, sigma, rng),
         steps,
         drift,
     }
@@ -301,17 +294,21 @@ fn generate_new(kind: Kind, rng: &mut Pcg64Mcg) -> Series {
         }
         factor
     };
-    let values = factor
+    Series {
+        kind,
+        values: noisy(&factor, base, sigma, rng),
+        steps,
+        drift,
+    }
+}
+
+/// The series' values: each point's level `base × factor` with log-normal noise of `sigma`.
+fn noisy(factor: &[f64], base: f64, sigma: f64, rng: &mut Pcg64Mcg) -> Vec<f64> {
+    factor
         .iter()
         .map(|f| {
             let z: f64 = rng.sample(StandardNormal);
             base * f * (sigma * z).exp()
         })
-        .collect();
-    Series {
-        kind,
-        values,
-        steps,
-        drift,
-    }
+        .collect()
 }
