@@ -80,10 +80,19 @@ pub fn build<T: Real, const D: usize>(
     rows: Range<usize>,
     part: &mut Part,
 ) -> BuildWork {
-    fill::<D>(part, rows.clone(), false, |out| match cover {
-        Cover::Half => half(bins, radius2, rows, out),
-        Cover::Targets(t) => targets(bins, slots, t.start, radius2, rows, out),
-    })
+    fill::<D>(
+        part,
+        rows.clone(),
+        false,
+        // The search is most of a rebuild: inlined like its callers, so that it is compiled
+        // with the wide instruction set of the `simd::dispatch` they run in (a closure is
+        // otherwise its own function, compiled for the baseline).
+        #[inline(always)]
+        |out| match cover {
+            Cover::Half => half(bins, radius2, rows, out),
+            Cover::Targets(t) => targets(bins, slots, t.start, radius2, rows, out),
+        },
+    )
 }
 
 /// Fills `part` with the rows `rows` that `search` writes (each entry with the code of its

@@ -180,6 +180,12 @@ pub(crate) trait Scatter<T> {
     fn add<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize);
     /// Subtracts it (a reaction).
     fn sub<const D: usize>(&mut self, s: usize, f: &[[T; LANES]; D], l: usize);
+    /// Adds lane `l` of `f` to slot `i` and subtracts it from slot `j` (one pair, both ends).
+    #[inline(always)]
+    fn pair<const D: usize>(&mut self, i: usize, j: usize, f: &[[T; LANES]; D], l: usize) {
+        self.add(i, f, l);
+        self.sub(j, f, l);
+    }
 }
 
 /// The forces of the slots from `base` on: slot `s` at `out[d][s - base]`.
@@ -202,6 +208,19 @@ impl<T: Real, const K: usize> Scatter<T> for Window<'_, T, K> {
         let at = s - self.base;
         for d in 0..D.min(K) {
             self.out[d][at] -= f[d][l];
+        }
+    }
+
+    /// Both ends of the pair axis by axis, each axis's column looked up once: the gas's force
+    /// loop scatters every entry's two ends, and the add and subtract of each its own pass
+    /// over the axes made the loop 25% slower in the sweep's 2-D walled box.
+    #[inline(always)]
+    fn pair<const D: usize>(&mut self, i: usize, j: usize, f: &[[T; LANES]; D], l: usize) {
+        let (i, j) = (i - self.base, j - self.base);
+        for d in 0..D.min(K) {
+            let column = &mut *self.out[d];
+            column[i] += f[d][l];
+            column[j] -= f[d][l];
         }
     }
 }
@@ -255,8 +274,7 @@ pub(crate) fn half_pairs<T: Real, L: PairLaw<T>, const D: usize, const PROBE: bo
         let (xi, xj) = (slots.gather(ii), partners(slots, part, e, images));
         let f = evaluate::<T, L, D, PROBE>(law, &xi, &xj, m - e, &mut probe);
         for l in 0..LANES {
-            out.add(ii[l] as usize, &f, l);
-            out.sub(jj[l] as usize, &f, l);
+            out.pair(ii[l] as usize, jj[l] as usize, &f, l);
         }
         e += LANES;
     }

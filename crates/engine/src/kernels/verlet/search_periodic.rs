@@ -144,10 +144,19 @@ pub(super) fn build<T: Real, const D: usize>(
     rows: Range<usize>,
     part: &mut Part,
 ) -> BuildWork {
-    fill::<D>(part, rows.clone(), true, |out| match cover {
-        Cover::Half => half(bins, images, radius2, rows, out),
-        Cover::Targets(t) => targets(bins, images, slots, t.start, radius2, rows, out),
-    })
+    fill::<D>(
+        part,
+        rows.clone(),
+        true,
+        // The search is most of a rebuild: inlined like its callers, so that it is compiled
+        // with the wide instruction set of the `simd::dispatch` they run in (a closure is
+        // otherwise its own function, compiled for the baseline).
+        #[inline(always)]
+        |out| match cover {
+            Cover::Half => half(bins, images, radius2, rows, out),
+            Cover::Targets(t) => targets(bins, images, slots, t.start, radius2, rows, out),
+        },
+    )
 }
 
 /// The half list's rows `rows` (sorted indices) in a periodic box, bin by bin: a particle's
