@@ -10,7 +10,8 @@
 #   stored in it with this build and compares with it (the fast path, about 15 s).
 # - Otherwise (another class, a stale baseline, or the machine running faster or slower than
 #   when its baseline was measured) it builds the baseline's commit in a git worktree (cached in
-#   target/gate-base/) and measures both builds here, interleaved case by case (A/B).
+#   target/gate-base/) and measures both builds here case by case, round by round, both at
+#   the same moment on a CPU each where two are free, else in turns (A/B).
 #   scripts/refresh-baseline.sh on such a machine adds its class's file.
 # The thresholds and the rule are docs/explanation/gate.md's, measured by `nbody-bench
 # gate-study` on each machine class.

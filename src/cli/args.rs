@@ -646,6 +646,14 @@ pub struct GateArgs {
     /// family-wise error is split evenly over its looks.
     #[arg(long, default_value_t = nbody_harness::gate::AB_MAX_ROUNDS, value_parser = parse_ab_rounds, conflicts_with = "current")]
     pub max_rounds: usize,
+    /// How an A/B run's two builds share the machine in a round: `duet` runs both at the same
+    /// moment, each pinned to a CPU of its own, the CPUs swapped every round (what the machine
+    /// does meanwhile falls on both); `turns` runs one after the other. Cases of several
+    /// threads or ranks, and external programs, always take turns. [default: duet, unless this
+    /// process may use one CPU only or other processes kept a CPU busy while the gate
+    /// calibrated; A/B runs only]
+    #[arg(long, value_enum, conflicts_with = "current")]
+    pub sides: Option<nbody_harness::gate::duet::Sides>,
     /// Longest one build's sweep of one case may take in an A/B run, seconds (also the limit
     /// of asking the base binary for its options) [default: 10 times the case's estimate, at
     /// least 120 s]; a child past its limit is stopped and the gate exits 2. The base build has
@@ -670,9 +678,9 @@ pub struct GateArgs {
     #[arg(long, value_enum, default_value = "auto")]
     pub normalize: nbody_harness::gate::NormalizationChoice,
     /// Which ratio a case is judged on: the normalised one, the raw one, or both (a change is
-    /// claimed only when both show it) [default: raw for A/B runs, where interleaving keeps raw
-    /// times fair; both for the fast path and two files, measured at different times: the
-    /// rules the gate's noise study chose, docs/explanation/gate.md].
+    /// claimed only when both show it) [default: raw for A/B runs, where measuring side by side
+    /// keeps raw times fair; both for the fast path and two files, measured at different times:
+    /// the rules the gate's noise study chose, docs/explanation/gate.md].
     #[arg(long, value_enum)]
     pub judge: Option<nbody_harness::gate::Judged>,
     /// Compare results from another machine (CPU model, logical CPUs), build or config anyway.
@@ -715,8 +723,9 @@ pub struct GateStudyArgs {
     /// What else runs meanwhile: nothing, or a process spinning on one CPU.
     #[arg(long, value_enum, default_value = "quiet")]
     pub load: nbody_harness::gate::study::Load,
-    /// Measure the two sides at the same moment, one per CPU (A/A only).
-    #[arg(long, conflicts_with = "load")]
+    /// Measure the two sides of each pair a decision compares at the same moment, one per CPU
+    /// (as the A/B gate's `--sides duet`).
+    #[arg(long)]
     pub duet: bool,
     /// The kernel made slower for the power decisions.
     #[arg(long, value_enum, default_value = "octree")]

@@ -14,6 +14,7 @@ pub fn gate(args: GateArgs) -> anyhow::Result<i32> {
         config: args.config.clone(),
         rounds: args.rounds,
         max_rounds: args.max_rounds,
+        sides: args.sides,
         timeout: args.timeout,
         out: args.out.clone(),
         threshold: args.threshold,

@@ -437,7 +437,16 @@ pub fn record_gate_run(
     outcome: &nbody_harness::gate::drive::Outcome,
     current: Option<&std::path::Path>,
 ) -> anyhow::Result<()> {
+    let duet = outcome.report.sides == Some(nbody_harness::gate::duet::Sides::Duet);
+    if duet {
+        eprintln!(
+            "gate: the builds were measured at the same moment (duet): their times, each with the \
+             other CPU busy, are not appended to the history, whose records are one build alone \
+             (`--sides turns` measures them so)"
+        );
+    }
     let files: Vec<std::path::PathBuf> = match (&outcome.kept_in, current) {
+        (Some(_), _) if duet => Vec::new(),
         (Some(kept), _) => ["base.json", "current.json", "results.json"]
             .iter()
             .map(|f| kept.join(f))

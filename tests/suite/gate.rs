@@ -199,6 +199,53 @@ fn assert_bad_input(o: &Output, message: &str) {
     assert!(!err.contains("panicked"), "{err}");
 }
 
+/// A case the measurements cannot settle: its ratio within the threshold, its interval too wide
+/// to show it unchanged. It is reported unknown, named with how to settle it, and fails nothing.
+#[test]
+fn an_undecided_case_is_reported_unknown_and_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = committed_baseline();
+    let mut first = String::new();
+    let current = edited(dir.path(), "current.json", |v| {
+        let case = &mut v["cases"][0];
+        first = case["key"].as_str().unwrap().to_string();
+        // Every other sample 0.8x, the rest 1.5x: a geometric mean near 1.095 (below 1.10),
+        // spread far beyond ±20%.
+        for round in case["rounds"].as_array_mut().unwrap() {
+            for (k, s) in round["samples_s"]
+                .as_array_mut()
+                .unwrap()
+                .iter_mut()
+                .enumerate()
+            {
+                let factor = if k % 2 == 0 { 0.8 } else { 1.5 };
+                *s = (s.as_f64().unwrap() * factor).into();
+            }
+        }
+    });
+    let o = gate(&base, &current, &["--format", "json"]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    for (key, verdict) in verdicts(&o) {
+        if key == first {
+            assert_eq!(verdict, "unknown", "{key}");
+        } else {
+            assert!(
+                verdict != "regressed" && verdict != "improved",
+                "{key}: {verdict}"
+            );
+        }
+    }
+    let o = gate(&base, &current, &[]);
+    assert_eq!(o.status.code(), Some(0), "{}", text(&o.stderr));
+    let out = text(&o.stdout);
+    let named = out
+        .lines()
+        .find(|l| l.starts_with("unknown: "))
+        .unwrap_or_default();
+    assert!(named.contains(&first), "{out}");
+    assert!(named.contains("gate --against"), "{out}");
+}
+
 #[test]
 fn the_committed_baseline_passes_against_itself() {
     let _serial = serial();
@@ -348,6 +395,12 @@ fn a_b(
     cmd.output().unwrap()
 }
 
+/// How the A/B run's builds shared the machine, from its JSON report.
+fn sides(out: &Output) -> String {
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    report["sides"].as_str().unwrap_or_default().to_string()
+}
+
 /// One test, so that its A/B runs never overlap.
 #[test]
 fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
@@ -359,9 +412,10 @@ fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
         "HEAD",
         "same",
         None,
-        &["--threshold", "0.75"],
+        &["--threshold", "0.75", "--sides", "turns"],
     );
     assert_eq!(same.status.code(), Some(0), "{}", text(&same.stderr));
+    assert_eq!(sides(&same), "turns");
     assert!(verdicts(&same).iter().all(|(_, v)| v == "unchanged"));
     assert_eq!(verdicts(&same).len(), 3);
     for kept in ["base.json", "current.json", "gate.json"] {
@@ -386,9 +440,12 @@ fn a_b_against_the_same_tree_passes_and_a_slower_current_side_fails() {
             "HEAD",
             "slow",
             Some("symmetric:5"),
-            &["--threshold", "0.75"],
+            &["--threshold", "0.75", "--sides", "duet"],
         );
         assert_eq!(slow.status.code(), Some(1), "{}", text(&slow.stderr));
+        // Both builds at once wherever this process may use two CPUs.
+        let two = nbody_harness::gate::duet::cpus().is_some();
+        assert_eq!(sides(&slow), if two { "duet" } else { "turns" });
         for (key, verdict) in verdicts(&slow) {
             let expected = if key.contains("/symmetric/") {
                 "regressed"

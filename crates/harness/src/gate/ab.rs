@@ -10,6 +10,7 @@
 //! and judged by [`super::compare`] like any two results files.
 
 use super::base_build::BaseBinary;
+use super::duet::Sides;
 use crate::children::supervised::{self as child, ChildError};
 use nbody_records::config::SweepConfig;
 use nbody_records::plan::{Case, cases};
@@ -127,7 +128,9 @@ pub struct AbPlan<'a> {
     pub work: &'a Path,
     /// The longest one build's one-case sweep of a case may take, by case; see
     /// [`child_limit`].
-    pub limit: &'a dyn Fn(&Case) -> Duration,
+    pub limit: &'a (dyn Fn(&Case) -> Duration + Sync),
+    /// Whether a round's two builds run at once, one per CPU, or take turns.
+    pub sides: Sides,
 }
 
 /// One case of an A/B run and the config text both builds sweep it with.
@@ -350,8 +353,15 @@ impl AbRun {
                 indices.reverse();
             }
             for i in indices {
-                for side in order(round, i) {
-                    self.one_round(plan, side, i, round)?;
+                let duet = plan.sides == Sides::Duet && super::duet::suits(&plan.cases[i].case);
+                match (duet, super::duet::cpus()) {
+                    (true, Some(cpus)) => self.duet_round(plan, cpus, i, round)?,
+                    _ => {
+                        for side in order(round, i) {
+                            let file = self.run(plan, side, i, round, None)?;
+                            self.absorb(plan, side, i, round, file)?;
+                        }
+                    }
                 }
             }
         }
@@ -363,28 +373,75 @@ impl AbRun {
         Ok(())
     }
 
-    fn one_round(
+    /// Both builds' round `round` of case `i` at the same moment, each pinned to one of `cpus`,
+    /// the CPUs swapped every round ([`super::duet::cpu_of`]).
+    fn duet_round(
         &mut self,
+        plan: &AbPlan<'_>,
+        cpus: [usize; 2],
+        i: usize,
+        round: usize,
+    ) -> Result<(), AbError> {
+        let this: &AbRun = self;
+        let [base, current] = std::thread::scope(|s| {
+            [Side::Base, Side::Current]
+                .map(|side| {
+                    let cpu = cpus[super::duet::cpu_of(side as usize, round)];
+                    s.spawn(move || this.run(plan, side, i, round, Some(cpu)))
+                })
+                .map(|h| h.join())
+        });
+        for (side, file) in [(Side::Base, base), (Side::Current, current)] {
+            let file = file.map_err(|_| AbError::Side {
+                side: side.name(),
+                key: plan.cases[i].case.key(),
+                round,
+                tail: "the thread that ran it panicked".to_string(),
+            })??;
+            self.absorb(plan, side, i, round, file)?;
+        }
+        Ok(())
+    }
+
+    /// One build's round `round` of case `i` (on `cpu` only, if given); its results file.
+    fn run(
+        &self,
         plan: &AbPlan<'_>,
         side: Side,
         i: usize,
         round: usize,
-    ) -> Result<(), AbError> {
-        let case = &plan.cases[i].case;
+        cpu: Option<usize>,
+    ) -> Result<ResultsFile, AbError> {
         let dir = plan
             .work
             .join(side.name())
             .join(format!("case{i}-round{round}"));
-        let slot = side as usize;
         let file = run_side(
             plan,
             side,
             &plan.cases[i].text,
             &dir,
-            case,
+            &plan.cases[i].case,
             round,
-            self.takes_yes[slot],
-        )?;
+            self.takes_yes[side as usize],
+            cpu,
+        );
+        // The one-case sweep's files are merged next; keep the scratch small.
+        let _ = std::fs::remove_dir_all(&dir);
+        file
+    }
+
+    /// Merges one build's one-case results file into that build's record of case `i`.
+    fn absorb(
+        &mut self,
+        plan: &AbPlan<'_>,
+        side: Side,
+        i: usize,
+        round: usize,
+        file: ResultsFile,
+    ) -> Result<(), AbError> {
+        let case = &plan.cases[i].case;
+        let slot = side as usize;
         self.metadata[slot].get_or_insert_with(|| file.metadata.clone());
         let record = file
             .cases
@@ -397,8 +454,6 @@ impl AbRun {
                 tail: "its results file has no such case".to_string(),
             })?;
         self.merged[slot][i].absorb(record, plan.config.measure.max_energy_drift);
-        // The one-case sweep's files have been merged; keep the scratch small.
-        let _ = std::fs::remove_dir_all(&dir);
         Ok(())
     }
 
@@ -535,7 +590,8 @@ fn one_case_config(table: &toml::Table, case: &Case, samples: usize) -> Result<S
     toml::to_string(&t).map_err(|e| format!("its one-case form does not serialize ({e})"))
 }
 
-/// One build's one-case sweep; its results file.
+/// One build's one-case sweep (on `cpu` only, if given); its results file.
+#[allow(clippy::too_many_arguments)]
 fn run_side(
     plan: &AbPlan<'_>,
     side: Side,
@@ -544,6 +600,7 @@ fn run_side(
     case: &Case,
     round: usize,
     takes_yes: bool,
+    cpu: Option<usize>,
 ) -> Result<ResultsFile, AbError> {
     let io = |path: &Path| {
         let path = path.to_path_buf();
@@ -567,6 +624,9 @@ fn run_side(
     // A one-case round needs no length estimate (older bases have no such step, nor the flag).
     if takes_yes {
         command.arg("--yes");
+    }
+    if let Some(cpu) = cpu {
+        super::duet::pin_command(&mut command, cpu);
     }
     if side == Side::Base {
         // The test-only slowdown knob is meant for this build only (a base revision from before

@@ -36,6 +36,7 @@ pub fn compare(
         family_alpha: FAMILY_ALPHA,
         pairing: options.pairing,
         looks: options.look.count.max(1),
+        sides: None,
     };
     for base in &baseline.cases {
         let missing = |reason: &str| MissingCase {

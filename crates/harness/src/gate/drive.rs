@@ -42,6 +42,9 @@ pub struct Request {
     /// Most rounds per build a case undecided after the first look is measured to, in looks of
     /// `rounds` more each ([`super::sequential::schedule`]); `rounds` itself judges once.
     pub max_rounds: usize,
+    /// How an A/B run's builds share the machine; `None`: duet where two CPUs are free
+    /// ([`super::duet::choose`]).
+    pub sides: Option<super::duet::Sides>,
     /// Longest one build's sweep of one case may take in an A/B run, seconds; `None`: from the
     /// case's estimate ([`ab::child_limit`]).
     pub timeout: Option<f64>,
@@ -448,6 +451,29 @@ fn a_b(
             prepared.round_s.get(&case.key()).copied(),
         ),
     };
+    let (sides, why) = super::duet::choose(request.sides, calibration.background_cpus);
+    say(&match (sides, why) {
+        (_, Some(why)) => why,
+        (super::duet::Sides::Duet, None) => {
+            let alone = prepared
+                .cases
+                .iter()
+                .filter(|c| !super::duet::suits(&c.case))
+                .count();
+            format!(
+                "the builds measure each round at the same moment, one per CPU (duet){}",
+                if alone > 0 {
+                    format!(
+                        "; {alone} case(s) of several threads or ranks, or of an external \
+                         program, take turns"
+                    )
+                } else {
+                    String::new()
+                }
+            )
+        }
+        (super::duet::Sides::Turns, None) => "the builds take turns in each round".to_string(),
+    });
     let plan = AbPlan {
         config,
         config_text: text,
@@ -457,10 +483,12 @@ fn a_b(
         rounds: request.rounds,
         work: &work,
         limit: &limit,
+        sides,
     };
     let judged = judge_in_looks(request, &plan, &calibration, say);
     let _ = std::fs::remove_dir_all(&work);
     let (mut report, results, reference) = judged?;
+    report.sides = Some(sides);
     results.base.save(&out.join("base.json"))?;
     results.current.save(&out.join("current.json"))?;
     if let Some(moved) = reference {

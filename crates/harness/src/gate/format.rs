@@ -239,9 +239,12 @@ fn rule(report: &GateReport) -> String {
         judged_on(report.judged_on),
         1.0 + report.threshold,
         percent(report.family_alpha),
-        match report.pairing {
-            super::paired::Pairing::Rounds => "pairs of back-to-back rounds",
-            super::paired::Pairing::Independent => "the two runs' samples",
+        match (report.pairing, report.sides) {
+            (super::paired::Pairing::Rounds, Some(super::duet::Sides::Duet)) => {
+                "pairs of rounds measured at the same moment, one build per CPU"
+            }
+            (super::paired::Pairing::Rounds, _) => "pairs of back-to-back rounds",
+            (super::paired::Pairing::Independent, _) => "the two runs' samples",
         },
         percent(super::sequential::EQUIVALENCE * report.threshold),
     )

@@ -306,6 +306,7 @@ mod tests {
             family_alpha: 0.025,
             pairing: crate::gate::paired::Pairing::Rounds,
             looks: 1,
+            sides: None,
         }
     }
 

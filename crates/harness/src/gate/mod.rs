@@ -24,6 +24,7 @@ pub mod baselines;
 mod checks;
 mod compare;
 pub mod drive;
+pub mod duet;
 pub mod family;
 mod format;
 pub mod guard;
@@ -423,6 +424,9 @@ pub struct GateReport {
     pub pairing: paired::Pairing,
     /// Looks the run could take (1: judged once); each judged at `family_alpha` / looks.
     pub looks: usize,
+    /// How an A/B run's two builds shared the machine in a round (none: not an A/B run).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sides: Option<duet::Sides>,
 }
 
 impl GateReport {

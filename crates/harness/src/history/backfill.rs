@@ -151,6 +151,8 @@ pub fn backfill(job: &Backfill, say: &mut dyn FnMut(&str)) -> anyhow::Result<Vec
             rounds: job.rounds,
             // The history measures every commit alike: one look, no case measured further.
             max_rounds: job.rounds,
+            // Turns: the history's times are one build alone on the machine, as in CI's sweeps.
+            sides: Some(crate::gate::duet::Sides::Turns),
             timeout: None,
             out: Some(out.clone()),
             threshold: None,

@@ -254,15 +254,11 @@ struct Outcome {
     slowed: (Vec<f64>, Vec<f64>),
 }
 
-/// The slowdowns a block can be judged at: 1 (A/A), and each of [`SLOWDOWNS`] unless the run
-/// measured both sides at once (duet: A/A only).
-fn levels(raw: &RawStudy) -> Vec<f64> {
+/// The slowdowns a block can be judged at: 1 (A/A), and each of [`SLOWDOWNS`] the block
+/// measured (none in duet runs from before duets measured slowdowns).
+fn levels(block: &Block) -> Vec<f64> {
     std::iter::once(1.0)
-        .chain(if raw.duet {
-            Vec::new()
-        } else {
-            SLOWDOWNS.to_vec()
-        })
+        .chain(SLOWDOWNS.iter().copied().take(block.slowed.len()))
         .collect()
 }
 
@@ -277,7 +273,8 @@ fn options(rule: Judged, threshold: f64, pairing: Pairing) -> GateOptions {
 
 fn judge_block(raw: &RawStudy, block: &Block, baseline: Option<&ResultsFile>) -> Vec<Outcome> {
     let mut out = Vec::new();
-    for (level_index, &slowdown) in levels(raw).iter().enumerate() {
+    for (level_index, &slowdown) in levels(block).iter().enumerate() {
+        let base = base_of(raw, block, level_index.checked_sub(1));
         let current = with_slowed(raw, block, level_index.checked_sub(1));
         let target = format!("/{}/", raw.slowed_kernel.name());
         for mode in MODES {
@@ -287,15 +284,18 @@ fn judge_block(raw: &RawStudy, block: &Block, baseline: Option<&ResultsFile>) ->
             for &threshold in mode.candidates() {
                 for &rule in mode.rules() {
                     let report = match (mode, baseline) {
-                        (Mode::Ab, _) => replay(raw, &block.a, &current, rule, threshold).0,
+                        (Mode::Ab, _) => replay(raw, &base, &current, rule, threshold).0,
                         (Mode::AbMedians, _) => {
                             let first = looks()[0];
                             let (a, b) = (
-                                truncated(&block.a, first, None),
+                                truncated(&base, first, None),
                                 truncated(&current, first, None),
                             );
                             medians_rule(&file(raw, a), &file(raw, b), threshold)
                         }
+                        // CI's sweep runs alone: a duet's sides, each measured beside the
+                        // other, stand for no fast-path run.
+                        (Mode::Fast, _) if raw.duet => None,
                         (Mode::Fast, Some(base)) => {
                             // CI's sweep: the first look's rounds of this side alone.
                             let first = truncated(&current, looks()[0], None);
@@ -453,21 +453,23 @@ fn medians_rule(base: &ResultsFile, current: &ResultsFile, threshold: f64) -> Op
 /// slowdown, under each candidate threshold of the gate's rule, would measure next.
 pub fn needs(raw: &RawStudy, block: &Block) -> Vec<(String, Side)> {
     let mut need: Vec<(String, Side)> = Vec::new();
-    for (level_index, _) in levels(raw).iter().enumerate() {
+    for (level_index, _) in levels(block).iter().enumerate() {
         let slowed = level_index.checked_sub(1);
+        let base = base_of(raw, block, slowed);
         let current = with_slowed(raw, block, slowed);
         for &threshold in Mode::Ab.candidates() {
             for &rule in Mode::Ab.rules() {
-                for key in replay(raw, &block.a, &current, rule, threshold).1 {
+                for key in replay(raw, &base, &current, rule, threshold).1 {
                     let is_slowed = block
                         .slowed
                         .first()
                         .is_some_and(|s| s.iter().any(|r| r.key == key));
-                    let side = match slowed {
-                        Some(k) if is_slowed => Side::Slowed(k),
-                        _ => Side::B,
+                    let sides = match slowed {
+                        Some(k) if is_slowed && raw.duet => [Side::Partner(k), Side::Slowed(k)],
+                        Some(k) if is_slowed => [Side::A, Side::Slowed(k)],
+                        _ => [Side::A, Side::B],
                     };
-                    for s in [Side::A, side] {
+                    for s in sides {
                         if !need.iter().any(|(k, x)| k == &key && *x == s) {
                             need.push((key.clone(), s));
                         }
@@ -488,6 +490,8 @@ pub enum Side {
     B,
     /// The slowed kernel at `SLOWDOWNS[i]`.
     Slowed(usize),
+    /// In a duet, A measured at the same moment as `Slowed(i)`.
+    Partner(usize),
 }
 
 /// The records with each case cut to its first `rounds` rounds (`keep`: only those keys).
@@ -507,12 +511,25 @@ fn truncated(records: &[CaseRecord], rounds: usize, keep: Option<&[String]>) -> 
 
 /// B's records with the slowed kernel's cases at slowdown `level` (none: B as it is).
 fn with_slowed(raw: &RawStudy, block: &Block, level: Option<usize>) -> Vec<CaseRecord> {
-    let Some(level) = level else {
-        return block.b.clone();
-    };
-    let mut slowed = block.slowed[level].iter();
-    block
-        .b
+    match level {
+        Some(level) => replaced(raw, &block.b, &block.slowed[level]),
+        None => block.b.clone(),
+    }
+}
+
+/// The base a decision at slowdown `level` pairs with: A, or in a duet the A rounds measured
+/// beside that slowdown's.
+fn base_of(raw: &RawStudy, block: &Block, level: Option<usize>) -> Vec<CaseRecord> {
+    match level.and_then(|l| block.partners.get(l)) {
+        Some(partners) if raw.duet => replaced(raw, &block.a, partners),
+        _ => block.a.clone(),
+    }
+}
+
+/// `records` with the slowed kernel's cases taken from `slowed`, in order.
+fn replaced(raw: &RawStudy, records: &[CaseRecord], slowed: &[CaseRecord]) -> Vec<CaseRecord> {
+    let mut slowed = slowed.iter();
+    records
         .iter()
         .map(|record| {
             if record.case.kernel == KernelOrProgram::Kernel(raw.slowed_kernel) {

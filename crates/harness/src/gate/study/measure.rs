@@ -11,15 +11,27 @@ use nbody_records::kernel_or_program::KernelOrProgram;
 use nbody_records::plan::Case;
 use nbody_records::results::CaseRecord;
 
-/// A spinning `sh` loop, stopped when dropped.
+/// A spinning `sh` loop, stopped when dropped, and killed by the kernel when the study's
+/// process ends any other way (interrupted, killed): left behind, it would spin on and hold
+/// whatever the study inherited, such as the measurement lock of `flock`.
 struct Spinner(std::process::Child);
 
 impl Spinner {
     fn start() -> std::io::Result<Spinner> {
-        std::process::Command::new("sh")
-            .args(["-c", "while :; do :; done"])
-            .spawn()
-            .map(Spinner)
+        use std::os::unix::process::CommandExt;
+        let mut command = std::process::Command::new("sh");
+        command.args(["-c", "while :; do :; done"]);
+        // SAFETY: prctl between fork and exec only sets the child's own death signal.
+        unsafe {
+            command.pre_exec(|| {
+                if libc::prctl(libc::PR_SET_PDEATHSIG, libc::SIGKILL) == 0 {
+                    Ok(())
+                } else {
+                    Err(std::io::Error::last_os_error())
+                }
+            });
+        }
+        command.spawn().map(Spinner)
     }
 }
 
@@ -59,14 +71,16 @@ pub fn measure_blocks(
             .iter()
             .filter(|c| c.kernel == KernelOrProgram::Kernel(slowed))
             .collect();
+        let slowed_records = || SLOWDOWNS.iter().map(|_| fresh(&slow_cases)).collect();
         let mut block = Block {
             wall_s: 0.0,
             a: fresh(&all),
             b: fresh(&all),
-            slowed: if raw.duet {
-                Vec::new()
+            slowed: slowed_records(),
+            partners: if raw.duet {
+                slowed_records()
             } else {
-                SLOWDOWNS.iter().map(|_| fresh(&slow_cases)).collect()
+                Vec::new()
             },
         };
         let looks = decide::looks();
@@ -75,8 +89,13 @@ pub fn measure_blocks(
         for c in cases {
             need.push((c.key(), Side::A));
             need.push((c.key(), Side::B));
-            if c.kernel == KernelOrProgram::Kernel(slowed) && !raw.duet {
-                need.extend((0..SLOWDOWNS.len()).map(|k| (c.key(), Side::Slowed(k))));
+            if c.kernel == KernelOrProgram::Kernel(slowed) {
+                for k in 0..SLOWDOWNS.len() {
+                    need.push((c.key(), Side::Slowed(k)));
+                    if raw.duet {
+                        need.push((c.key(), Side::Partner(k)));
+                    }
+                }
             }
         }
         for &until in &looks {
@@ -95,7 +114,7 @@ pub fn measure_blocks(
 
 /// Rounds of the sides `need` names until each has `until`: round by round, the cases' order
 /// reversed every round, each case's sides in an order rotating over rounds and cases (duet:
-/// A and B at the same moment, one per CPU).
+/// each pair a decision compares at the same moment, one per CPU).
 fn measure_look(
     raw: &RawStudy,
     cases: &[Case],
@@ -136,39 +155,101 @@ fn measure_look(
             if sides.is_empty() {
                 continue;
             }
-            if raw.duet && sides.len() == 2 {
-                let (a, b) = std::thread::scope(|s| {
-                    let a = s.spawn(|| one_round(config, case, samples, 1.0));
-                    let b = s.spawn(|| one_round(config, case, samples, 1.0));
-                    (a.join(), b.join())
-                });
-                let joined = |r: std::thread::Result<Result<_, String>>| {
-                    r.map_err(|_| format!("{key}: a measuring thread panicked"))?
+            let runs: Vec<Vec<Side>> = if raw.duet && crate::gate::duet::suits(case) {
+                duet_pairs(&sides)
+            } else {
+                // Each side goes first as often as the others, over rounds and cases.
+                let shift = (round + i) % sides.len();
+                sides.rotate_left(shift);
+                sides.into_iter().map(|s| vec![s]).collect()
+            };
+            for run in runs {
+                let outcomes = if run.len() == 2 {
+                    duet_round(config, case, samples, [run[0], run[1]], round)?
+                } else {
+                    vec![one_round(config, case, samples, factor(run[0]))?]
                 };
-                block.a[i].add_round(joined(a)?, drift);
-                block.b[i].add_round(joined(b)?, drift);
-                continue;
-            }
-            // Each side goes first as often as the others, over rounds and cases.
-            let shift = (round + i) % sides.len();
-            sides.rotate_left(shift);
-            for side in sides {
-                let factor = match side {
-                    Side::Slowed(k) => SLOWDOWNS[k],
-                    _ => 1.0,
-                };
-                let outcome = one_round(config, case, samples, factor)?;
-                match (side, j) {
-                    (Side::A, _) => block.a[i].add_round(outcome, drift),
-                    (Side::B, _) => block.b[i].add_round(outcome, drift),
-                    (Side::Slowed(k), Some(j)) => block.slowed[k][j].add_round(outcome, drift),
-                    // Slowed sides are only planned for the slowed kernel's cases.
-                    (Side::Slowed(_), None) => {}
+                for (side, outcome) in run.into_iter().zip(outcomes) {
+                    match (side, j) {
+                        (Side::A, _) => block.a[i].add_round(outcome, drift),
+                        (Side::B, _) => block.b[i].add_round(outcome, drift),
+                        (Side::Slowed(k), Some(j)) => block.slowed[k][j].add_round(outcome, drift),
+                        (Side::Partner(k), Some(j)) => {
+                            block.partners[k][j].add_round(outcome, drift)
+                        }
+                        // Slowed sides are only planned for the slowed kernel's cases.
+                        (Side::Slowed(_) | Side::Partner(_), None) => {}
+                    }
                 }
             }
         }
     }
     Ok(())
+}
+
+/// The slowdown knob's factor for `side` (1: unchanged code).
+fn factor(side: Side) -> f64 {
+    match side {
+        Side::Slowed(k) => SLOWDOWNS[k],
+        _ => 1.0,
+    }
+}
+
+/// A duet's sides grouped into the pairs measured at once: A with B, each slowdown with its
+/// partner; a side without its pair (none, as the decisions ask for them) alone.
+fn duet_pairs(sides: &[Side]) -> Vec<Vec<Side>> {
+    let partner = |s: Side| match s {
+        Side::A => Side::B,
+        Side::B => Side::A,
+        Side::Slowed(k) => Side::Partner(k),
+        Side::Partner(k) => Side::Slowed(k),
+    };
+    let mut runs: Vec<Vec<Side>> = Vec::new();
+    for &side in sides {
+        if runs.iter().flatten().any(|&s| s == side) {
+            continue;
+        }
+        let other = partner(side);
+        if sides.contains(&other) {
+            // The unchanged side (A or the partner) first: it takes the round's first CPU.
+            let mut pair = vec![side, other];
+            pair.sort_by_key(|s| matches!(s, Side::B | Side::Slowed(_)));
+            runs.push(pair);
+        } else {
+            runs.push(vec![side]);
+        }
+    }
+    runs
+}
+
+/// One round of each of `sides` at the same moment, each on a CPU of its own (swapped every
+/// round, [`crate::gate::duet::cpu_of`]).
+fn duet_round(
+    config: &SweepConfig,
+    case: &Case,
+    samples: usize,
+    sides: [Side; 2],
+    round: usize,
+) -> Result<Vec<nbody_records::round::RoundOutcome>, String> {
+    use crate::gate::duet;
+    let cpus = duet::cpus();
+    let outcomes = std::thread::scope(|s| {
+        let run = |slot: usize| {
+            let side = sides[slot];
+            s.spawn(move || {
+                if let Some(cpus) = cpus {
+                    duet::pin_this_thread(cpus[duet::cpu_of(slot, round)]);
+                }
+                one_round(config, case, samples, factor(side))
+            })
+        };
+        let handles = [run(0), run(1)];
+        handles.map(|h| h.join())
+    });
+    outcomes
+        .into_iter()
+        .map(|r| r.map_err(|_| format!("{}: a measuring thread panicked", case.key()))?)
+        .collect()
 }
 
 /// The record of case `key` on `side` (`slot`: its index among the slowed kernel's cases).
@@ -182,6 +263,7 @@ fn record<'a>(
         Side::A => block.a.iter().find(|r| r.key == key),
         Side::B => block.b.iter().find(|r| r.key == key),
         Side::Slowed(k) => block.slowed.get(k)?.get(slot?),
+        Side::Partner(k) => block.partners.get(k)?.get(slot?),
     }
 }
 
@@ -213,4 +295,33 @@ fn one_round(
     measure_round(&setup, case, kernel, &spec, &WallClock::new())
         .map_err(|e| format!("{}: {e}", case.key()))?
         .map_err(|e| format!("{}: {e}", case.key()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_duet_pairs_each_side_with_the_one_its_decision_compares() {
+        let sides = [
+            Side::Slowed(1),
+            Side::B,
+            Side::Partner(0),
+            Side::A,
+            Side::Slowed(0),
+            Side::Partner(1),
+            Side::Slowed(2),
+        ];
+        let runs = duet_pairs(&sides);
+        assert_eq!(
+            runs,
+            vec![
+                vec![Side::Partner(1), Side::Slowed(1)],
+                vec![Side::A, Side::B],
+                vec![Side::Partner(0), Side::Slowed(0)],
+                // A slowdown whose partner is not asked for runs alone.
+                vec![Side::Slowed(2)],
+            ]
+        );
+    }
 }

@@ -66,6 +66,11 @@ pub struct Block {
     /// For each slowdown of [`SLOWDOWNS`], the slowed kernel's cases' records (the others are
     /// B's: the knob changes nothing else).
     pub slowed: Vec<Vec<CaseRecord>>,
+    /// In a duet, for each slowdown, the slowed kernel's cases' A records measured at the same
+    /// moment as that slowdown's rounds: the slowdown's decisions pair those (empty when the
+    /// sides took turns, whose slowdown decisions pair with A).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub partners: Vec<Vec<CaseRecord>>,
 }
 
 /// One measuring run of the study: its conditions and raw blocks (kept in the run

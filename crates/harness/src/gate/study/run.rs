@@ -22,7 +22,7 @@ pub struct StudyOptions {
     pub blocks: usize,
     /// What else runs on the machine meanwhile.
     pub load: Load,
-    /// Measure both sides at the same moment, one per CPU (A/A decisions only).
+    /// Measure the two sides of each pair a decision compares at the same moment, one per CPU.
     pub duet: bool,
     /// The kernel made slower for the power decisions; the config must have cases of it.
     pub slowed: KernelKind,
@@ -122,17 +122,18 @@ pub fn run(options: &StudyOptions, say: &mut dyn FnMut(&str)) -> anyhow::Result<
     let run_dir = nbody_records::locate::new_run_dir(&options.runs_root, "gate-study", &utc_now())?;
     let raw_path = run_dir.join("raw.json");
     say(&format!(
-        "{} blocks of {} cases x {} to {} rounds x {} samples, sides A and B{}, load {:?}{}; \
-         fast-path decisions against {}; raw measurements in {}",
+        "{} blocks of {} cases x {} to {} rounds x {} samples, sides A and B and `{}` slowed \
+         5/10/25%{}, load {:?}{}; fast-path decisions against {}; raw measurements in {}",
         options.blocks,
         cases.len(),
         rounds,
         crate::gate::AB_MAX_ROUNDS,
         samples,
+        options.slowed.name(),
         if options.duet {
-            " at the same moment (duet)".to_string()
+            ", each pair at the same moment (duet)"
         } else {
-            format!(" and `{}` slowed 5/10/25%", options.slowed.name())
+            ""
         },
         options.load,
         if options.load == Load::Spin {
@@ -140,9 +141,11 @@ pub fn run(options: &StudyOptions, say: &mut dyn FnMut(&str)) -> anyhow::Result<
         } else {
             ""
         },
-        baseline_name
-            .as_deref()
-            .unwrap_or("nothing (no baseline of this class)"),
+        match (&baseline_name, options.duet) {
+            (_, true) => "nothing (CI's sweep runs alone, a duet's sides beside each other)",
+            (Some(name), false) => name.as_str(),
+            (None, false) => "nothing (no baseline of this class and config)",
+        },
         raw_path.display()
     ));
     say("calibrating the machine...");

@@ -34,9 +34,10 @@ fn rule(mode: Mode) -> Judged {
 
 fn condition(run: &StudyRun) -> String {
     let load = match (run.duet, run.load) {
-        (true, _) => "duet (both sides at once, one per CPU)",
-        (false, Load::Quiet) => "quiet",
-        (false, Load::Spin) => "a process spinning on one CPU",
+        (true, Load::Quiet) => "quiet, duet (both sides at once, one per CPU)",
+        (true, Load::Spin) => "a process spinning on one CPU, duet",
+        (false, Load::Quiet) => "quiet, sides in turns",
+        (false, Load::Spin) => "a process spinning on one CPU, sides in turns",
     };
     match run.method {
         Method::PairedSequential => load.to_string(),
@@ -240,7 +241,7 @@ fn rules_table(file: &StudyFile) -> String {
         Align::Right,
     ]);
     let mut any = false;
-    for run in file.runs.iter().filter(|r| !r.duet) {
+    for run in &file.runs {
         for mode in super::decide::MODES {
             let th = threshold(run, mode);
             for rule in super::decide::RULES {
@@ -292,7 +293,7 @@ fn thresholds_table(file: &StudyFile) -> String {
         Align::Right,
     ]);
     let mut any = false;
-    for run in file.runs.iter().filter(|r| !r.duet) {
+    for run in &file.runs {
         for mode in super::decide::MODES {
             let rule = rule(mode);
             for th in thresholds(run, mode, rule) {

@@ -94,6 +94,8 @@ impl Probe for GateProbe<'_> {
             rounds,
             work: &dir.join("work"),
             limit: &limit,
+            // A bisection's few rounds of one case: the builds take turns, as before duets.
+            sides: crate::gate::duet::Sides::Turns,
         };
         let mut results = ab::measure(&plan, &mut *self.progress)?;
         // Each binary reads the commit from the checkout it runs in: name the ones measured.
