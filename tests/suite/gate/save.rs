@@ -117,7 +117,11 @@ fn a_regression_is_saved_into_a_baseline_only_when_accepted_by_name() {
         "typo",
         &["--accept", "lj-box/nave", "--reason", "x"],
     );
-    let err = assert_exit(&o, 2, "not a case of the results being saved");
+    let err = assert_exit(
+        &o,
+        2,
+        "not a case the A/B run against the replaced baseline measures",
+    );
     assert!(err.contains(SYMMETRIC) && err.contains(NAIVE), "{err}");
     let o = save(repo, &target, "reason-alone", &["--reason", "x"]);
     assert_exit(&o, 2, "--accept");

@@ -46,8 +46,8 @@ impl Acceptance {
     }
 
     /// Checks what can be checked before measuring: a reason with every acceptance, and every
-    /// accepted key a case of the results to be saved (`cases`), so that a typo costs no A/B
-    /// run. The trimmed reason when something is accepted.
+    /// accepted key a case the A/B run measures (`cases`: the replaced baseline's), so that a
+    /// typo costs no A/B run. The trimmed reason when something is accepted.
     pub fn check(&self, cases: &[String]) -> Result<Option<String>, GuardError> {
         let reason = self.reason.as_deref().map(str::trim);
         if self.cases.is_empty() {
@@ -107,16 +107,17 @@ pub enum GuardError {
     /// `--reason` without `--accept`: nothing to give a reason for.
     #[error("--reason is only for --accept CASE...: name the regressed cases it explains")]
     ReasonWithoutAccept,
-    /// An accepted key is not a case of the results being saved.
+    /// An accepted key is not a case the A/B run measures.
     #[error(
-        "--accept {}: not a case of the results being saved; its cases are: {}",
+        "--accept {}: not a case the A/B run against the replaced baseline measures; its cases \
+         are: {}",
         .unknown.join(", "),
         super::listed(.cases)
     )]
     NotACase {
         /// The accepted keys that are no case.
         unknown: Vec<String>,
-        /// The results' case keys.
+        /// The case keys the A/B run measures.
         cases: Vec<String>,
     },
     /// An accepted case did not regress in the A/B run: accepting it would say something false.

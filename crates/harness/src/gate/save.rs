@@ -9,6 +9,7 @@ use super::listed;
 use super::{BUSY_BASELINE_CPUS, GateOptions, RunInfo, background_cpus, baselines, compare};
 use nbody_records::config::SweepConfig;
 use nbody_records::locate;
+use nbody_records::plan::{Case, cases};
 use nbody_records::results::{ResultsFile, read_json};
 use std::path::{Path, PathBuf};
 
@@ -82,8 +83,8 @@ pub enum Judgement {
 /// usual rule) and decides ([`guard::decide`]). Bad input is an error; nothing is written here.
 pub fn judge_save(request: &SaveRequest, say: &mut dyn FnMut(&str)) -> anyhow::Result<Judgement> {
     let candidate = check(&request.folder, &request.results)?;
-    let reason = request.accept.check(&candidate.cases)?;
     if !candidate.target.exists() {
+        request.accept.check(&candidate.cases)?;
         if !request.accept.is_empty() {
             return Err(guard::GuardError::NothingToCompare.into());
         }
@@ -112,20 +113,28 @@ pub fn judge_save(request: &SaveRequest, say: &mut dyn FnMut(&str)) -> anyhow::R
             super::prefix(&old.git_commit, 12)
         ));
     }
+    // The replaced baseline's own cases are the ones its commit can run and the ones a
+    // regression would hide in; the candidate's config (which may name newer kernels or other
+    // sizes) only when this build cannot reproduce the old one.
+    let replaced_config = baselines::examine(&candidate.target)?.fitness;
+    let (config, text, whose) = match replaced_config {
+        baselines::Fitness::Reproducible(r) => (r.config, r.text, "that baseline's cases"),
+        baselines::Fitness::Stale(_) => (
+            candidate.config.clone(),
+            candidate.text.clone(),
+            "the new baseline's cases (this build cannot reproduce the old one's config)",
+        ),
+    };
     say(&format!(
         "{} replaces {}: measuring this build and that baseline's commit {} side by side (A/B) \
-         first, so that no regression goes into the baseline unseen",
+         on {whose} first, so that no regression goes into the baseline unseen",
         candidate.source.display(),
         candidate.target.display(),
         super::prefix(&old.git_commit, 12)
     ));
-    let outcome = drive::a_b_run(
-        &request.a_b,
-        &old.git_commit,
-        &candidate.config,
-        &candidate.text,
-        say,
-    )?;
+    let measured: Vec<String> = cases(&config).iter().map(Case::key).collect();
+    let reason = request.accept.check(&measured)?;
+    let outcome = drive::a_b_run(&request.a_b, &old.git_commit, &config, &text, say)?;
     match guard::decide(&outcome.report, &request.accept.cases)? {
         Decision::Save { accepted } => Ok(Judgement::Ready(Box::new(Pending {
             replaced: Some(Replaced {
