@@ -29,7 +29,8 @@ pub fn sizes(kernel: KernelKind) -> &'static [usize] {
         | KernelKind::Octree
         | KernelKind::Verlet
         | KernelKind::ClusterPair
-        | KernelKind::Fmm => &[1000, 4000, 16000],
+        | KernelKind::Fmm
+        | KernelKind::FmmHarmonic => &[1000, 4000, 16000],
         KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => &[500, 1000, 2000],
     }
 }

@@ -20,7 +20,7 @@ use std::path::PathBuf;
     about = "Characterize the performance of particle (N-body) simulation codes",
     long_about = "Characterize the performance of particle (N-body) simulation codes.\n\n\
         An engine with interchangeable force kernels (naive, symmetric, per-thread, cell-list, \
-        octree, verlet, cluster-pair, fmm) over physical scenarios (lj-box, lj-liquid, lj-gas, \
+        octree, verlet, cluster-pair, fmm, fmm-harmonic) over physical scenarios (lj-box, lj-liquid, lj-gas, \
         lj-melt, coulomb, galaxy), with timers, work counters and physics checks.\n\nExit codes: 0 success, 1 validation failed, 2 bad input or a run that failed.",
     after_help = "Examples:\n  nbody-bench list\n  nbody-bench sweep --config configs/quick.toml\n  nbody-bench run --scenario lj-box --kernel cell-list -n 100000 --steps 200\n  nbody-bench validate"
 )]
@@ -277,9 +277,9 @@ pub struct KernelArgs {
     /// Expansion order of the tree nodes the octree accepts (octree only) [default: quadrupole].
     #[arg(long, value_enum)]
     pub multipole: Option<Multipole>,
-    /// Expansion order p of the fmm's cells, 1 to 8 (fmm only): the force error falls as
-    /// theta^p [default: 4].
-    #[arg(long, value_parser = parse_count_at_most::<{ nbody_engine::kernels::MAX_FMM_ORDER }>)]
+    /// Expansion order p of the fmm's cells, 1 to 8 for the fmm, 1 to 20 for fmm-harmonic:
+    /// the force error falls as theta^p [default: 4].
+    #[arg(long, value_parser = parse_count_at_most::<{ nbody_engine::kernels::MAX_FMM_HARMONIC_ORDER }>)]
     pub order: Option<usize>,
     /// Most particles in a tree leaf (octree and fmm) [default: 8 for the octree, 64 for
     /// the fmm].

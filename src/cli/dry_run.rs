@@ -224,7 +224,7 @@ pub fn refuse_long_run(
         multipole: kernel_args
             .multipole
             .unwrap_or(nbody_engine::kernels::KernelParams::default().multipole),
-        order: (kernel == nbody_engine::kernels::KernelKind::Fmm).then(|| {
+        order: kernel.is_fmm().then(|| {
             kernel_args
                 .order
                 .unwrap_or(nbody_engine::kernels::KernelParams::default().order)

@@ -30,6 +30,10 @@ pub fn list() -> anyhow::Result<i32> {
                 "fast multipole (3-D): mutual cell-cell expansions of --order 1..8 between \
                  cells with r1 + r2 < --theta x distance, near leaves directly; O(n)"
             }
+            KernelKind::FmmHarmonic => {
+                "the fmm on solid harmonics of --order 1..20, each translation O(p^3) by \
+                 rotation to the z-axis; the unsoftened 1/r law (coulomb); O(n)"
+            }
         };
         outln!("  {:<12} {what}", k.name());
     }

@@ -155,7 +155,7 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
             kernel.name()
         );
     }
-    let trees = [KernelKind::Octree, KernelKind::Fmm];
+    let trees = [KernelKind::Octree, KernelKind::Fmm, KernelKind::FmmHarmonic];
     if let Some(kernel) = kernel {
         for (flag, given, users) in [
             ("--theta", args.theta.is_some(), &trees[..]),
@@ -165,10 +165,15 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
         ] {
             if given && !users.contains(&kernel) {
                 let names: Vec<&str> = users.iter().map(|k| k.name()).collect();
+                let listed = match names.split_last() {
+                    Some((last, rest)) if !rest.is_empty() => {
+                        format!("{} and {last}", rest.join(", "))
+                    }
+                    _ => names.join(""),
+                };
                 anyhow::bail!(
-                    "{flag} applies to the {} kernel{} only; `{}` does not use it: drop it, or \
-                     pass --kernel {}",
-                    names.join(" and "),
+                    "{flag} applies to the {listed} kernel{} only; `{}` does not use it: drop it, \
+                     or pass --kernel {}",
                     if names.len() > 1 { "s" } else { "" },
                     kernel.name(),
                     names[0]
@@ -177,7 +182,7 @@ fn kernel_params(args: &KernelArgs, kernel: Option<KernelKind>) -> anyhow::Resul
         }
     }
     let defaults = KernelParams::default();
-    let fmm_only = kernel == Some(KernelKind::Fmm);
+    let fmm_only = kernel.is_some_and(KernelKind::is_fmm);
     let octree_only = kernel.is_some() && !fmm_only;
     Ok(KernelParams {
         theta: args.theta.unwrap_or(defaults.theta),

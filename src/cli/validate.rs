@@ -186,7 +186,7 @@ fn print_check(c: &ScenarioCheck) {
         c.theta
     );
     outln!(
-        "  {:<11} {:>12} {:>12}  {:<6} criterion",
+        "  {:<12} {:>12} {:>12}  {:<6} criterion",
         "kernel",
         "max rel err",
         "median",
@@ -195,7 +195,7 @@ fn print_check(c: &ScenarioCheck) {
     for k in &c.kernels {
         if k.skipped {
             outln!(
-                "  {:<11} {:>12} {:>12}  {:<6} {}",
+                "  {:<12} {:>12} {:>12}  {:<6} {}",
                 k.kernel,
                 "-",
                 "-",
@@ -205,7 +205,7 @@ fn print_check(c: &ScenarioCheck) {
             continue;
         }
         outln!(
-            "  {:<11} {:>12.3e} {:>12.3e}  {:<6} {}",
+            "  {:<12} {:>12.3e} {:>12.3e}  {:<6} {}",
             k.kernel,
             k.max_rel_error,
             k.median_rel_error,

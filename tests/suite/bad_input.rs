@@ -249,12 +249,20 @@ fn a_missing_config_lists_the_places_and_the_configs() {
 #[test]
 fn tree_flags_with_a_kernel_that_ignores_them_are_refused() {
     for (kernel, flag, users) in [
-        ("naive", ["--theta", "0.7"], "octree and fmm kernels"),
-        ("naive", ["--leaf-size", "4"], "octree and fmm kernels"),
+        (
+            "naive",
+            ["--theta", "0.7"],
+            "octree, fmm and fmm-harmonic kernels",
+        ),
+        (
+            "naive",
+            ["--leaf-size", "4"],
+            "octree, fmm and fmm-harmonic kernels",
+        ),
         ("naive", ["--multipole", "quadrupole"], "octree kernel"),
         ("fmm", ["--multipole", "quadrupole"], "octree kernel"),
-        ("naive", ["--order", "3"], "fmm kernel"),
-        ("octree", ["--order", "3"], "fmm kernel"),
+        ("naive", ["--order", "3"], "fmm and fmm-harmonic kernels"),
+        ("octree", ["--order", "3"], "fmm and fmm-harmonic kernels"),
     ] {
         let o = bin()
             .args([

@@ -364,15 +364,20 @@ fn validate_at_theta_one_skips_the_fmm_and_passes() {
     );
     let skips: Vec<&str> = out.lines().filter(|l| l.contains("skip")).collect();
     // The melt's verlet (a lattice of 300 atoms or fewer is too small a box for its bins),
-    // one row per long-range scenario, and the closing line.
-    assert_eq!(skips.len(), 4, "{out}");
+    // one row per fmm on each long-range scenario (the harmonic one on Coulomb only), and the
+    // closing line.
+    assert_eq!(skips.len(), 5, "{out}");
     assert!(skips[0].trim_start().starts_with("verlet"), "{}", skips[0]);
-    for row in &skips[1..3] {
+    for row in &skips[1..4] {
         assert!(row.trim_start().starts_with("fmm"), "{row}");
-        assert!(row.contains("skipped (fmm needs theta below 1)"), "{row}");
+        assert!(
+            row.contains("skipped (the fmm needs theta below 1)"),
+            "{row}"
+        );
     }
     assert!(
-        out.contains("skipped: lj-melt/verlet, coulomb/fmm, galaxy/fmm") && !out.contains("FAIL"),
+        out.contains("skipped: lj-melt/verlet, coulomb/fmm, coulomb/fmm-harmonic, galaxy/fmm")
+            && !out.contains("FAIL"),
         "{out}"
     );
     // The octree still ran at θ = 1.

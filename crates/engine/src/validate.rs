@@ -183,8 +183,15 @@ impl SystemJob for ValidateJob {
         {
             // The fmm's expansions diverge at θ ≥ 1, where the octree still runs: the other
             // kernels are still worth checking at that θ.
-            if kind == KernelKind::Fmm && !self.params.fmm_converges() {
-                checks.push(KernelCheck::skipped(kind, "fmm needs theta below 1"));
+            if kind.is_fmm() && !self.params.fmm_converges() {
+                checks.push(KernelCheck::skipped(kind, "the fmm needs theta below 1"));
+                continue;
+            }
+            if kind == KernelKind::Fmm && self.params.order > crate::kernels::MAX_FMM_ORDER {
+                checks.push(KernelCheck::skipped(
+                    kind,
+                    "the fmm's Cartesian expansions stop at order 8 (fmm-harmonic goes on)",
+                ));
                 continue;
             }
             let mut kernel: Box<dyn ForceKernel<T, D>> = match system.kernel(kind, &self.params) {
@@ -348,7 +355,7 @@ fn check<T: Real, const D: usize>(
         )
     } else {
         let (tol, setting) = match kind {
-            KernelKind::Fmm => (
+            k if k.is_fmm() => (
                 fmm_tolerance(theta, params.order),
                 format!("theta = {theta}, order {}", params.order),
             ),

@@ -662,7 +662,7 @@ impl SweepConfig {
                 "must list at least one of \"monopole\", \"quadrupole\"".into(),
             ));
         }
-        if self.kernels.contains(&KernelKind::Fmm) && !self.theta.iter().any(|&t| t < 1.0) {
+        if self.kernels.iter().any(|k| k.is_fmm()) && !self.theta.iter().any(|&t| t < 1.0) {
             return Err(bad(
                 "theta",
                 "has no value below 1, and the fmm kernel runs only there (its expansions \
@@ -696,11 +696,21 @@ impl SweepConfig {
                     .into(),
             ));
         }
-        let max_order = nbody_engine::kernels::MAX_FMM_ORDER;
+        let max_order = nbody_engine::kernels::MAX_FMM_HARMONIC_ORDER;
         if self.order.is_empty() || self.order.iter().any(|p| !(1..=max_order).contains(p)) {
             return Err(bad(
                 "order",
                 format!("must be a non-empty list of expansion orders from 1 to {max_order}"),
+            ));
+        }
+        let cartesian = nbody_engine::kernels::MAX_FMM_ORDER;
+        if self.kernels.contains(&KernelKind::Fmm) && !self.order.iter().any(|&p| p <= cartesian) {
+            return Err(bad(
+                "order",
+                format!(
+                    "has no value the fmm kernel runs (its Cartesian expansions go to order \
+                     {cartesian}; fmm-harmonic's to {max_order}); add one, such as 4"
+                ),
             ));
         }
         Ok(())

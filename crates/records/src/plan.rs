@@ -126,7 +126,7 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
             let thetas: Vec<Option<f64>> = match kernel {
                 KernelKind::Octree => config.theta.iter().map(|&t| Some(t)).collect(),
                 // The fmm's expansions converge for θ below 1 only (validation keeps one).
-                KernelKind::Fmm => config
+                k if k.is_fmm() => config
                     .theta
                     .iter()
                     .filter(|&&t| t < 1.0)
@@ -137,9 +137,14 @@ pub fn cases(config: &SweepConfig) -> Vec<Case> {
             // The expansion orders: the octree's multipoles, the fmm's p.
             let orders: Vec<(Multipole, Option<usize>)> = match kernel {
                 KernelKind::Octree => config.multipole.iter().map(|&m| (m, None)).collect(),
-                KernelKind::Fmm => config
+                // The Cartesian fmm's orders stop at 8 (validation keeps one); the harmonic
+                // one's go on.
+                k if k.is_fmm() => config
                     .order
                     .iter()
+                    .filter(|&&p| {
+                        k == KernelKind::FmmHarmonic || p <= nbody_engine::kernels::MAX_FMM_ORDER
+                    })
                     .map(|&p| (Multipole::Monopole, Some(p)))
                     .collect(),
                 _ => vec![(Multipole::Monopole, None)],
@@ -305,7 +310,8 @@ pub(crate) fn weak_size(
                 KernelKind::CellList
                 | KernelKind::Verlet
                 | KernelKind::ClusterPair
-                | KernelKind::Fmm,
+                | KernelKind::Fmm
+                | KernelKind::FmmHarmonic,
             ) => b * pf,
             Some(KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread) => {
                 b * pf.sqrt()

@@ -32,6 +32,7 @@ pub mod verlet;
 pub use cell_list::CellList;
 pub use cluster_pair::ClusterPair;
 pub use compiled::CompiledKernels;
+pub use fmm::harmonic::MAX_HARMONIC_ORDER as MAX_FMM_HARMONIC_ORDER;
 pub use fmm::{Fmm, MAX_ORDER as MAX_FMM_ORDER};
 pub use naive::Naive;
 pub(crate) use octree::far_from_box;
@@ -73,11 +74,14 @@ pub enum KernelKind {
     /// Fast multipole method (falcON style): mutual cell–cell interactions of Cartesian
     /// order p between cells that pass the opening test with θ, near leaves directly (O(n)).
     Fmm,
+    /// The fmm on complex solid harmonics of order p up to 20, each translation O(p³) by
+    /// rotation to the z-axis: for high accuracy on the unsoftened 1/r law (Coulomb) (O(n)).
+    FmmHarmonic,
 }
 
 impl KernelKind {
     /// Every kernel, in the order `list`, `validate` and the sweeps go through them.
-    pub const ALL: [KernelKind; 8] = [
+    pub const ALL: [KernelKind; 9] = [
         KernelKind::Naive,
         KernelKind::Symmetric,
         KernelKind::PerThread,
@@ -86,6 +90,7 @@ impl KernelKind {
         KernelKind::Verlet,
         KernelKind::ClusterPair,
         KernelKind::Fmm,
+        KernelKind::FmmHarmonic,
     ];
 
     /// The kernel's name on the command line and in results.
@@ -99,12 +104,21 @@ impl KernelKind {
             KernelKind::Verlet => "verlet",
             KernelKind::ClusterPair => "cluster-pair",
             KernelKind::Fmm => "fmm",
+            KernelKind::FmmHarmonic => "fmm-harmonic",
         }
+    }
+
+    /// Whether the kernel is a fast multipole method (θ below 1, an expansion order p).
+    pub fn is_fmm(self) -> bool {
+        matches!(self, KernelKind::Fmm | KernelKind::FmmHarmonic)
     }
 
     /// Whether the kernel computes the exact pair sum (to rounding) rather than an approximation.
     pub fn is_exact(self) -> bool {
-        !matches!(self, KernelKind::Octree | KernelKind::Fmm)
+        !matches!(
+            self,
+            KernelKind::Octree | KernelKind::Fmm | KernelKind::FmmHarmonic
+        )
     }
 
     /// Whether the kernel can compute forces for a law of this family.
@@ -113,6 +127,8 @@ impl KernelKind {
             KernelKind::Naive | KernelKind::Symmetric | KernelKind::PerThread => true,
             KernelKind::CellList | KernelKind::Verlet | KernelKind::ClusterPair => law.has_cutoff(),
             KernelKind::Octree | KernelKind::Fmm => law.is_inverse_square(),
+            // Its harmonics expand 1/r: no softening, so not the softened gravity.
+            KernelKind::FmmHarmonic => law == LawKind::Coulomb,
         }
     }
 
@@ -126,7 +142,8 @@ impl KernelKind {
             KernelKind::CellList
             | KernelKind::Verlet
             | KernelKind::ClusterPair
-            | KernelKind::Fmm => Complexity::Linear,
+            | KernelKind::Fmm
+            | KernelKind::FmmHarmonic => Complexity::Linear,
             KernelKind::Octree => Complexity::NLogN,
         }
     }
@@ -214,13 +231,24 @@ impl KernelKind {
             KernelKind::Verlet => Box::new(Verlet::new(law, params.skin)?),
             KernelKind::ClusterPair => Box::new(ClusterPair::new(law, params.skin)?),
             KernelKind::Fmm => {
-                params.validate_fmm::<D>()?;
+                params.validate_fmm::<D>(self)?;
                 Box::new(Fmm::new(
                     law,
                     params.theta,
                     params.order,
                     params.fmm_leaf_size,
                 ))
+            }
+            KernelKind::FmmHarmonic => {
+                params.validate_fmm::<D>(self)?;
+                let kernel = Fmm::harmonic(law, params.theta, params.order, params.fmm_leaf_size);
+                Box::new(kernel.ok_or_else(|| {
+                    KernelError::BadParam(
+                        "fmm-harmonic expands the unsoftened 1/r potential, and this law is \
+                         softened or not 1/r: use the fmm kernel"
+                            .into(),
+                    )
+                })?)
             }
         })
     }
@@ -327,9 +355,11 @@ impl KernelParams {
                 KernelParams::default().leaf_size
             )));
         }
-        if !(1..=fmm::MAX_ORDER).contains(&self.order) {
+        if !(1..=fmm::harmonic::MAX_HARMONIC_ORDER).contains(&self.order) {
             return Err(KernelError::BadParam(format!(
-                "order must be between 1 and {} (got {}); {} is the default",
+                "order must be between 1 and {} (the fmm kernel's up to {}; got {}); {} is the \
+                 default",
+                fmm::harmonic::MAX_HARMONIC_ORDER,
                 fmm::MAX_ORDER,
                 self.order,
                 default_order()
@@ -362,7 +392,7 @@ impl KernelParams {
 
     /// What the fast multipole kernel needs beyond [`KernelParams::validate`]: θ below 1 (the
     /// expansions converge only there) and three dimensions (its expansions are 3-D).
-    fn validate_fmm<const D: usize>(&self) -> Result<(), KernelError> {
+    fn validate_fmm<const D: usize>(&self, kind: KernelKind) -> Result<(), KernelError> {
         if !self.fmm_converges() {
             return Err(KernelError::BadParam(format!(
                 "theta must be below 1 for the fmm kernel (got {}): two cells interact through \
@@ -374,9 +404,18 @@ impl KernelParams {
         }
         if D != 3 {
             return Err(KernelError::Dimension {
-                kernel: KernelKind::Fmm.name(),
+                kernel: kind.name(),
                 dim: D,
             });
+        }
+        if kind == KernelKind::Fmm && self.order > fmm::MAX_ORDER {
+            return Err(KernelError::BadParam(format!(
+                "order must be between 1 and {} for the fmm kernel's Cartesian expansions (got \
+                 {}); fmm-harmonic runs orders up to {}",
+                fmm::MAX_ORDER,
+                self.order,
+                fmm::harmonic::MAX_HARMONIC_ORDER
+            )));
         }
         Ok(())
     }

@@ -118,6 +118,17 @@ impl SystemJob for Prepare {
                             params.fmm_leaf_size,
                         ))
                     }
+                    KernelKind::FmmHarmonic => {
+                        // Checks θ, the order, the dimension and the law as a run would.
+                        build()?;
+                        let kernel = Fmm::harmonic(
+                            system.law,
+                            params.theta,
+                            params.order,
+                            params.fmm_leaf_size,
+                        );
+                        Box::new(kernel.expect("built above, so the law is 1/r"))
+                    }
                     other => {
                         return Err(BenchCaseError::Kernel(format!(
                             "{} has no build phase",
@@ -245,7 +256,8 @@ mod tests {
                     KernelKind::CellList
                     | KernelKind::Octree
                     | KernelKind::Verlet
-                    | KernelKind::Fmm => {
+                    | KernelKind::Fmm
+                    | KernelKind::FmmHarmonic => {
                         build.unwrap().run();
                     }
                     _ => assert!(build.is_err(), "{kernel:?} has no build phase"),

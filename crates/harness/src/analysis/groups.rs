@@ -363,7 +363,7 @@ pub fn group(results: &ResultsFile) -> Groups {
     .into_iter()
     .filter(|s| {
         (s.key.kernel == KernelKind::Octree
-            || s.key.kernel == KernelKind::Fmm
+            || s.key.kernel.kernel().is_some_and(KernelKind::is_fmm)
             || s.key.kernel.is_external())
             && distinct(s, &by_accuracy) >= 2
     })

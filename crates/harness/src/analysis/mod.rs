@@ -526,7 +526,8 @@ fn cost_class(kernel: &KernelOrProgram, rule: Option<WeakRule>) -> ComplexityCla
                 KernelKind::CellList
                 | KernelKind::Verlet
                 | KernelKind::ClusterPair
-                | KernelKind::Fmm,
+                | KernelKind::Fmm
+                | KernelKind::FmmHarmonic,
             ),
             _,
         ) => ComplexityClass::N,

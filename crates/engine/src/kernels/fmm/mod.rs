@@ -32,6 +32,8 @@
 //! pair and its entry in both cells' lists). `footprint` has the measured totals.
 
 mod expansion;
+mod family;
+pub mod harmonic;
 mod m2l;
 mod near;
 mod tree;
@@ -49,6 +51,7 @@ use crate::simd;
 use crate::state::{Field, State};
 pub use expansion::MAX_ORDER;
 use expansion::{Batch, Expansion, Lanes};
+use family::Family;
 use rayon::prelude::*;
 use std::ops::Range;
 use std::time::Instant;
@@ -76,7 +79,7 @@ pub struct Fmm<L: PairLaw<T>, T: Real, const D: usize> {
     /// The law in f64, for the expansions.
     wide: L::Wide,
     theta: f64,
-    exp: Expansion,
+    exp: Family,
     tree: Tree<T, D>,
     cells: Cells,
     walk: Walk,
@@ -91,11 +94,33 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
     /// order panics): `KernelKind::build` checks them first (`KernelParams::validate`), and
     /// users outside the crate go through it, as this is the crate's own.
     pub(crate) fn new(law: L, theta: f64, order: usize, leaf_size: usize) -> Self {
+        Self::of_family(
+            law,
+            theta,
+            Family::Cartesian(Expansion::new(order)),
+            leaf_size,
+        )
+    }
+
+    /// The kernel on solid harmonics of order `1 ≤ order ≤ MAX_HARMONIC_ORDER` (a bad order
+    /// panics, as in [`Fmm::new`]); `None` for a law with softening or no 1/r potential,
+    /// which these harmonics cannot expand.
+    pub(crate) fn harmonic(law: L, theta: f64, order: usize, leaf_size: usize) -> Option<Self> {
+        let law_1r = law.widen().inverse_square()?;
+        if law_1r.eps2 != 0.0 {
+            return None;
+        }
+        // The pair force coefficient is k/r³ for a potential −k s_i s_j / r: κ = −k.
+        let family = Family::Harmonic(Box::new(harmonic::Harmonic::new(order)), -law_1r.k);
+        Some(Self::of_family(law, theta, family, leaf_size))
+    }
+
+    fn of_family(law: L, theta: f64, exp: Family, leaf_size: usize) -> Self {
         Fmm {
             law,
             wide: law.widen(),
             theta,
-            exp: Expansion::new(order),
+            exp,
             tree: Tree::one_class(leaf_size),
             cells: Cells::new(),
             walk: Walk::new(),
@@ -119,32 +144,60 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
     /// or with `probe` from the potential on), the cells on the pool's threads when
     /// `parallel`.
     fn far_field(&mut self, parallel: bool, probe: bool) {
-        let len = self.exp.len;
-        let first = if probe { 0 } else { 1 };
+        let len = self.exp.len();
         let mut local = std::mem::take(&mut self.cells.local);
-        let (exp, wide, cells, lists) = (&self.exp, &self.wide, &self.cells, &self.walk.far);
-        let cell = |batch: &mut Batch, (c, local): (usize, &mut [f64])| {
-            let partners = lists.of(c);
-            if partners.is_empty() {
-                return;
+        match &self.exp {
+            Family::Cartesian(exp) => {
+                let first = if probe { 0 } else { 1 };
+                let (wide, cells, lists) = (&self.wide, &self.cells, &self.walk.far);
+                let cell = |batch: &mut Batch, (c, local): (usize, &mut [f64])| {
+                    let partners = lists.of(c);
+                    if partners.is_empty() {
+                        return;
+                    }
+                    simd::dispatch(
+                        #[inline(always)]
+                        || far_of_cell(exp, wide, cells, c, partners, first, batch, local),
+                    );
+                };
+                if parallel {
+                    local
+                        .par_chunks_mut(len)
+                        .enumerate()
+                        .with_min_len(CELLS_PER_TASK)
+                        .for_each_init(|| Batch::new(len), cell);
+                } else {
+                    let mut batch = Batch::new(len);
+                    local
+                        .chunks_mut(len)
+                        .enumerate()
+                        .for_each(|item| cell(&mut batch, item));
+                }
             }
-            simd::dispatch(
-                #[inline(always)]
-                || far_of_cell(exp, wide, cells, c, partners, first, batch, local),
-            );
-        };
-        if parallel {
-            local
-                .par_chunks_mut(len)
-                .enumerate()
-                .with_min_len(CELLS_PER_TASK)
-                .for_each_init(|| Batch::new(len), cell);
-        } else {
-            let mut batch = Batch::new(len);
-            local
-                .chunks_mut(len)
-                .enumerate()
-                .for_each(|item| cell(&mut batch, item));
+            Family::Harmonic(h, kappa) => {
+                let (cells, lists) = (&self.cells, &self.walk.far);
+                let cell = |scratch: &mut harmonic::Scratch, (c, local): (usize, &mut [f64])| {
+                    let z = cells.centre[c];
+                    let partners = lists.of(c).iter().map(|&b| {
+                        let zb = cells.centre[b as usize];
+                        ([z[0] - zb[0], z[1] - zb[1], z[2] - zb[2]], b as usize)
+                    });
+                    Family::harmonic_far(h, *kappa, partners, &cells.multipole, local, scratch);
+                };
+                if parallel {
+                    local
+                        .par_chunks_mut(len)
+                        .enumerate()
+                        .with_min_len(CELLS_PER_TASK)
+                        .for_each_init(|| h.scratch(), cell);
+                } else {
+                    let mut scratch = h.scratch();
+                    local
+                        .chunks_mut(len)
+                        .enumerate()
+                        .for_each(|item| cell(&mut scratch, item));
+                }
+            }
         }
         self.cells.local = local;
     }
@@ -173,7 +226,8 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
             parts.push(std::array::from_fn(|d| cut[d].0.take().expect("cut once")));
             rest = std::array::from_fn(|d| cut[d].1.take().expect("cut once"));
         }
-        let leaf = |ranges: &mut Vec<Range<usize>>, (&i, out): (&u32, &mut [&mut [T]; D])| {
+        let leaf = |(ranges, scratch): &mut (Vec<Range<usize>>, family::Scratch),
+                    (&i, out): (&u32, &mut [&mut [T]; D])| {
             let i = i as usize;
             let node = &tree.nodes[i];
             let slots = node.start as usize..node.end as usize;
@@ -195,7 +249,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
                 );
                 (0.0, 0)
             };
-            let potential = tree::evaluate(exp, cells, tree, i, PROBE, out);
+            let potential = tree::evaluate(exp, cells, tree, i, PROBE, out, scratch);
             (energy, potential, interacting)
         };
         let add = |a: (f64, f64, u64), b: (f64, f64, u64)| (a.0 + b.0, a.1 + b.1, a.2 + b.2);
@@ -205,17 +259,20 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
                 .par_iter()
                 .zip(parts.par_iter_mut())
                 .with_min_len(CELLS_PER_TASK)
-                .for_each_init(Vec::new, |ranges, item| {
-                    leaf(ranges, item);
-                });
+                .for_each_init(
+                    || (Vec::new(), exp.scratch()),
+                    |buffers, item| {
+                        leaf(buffers, item);
+                    },
+                );
             (0.0, 0.0, 0)
         } else {
-            let mut ranges = Vec::new();
+            let mut buffers = (Vec::new(), exp.scratch());
             cells
                 .leaves
                 .iter()
                 .zip(parts.iter_mut())
-                .map(|item| leaf(&mut ranges, item))
+                .map(|item| leaf(&mut buffers, item))
                 .fold((0.0, 0.0, 0), add)
         }
     }
@@ -345,7 +402,7 @@ impl<L: PairLaw<T>, T: Real, const D: usize> ForceKernel<T, D> for Fmm<L, T, D> 
         // A cell pair counts as many particle pairs as its contraction has terms (210 at order
         // 4, about what one costs there; 7 at order 1, 3003 at order 8): its work grows with
         // the order as they do.
-        self.last_work = Some(pairs + self.exp.m2l_terms() as u64 * counts.m2l);
+        self.last_work = Some(pairs + self.exp.m2l_work() as u64 * counts.m2l);
         ForceReport {
             // Every pair is seen from both ends, near or far.
             energy: probe.then_some(0.5 * (near_energy + potential)),

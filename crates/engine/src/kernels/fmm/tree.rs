@@ -18,7 +18,7 @@
 //! a leaf, and at an internal node the smaller of the bound through the children
 //! (`max |z_c − z| + r_c`) and the distance to the farthest corner of the particles' box.
 
-use super::expansion::{Expansion, MAX_ORDER, terms};
+use super::family::{Family, Scratch};
 use super::point;
 use crate::geometry::Bounds;
 use crate::kernels::octree::Tree;
@@ -78,12 +78,12 @@ impl Cells {
     pub(crate) fn upward<T: Real, const D: usize>(
         &mut self,
         tree: &Tree<T, D>,
-        exp: &Expansion,
+        exp: &Family,
         parallel: bool,
     ) {
         let nodes = &tree.nodes;
         let count = nodes.len();
-        let len = exp.len;
+        let len = exp.len();
         self.leaves.clear();
         self.leaves
             .extend((0..count as u32).filter(|&i| nodes[i as usize].children == 0));
@@ -91,7 +91,9 @@ impl Cells {
             .sort_unstable_by_key(|&i| nodes[i as usize].start);
 
         // The leaves from their particles, each into its own entries.
-        let leaf = |(&i, m): (&u32, &mut [f64])| leaf_sums(tree, exp, i as usize, m);
+        let leaf = |scratch: &mut Scratch, (&i, m): (&u32, &mut [f64])| {
+            leaf_sums(tree, exp, i as usize, m, scratch)
+        };
         self.leaf_multipoles.clear();
         self.leaf_multipoles.resize(self.leaves.len() * len, 0.0);
         if parallel {
@@ -99,15 +101,16 @@ impl Cells {
                 .par_iter()
                 .zip(self.leaf_multipoles.par_chunks_mut(len))
                 .with_min_len(LEAF_CHUNK)
-                .map(leaf)
+                .map_init(|| exp.scratch(), leaf)
                 .collect_into_vec(&mut self.leaf_sums);
         } else {
+            let mut scratch = exp.scratch();
             self.leaf_sums.clear();
             self.leaf_sums.extend(
                 self.leaves
                     .iter()
                     .zip(self.leaf_multipoles.chunks_mut(len))
-                    .map(leaf),
+                    .map(|item| leaf(&mut scratch, item)),
             );
         }
 
@@ -131,7 +134,7 @@ impl Cells {
 
         // Internal nodes from their children: a family is allocated after its parent, so a
         // reverse pass over the arena meets every child before its parent.
-        let mut mono = vec![0.0; len];
+        let mut scratch = exp.scratch();
         for i in (0..count).rev() {
             let node = &nodes[i];
             if node.children == 0 {
@@ -158,7 +161,7 @@ impl Cells {
                 let dist = d.iter().map(|x| x * x).sum::<f64>().sqrt();
                 through_children = through_children.max(dist + self.radius[c]);
                 let off = (c - kids.start) * len;
-                exp.m2m(d, &below[off..off + len], m, &mut mono);
+                exp.m2m(d, &below[off..off + len], m, &mut scratch);
             }
             let corner: f64 = (0..3)
                 .map(|d| (z[d] - l[d]).abs().max((h[d] - z[d]).abs()).powi(2))
@@ -176,9 +179,9 @@ impl Cells {
 
     /// L2L: moves every internal node's local expansion to its children's centres and adds
     /// it there, top-down (a parent's arena index is below its children's).
-    pub(crate) fn downward<T, const D: usize>(&mut self, tree: &Tree<T, D>, exp: &Expansion) {
-        let len = exp.len;
-        let mut mono = vec![0.0; len];
+    pub(crate) fn downward<T, const D: usize>(&mut self, tree: &Tree<T, D>, exp: &Family) {
+        let len = exp.len();
+        let mut scratch = exp.scratch();
         for (i, node) in tree.nodes.iter().enumerate() {
             if node.children == 0 {
                 continue;
@@ -191,7 +194,7 @@ impl Cells {
                 let zc = self.centre[c];
                 let d = [zc[0] - z[0], zc[1] - z[1], zc[2] - z[2]];
                 let off = (c - first) * len;
-                exp.l2l(d, l, &mut below[off..off + len], &mut mono);
+                exp.l2l(d, l, &mut below[off..off + len], &mut scratch);
             }
         }
     }
@@ -200,9 +203,10 @@ impl Cells {
 /// Centre, radius, box and multipole (into `m`) of leaf `i` from its particles.
 fn leaf_sums<T: Real, const D: usize>(
     tree: &Tree<T, D>,
-    exp: &Expansion,
+    exp: &Family,
     i: usize,
     m: &mut [f64],
+    scratch: &mut Scratch,
 ) -> LeafSums {
     let node = &tree.nodes[i];
     let (start, end) = (node.start as usize, node.end as usize);
@@ -216,13 +220,12 @@ fn leaf_sums<T: Real, const D: usize>(
         sums.bounds.extend(x);
     }
     let z = centre_of(sums.weight, sums.weighted, &sums.bounds);
-    let mut mono = [0.0; terms(MAX_ORDER)];
     let mut r2: f64 = 0.0;
     for k in start..end {
         let x = point(&tree.pos, k);
         let off = [z[0] - x[0], z[1] - x[1], z[2] - x[2]];
         r2 = r2.max(off.iter().map(|o| o * o).sum());
-        exp.p2m(off, tree.src[k].as_f64(), m, &mut mono[..exp.len]);
+        exp.p2m(off, tree.src[k].as_f64(), m, scratch);
     }
     sums.centre = z;
     sums.radius = r2.sqrt();
@@ -232,22 +235,22 @@ fn leaf_sums<T: Real, const D: usize>(
 /// L2P of leaf `i`: adds the far field's force `−s ∇ψ` to each of its particles (`out`, the
 /// leaf's slots); with `potential`, returns Σ s ψ over them (else 0).
 pub(super) fn evaluate<T: Real, const D: usize>(
-    exp: &Expansion,
+    exp: &Family,
     cells: &Cells,
     tree: &Tree<T, D>,
     i: usize,
     potential: bool,
     out: &mut [&mut [T]; D],
+    scratch: &mut Scratch,
 ) -> f64 {
-    let len = exp.len;
+    let len = exp.len();
     let node = &tree.nodes[i];
     let (z, l) = (cells.centre[i], &cells.local[i * len..(i + 1) * len]);
-    let mut mono = [0.0; terms(MAX_ORDER)];
     let mut sum = 0.0;
     for (k, slot) in (node.start as usize..node.end as usize).enumerate() {
         let x = point(&tree.pos, slot);
         let r = [x[0] - z[0], x[1] - z[1], x[2] - z[2]];
-        let (grad, psi) = exp.l2p(r, l, potential, &mut mono);
+        let (grad, psi) = exp.l2p(r, l, potential, scratch);
         let s = tree.src[slot].as_f64();
         for d in 0..D {
             out[d][k] += T::of(-s * grad[d]);

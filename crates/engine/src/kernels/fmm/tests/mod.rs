@@ -3,6 +3,7 @@
 //! its closed form, the same bits at every thread count, and the parameters it refuses;
 //! the expansion operators alone in [`operators`].
 
+mod harmonic_kernel;
 mod operators;
 
 use super::*;
@@ -308,7 +309,7 @@ fn bad_parameters_and_systems_are_refused() {
     // A 2-D system (checked before the kernel is built: building it for a 2-D gravity would
     // compile every kernel for a system no scenario has), and a short-range law (the 2-D LJ
     // scenarios).
-    let err = ok.validate_fmm::<2>().unwrap_err();
+    let err = ok.validate_fmm::<2>(KernelKind::Fmm).unwrap_err();
     assert!(
         matches!(err, KernelError::Dimension { dim: 2, .. }),
         "{err}"
