@@ -288,7 +288,7 @@ crate::config_keys::documented_keys! {
         /// Example: `seeds = [2]`
         #[serde(default = "one_seed")]
         pub seeds: Vec<u64>,
-        /// Opening angles, octree and fmm cases only (the fmm takes those below 1).
+        /// Opening angles, octree and fmm cases only (the fmms take those below 1).
         ///
         /// Accepts a list of opening angles of at least 0, such as theta = [0.5, 0.7].
         ///
@@ -302,9 +302,10 @@ crate::config_keys::documented_keys! {
         /// Example: `multipole = ["monopole"]`
         #[serde(default = "default_multipole")]
         pub multipole: Vec<nbody_engine::kernels::Multipole>,
-        /// Expansion orders of the fmm's cells, fmm cases only.
+        /// Expansion orders of the fmm's cells, fmm and fmm-harmonic cases only (the fmm takes
+        /// those up to 8, its Cartesian expansions' limit).
         ///
-        /// Accepts a list of fmm expansion orders from 1 to 8, such as order = [3, 4, 6].
+        /// Accepts a list of expansion orders from 1 to 20, such as order = [3, 4, 6].
         ///
         /// Example: `order = [6]`
         #[serde(default = "default_order")]

@@ -72,7 +72,7 @@ pub struct Scratch {
     wigner: Wigner,
     /// `e^{imφ}`, m = 0..=p.
     phases: Vec<C>,
-    /// One degree's coefficients over m = −n..=n, and the rotated ones over m ≥ 0.
+    /// One degree's coefficients over m ≥ 0, before and after a rotation.
     full: Vec<C>,
     row: Vec<C>,
     /// Triangles: the rotated input, the shifted one; the harmonics of a point.
@@ -120,7 +120,7 @@ impl Harmonic {
         Scratch {
             wigner: Wigner::new(p),
             phases: vec![C::ZERO; p + 1],
-            full: vec![C::ZERO; 2 * p + 1],
+            full: vec![C::ZERO; p + 1],
             row: vec![C::ZERO; p + 1],
             rotated: vec![C::ZERO; count(p)],
             shifted: vec![C::ZERO; count(p)],
@@ -287,11 +287,9 @@ impl Harmonic {
                     Kind::Multipole => (input[at(n, m)].scale(norm), phases[m]),
                     Kind::Local => (input[at(n, m)].scale(1.0 / norm), phases[m].conj()),
                 };
-                let v = scaled * phase;
-                full[n + m] = v;
-                full[n - m] = v.conj().scale(sign(m));
+                full[m] = scaled * phase;
             }
-            apply(wigner, n, &full[..2 * n + 1], true, &mut row[..=n]);
+            apply(wigner, n, &full[..=n], true, &mut row[..=n]);
             for m in 0..=n {
                 let norm = self.norm[at(n, m)];
                 rotated[at(n, m)] = match kind {
@@ -315,14 +313,12 @@ impl Harmonic {
         for n in 0..=self.p {
             for m in 0..=n {
                 let norm = self.norm[at(n, m)];
-                let v = match kind {
+                full[m] = match kind {
                     Kind::Multipole => shifted[at(n, m)].scale(norm),
                     Kind::Local => shifted[at(n, m)].scale(1.0 / norm),
                 };
-                full[n + m] = v;
-                full[n - m] = v.conj().scale(sign(m));
             }
-            apply(wigner, n, &full[..2 * n + 1], false, &mut row[..=n]);
+            apply(wigner, n, &full[..=n], false, &mut row[..=n]);
             for m in 0..=n {
                 let norm = self.norm[at(n, m)];
                 let v = match kind {

@@ -101,10 +101,19 @@ impl Wigner {
         self.start[n] + row * w + col
     }
 
-    /// `d^n_{m'm}`.
-    #[inline(always)]
+    /// `d^n_{m'm}` (any m', by symmetry from the rows computed), for the tests; the rotations
+    /// read the rows whole.
+    #[cfg(test)]
     pub fn get(&self, n: usize, mp: isize, m: isize) -> f64 {
-        self.d[self.index(n, mp, m)]
+        if mp >= 0 {
+            self.d[self.index(n, mp, m)]
+        } else if m <= 0 {
+            // d_{m'm} = d_{−m,−m'}.
+            self.d[self.index(n, -m, -mp)]
+        } else {
+            // d_{m'm} = (−1)^{m−m'} d_{mm'}.
+            sign((m - mp).unsigned_abs()) * self.d[self.index(n, m, mp)]
+        }
     }
 
     /// The matrices for the angle β with `cos β = c` and `sin β = s ≥ 0` (β in [0, π]).
@@ -124,7 +133,8 @@ impl Wigner {
                 pw[j] = pw[j - 1] * base;
             }
         }
-        for mp in -p..=p {
+        // The rows m' ≥ 0 only: `apply` reads the others through d_{mm'} = (−1)^{m−m'} d_{m'm}.
+        for mp in 0..=p {
             for m in -p..=p {
                 let n0 = mp.unsigned_abs().max(m.unsigned_abs());
                 let first = self.edge(n0, mp, m);
@@ -161,20 +171,31 @@ impl Wigner {
     }
 }
 
-/// Rotates the coefficients `a_m`, m = −n..=n, of one degree (`a[m + n]`) by `d`:
-/// `out[m'] = Σ_m d^n_{m'm} a_m` (`transpose`: `d^n_{mm'}`) for m' = 0..=n only.
+/// Rotates the coefficients `a_m` of one degree n by `d`: `out[m'] = Σ_{m=−n}^{n} d^n_{m'm} a_m`
+/// (`transpose`: `d^n_{mm'}`) for m' = 0..=n, from `a[0..=n]` alone, the orders `m ≥ 0`: the
+/// rest are `a_{−m} = (−1)^m conj(a_m)`, as in every expansion of a real field, so each pair
+/// `±m` takes one complex multiply-add by two real coefficients.
 pub fn apply(w: &Wigner, n: usize, a: &[C], transpose: bool, out: &mut [C]) {
-    let ni = n as isize;
-    for mp in 0..=ni {
-        let mut sum = C::ZERO;
-        for m in -ni..=ni {
-            let d = if transpose {
-                w.get(n, m, mp)
+    let width = 2 * n + 1;
+    let mat = &w.d[w.start[n]..w.start[n + 1]];
+    for mp in 0..=n {
+        // Row m' holds d^n_{m'm} at n + m; the transpose reads d^n_{mm'} = (−1)^{m'−m} d^n_{m'm}
+        // (the same parity for ±m).
+        let row = &mat[(mp + n) * width..(mp + n + 1) * width];
+        let flip = |m: usize| {
+            if transpose && (mp + m) % 2 == 1 {
+                -1.0
             } else {
-                w.get(n, mp, m)
-            };
-            sum += a[(m + ni) as usize].scale(d);
+                1.0
+            }
+        };
+        let mut sum = a[0].scale(row[n] * flip(0));
+        for (m, am) in a.iter().enumerate().take(n + 1).skip(1) {
+            let t = flip(m);
+            let (plus, minus) = (t * row[n + m], t * sign(m) * row[n - m]);
+            sum.re += (plus + minus) * am.re;
+            sum.im += (plus - minus) * am.im;
         }
-        out[mp as usize] = sum;
+        out[mp] = sum;
     }
 }
