@@ -323,3 +323,77 @@ lanes!(Avx2F32, __m256, f32, 8,
     less |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b), v),
     equal |a, b, v| _mm256_andnot_ps(_mm256_cmp_ps::<_CMP_EQ_OQ>(a, b), v),
     keep_less |a, b, v| _mm256_and_ps(_mm256_cmp_ps::<_CMP_LT_OQ>(a, b), v), div _mm256_div_ps, cube_terms 2);
+
+/// One f64 in a "register": the portable form of a kernel written over [`Lanes`], for the
+/// baseline instruction set (and other architectures). `mul_add` rounds once, as the vector
+/// forms do (`f64::mul_add`).
+#[derive(Clone, Copy)]
+pub(super) struct Scalar(f64);
+
+// SAFETY: plain f64 arithmetic, which every CPU runs.
+unsafe impl Lanes for Scalar {
+    type Elem = f64;
+    const WIDTH: usize = 1;
+    #[inline(always)]
+    unsafe fn splat(x: f64) -> Self {
+        Scalar(x)
+    }
+    #[inline(always)]
+    unsafe fn load(p: *const f64) -> Self {
+        // SAFETY: the caller passes a pointer to one readable f64.
+        Scalar(unsafe { *p })
+    }
+    #[inline(always)]
+    unsafe fn store(self, p: *mut f64) {
+        // SAFETY: the caller passes a pointer to one writable f64.
+        unsafe { *p = self.0 }
+    }
+    #[inline(always)]
+    unsafe fn add(self, b: Self) -> Self {
+        Scalar(self.0 + b.0)
+    }
+    #[inline(always)]
+    unsafe fn sub(self, b: Self) -> Self {
+        Scalar(self.0 - b.0)
+    }
+    #[inline(always)]
+    unsafe fn mul(self, b: Self) -> Self {
+        Scalar(self.0 * b.0)
+    }
+    #[inline(always)]
+    unsafe fn mul_add(self, b: Self, c: Self) -> Self {
+        Scalar(self.0.mul_add(b.0, c.0))
+    }
+    #[inline(always)]
+    unsafe fn neg_mul_add(self, b: Self, c: Self) -> Self {
+        Scalar((-self.0).mul_add(b.0, c.0))
+    }
+    #[inline(always)]
+    unsafe fn rsqrt(self) -> Self {
+        Scalar(1.0 / self.0.sqrt())
+    }
+    #[inline(always)]
+    unsafe fn zero_where_less(self, a: Self, b: Self) -> Self {
+        Scalar(if a.0 < b.0 { 0.0 } else { self.0 })
+    }
+    #[inline(always)]
+    unsafe fn zero_where_equal(self, a: Self, b: Self) -> Self {
+        Scalar(if a.0 == b.0 { 0.0 } else { self.0 })
+    }
+    #[inline(always)]
+    unsafe fn keep_where_less(self, a: Self, b: Self) -> Self {
+        Scalar(if a.0 < b.0 { self.0 } else { 0.0 })
+    }
+    #[inline(always)]
+    unsafe fn div(self, b: Self) -> Self {
+        Scalar(self.0 / b.0)
+    }
+    #[inline(always)]
+    unsafe fn constant(x: f64) -> Self {
+        Scalar(x)
+    }
+    #[inline(always)]
+    unsafe fn rsqrt_cubed_scaled(self, scale: Self) -> Self {
+        Scalar(scale.0 / (self.0 * self.0.sqrt()))
+    }
+}

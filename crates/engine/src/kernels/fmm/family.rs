@@ -99,23 +99,4 @@ impl Family {
             _ => unreachable!("scratch of another family"),
         }
     }
-
-    /// The harmonic M2L of one cell: its local expansion (overwritten) from its `partners`,
-    /// each `t = c − z_b` from it, in list order.
-    pub fn harmonic_far(
-        h: &Harmonic,
-        kappa: f64,
-        partners: impl Iterator<Item = ([f64; 3], usize)>,
-        multipoles: &[f64],
-        local: &mut [f64],
-        scratch: &mut harmonic::Scratch,
-    ) {
-        local.fill(0.0);
-        let len = 2 * h.len;
-        let local = complex_mut(local);
-        for (t, b) in partners {
-            let m = complex(&multipoles[b * len..(b + 1) * len]);
-            h.m2l(t, kappa, m, local, scratch);
-        }
-    }
 }

@@ -175,14 +175,24 @@ impl<L: PairLaw<T>, T: Real, const D: usize> Fmm<L, T, D> {
                 }
             }
             Family::Harmonic(h, kappa) => {
-                let (cells, lists) = (&self.cells, &self.walk.far);
+                let (cells, lists, isa) = (&self.cells, &self.walk.far, m2l::isa());
                 let cell = |scratch: &mut harmonic::Scratch, (c, local): (usize, &mut [f64])| {
-                    let z = cells.centre[c];
-                    let partners = lists.of(c).iter().map(|&b| {
-                        let zb = cells.centre[b as usize];
-                        ([z[0] - zb[0], z[1] - zb[1], z[2] - zb[2]], b as usize)
-                    });
-                    Family::harmonic_far(h, *kappa, partners, &cells.multipole, local, scratch);
+                    let partners = lists.of(c);
+                    if partners.is_empty() {
+                        local.fill(0.0);
+                        return;
+                    }
+                    harmonic::batch::far(
+                        &h.plan,
+                        *kappa,
+                        isa,
+                        cells.centre[c],
+                        partners,
+                        &cells.centre,
+                        &cells.multipole,
+                        local,
+                        &mut scratch.batch,
+                    );
                 };
                 if parallel {
                     local

@@ -17,6 +17,7 @@
 //! `m ≥ 0` are stored (`(p+1)(p+2)/2` complex numbers): a real potential has
 //! `M_n^{−m} = (−1)^m conj(M_n^m)`, the same for `L`.
 
+pub mod batch;
 pub mod rotation;
 pub mod solid;
 
@@ -24,7 +25,9 @@ pub mod solid;
 mod tests;
 
 use rotation::{Wigner, apply};
-use solid::{C, at, count, regular, sign, signed};
+#[cfg(test)]
+use solid::sign;
+use solid::{C, at, count, regular, signed};
 
 /// Highest order of the harmonic expansions.
 pub const MAX_HARMONIC_ORDER: usize = 20;
@@ -37,6 +40,8 @@ pub struct Harmonic {
     /// `√((n+m)! (n−m)!)` at `at(n, m)`: the scale between these harmonics and the ones that
     /// rotate by Wigner's matrices (`R = C/N`, `S = N C / r^{2n+1}`).
     norm: Vec<f64>,
+    /// The tables of the batched M2L.
+    pub plan: batch::Plan,
 }
 
 /// A direction and length: the translation vector's spherical angles.
@@ -81,6 +86,8 @@ pub struct Scratch {
     harmonics: Vec<C>,
     /// Powers `ρ^k / k!` or `k!/ρ^{k+1}` along the axis.
     axis: Vec<f64>,
+    /// The rows of the batched M2L.
+    pub batch: batch::Batch,
 }
 
 /// Which expansion a rotation moves: they rotate by conjugate matrices.
@@ -111,6 +118,7 @@ impl Harmonic {
             p,
             len: count(p),
             norm,
+            plan: batch::Plan::new(p),
         }
     }
 
@@ -126,6 +134,7 @@ impl Harmonic {
             shifted: vec![C::ZERO; count(p)],
             harmonics: vec![C::ZERO; count(p)],
             axis: vec![0.0; 2 * p + 2],
+            batch: batch::Batch::new(&self.plan),
         }
     }
 
@@ -165,7 +174,9 @@ impl Harmonic {
     }
 
     /// M2L: adds to the local expansion `local` about c the field `κ ψ` of the multipole `m`
-    /// about z, `t = c − z`.
+    /// about z, `t = c − z`: one translation at a time, the reference of the batched ones
+    /// ([`batch`]) that the kernel runs.
+    #[cfg(test)]
     pub fn m2l(&self, t: [f64; 3], kappa: f64, m: &[C], local: &mut [C], scratch: &mut Scratch) {
         let dir = Direction::of(t);
         self.prepare(&dir, scratch);

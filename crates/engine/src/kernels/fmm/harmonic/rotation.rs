@@ -32,8 +32,8 @@ pub struct Wigner {
     steps: Vec<[f64; 3]>,
     /// `√C(2n, n + m)` at `n (2p + 1) + m + p`.
     binom: Vec<f64>,
-    /// `cos(β/2)^k`, `(−sin(β/2))^k` and `sin(β/2)^k` for k = 0..=2p of the angle computed.
-    powers: [Vec<f64>; 3],
+    /// `cos(β/2)^k` and `sin(β/2)^k` for k = 0..=2p of the angle computed.
+    powers: [Vec<f64>; 2],
 }
 
 impl Wigner {
@@ -46,19 +46,7 @@ impl Wigner {
             at += (2 * n + 1) * (2 * n + 1);
         }
         start.push(at);
-        let mut ln_fact = vec![0.0; 2 * p + 2];
-        for k in 1..ln_fact.len() {
-            ln_fact[k] = ln_fact[k - 1] + (k as f64).ln();
-        }
-        let w = 2 * p + 1;
-        let mut binom = vec![0.0; (p + 1) * w];
-        for n in 0..=p {
-            for m in 0..=2 * n {
-                // m here is n + (the order).
-                binom[n * w + m + p - n] =
-                    (0.5 * (ln_fact[2 * n] - ln_fact[m] - ln_fact[2 * n - m])).exp();
-            }
-        }
+        let binom = binomials(p);
         let mut wigner = Wigner {
             p,
             start,
@@ -72,21 +60,8 @@ impl Wigner {
             for m in -pi..=pi {
                 let n0 = mp.unsigned_abs().max(m.unsigned_abs());
                 for n in n0 + 1..=p {
-                    let nf = n as f64;
-                    let (mf, mpf) = (m as f64, mp as f64);
-                    let step = if n == 1 {
-                        // n0 = 0: m = m' = 0, d^1_00 = cos β.
-                        [1.0, 0.0, 0.0]
-                    } else {
-                        let norm = ((nf * nf - mf * mf) * (nf * nf - mpf * mpf)).sqrt();
-                        let n1 = nf - 1.0;
-                        let a = nf * (2.0 * nf - 1.0) / norm;
-                        let b =
-                            nf * ((n1 * n1 - mf * mf) * (n1 * n1 - mpf * mpf)).sqrt() / (n1 * norm);
-                        [a, -a * mf * mpf / (nf * n1), b]
-                    };
                     let i = wigner.index(n, mp, m);
-                    wigner.steps[i] = step;
+                    wigner.steps[i] = step(n, mp, m);
                 }
             }
         }
@@ -119,14 +94,8 @@ impl Wigner {
     /// The matrices for the angle β with `cos β = c` and `sin β = s ≥ 0` (β in [0, π]).
     pub fn compute(&mut self, c: f64, s: f64) {
         let p = self.p as isize;
-        // cos(β/2), sin(β/2) from c and s without cancellation near either end.
-        let half_c = ((1.0 + c) / 2.0).max(0.0).sqrt();
-        let half_s = if half_c > 0.5 {
-            s / (2.0 * half_c)
-        } else {
-            ((1.0 - c) / 2.0).max(0.0).sqrt()
-        };
-        for (k, base) in [half_c, -half_s, half_s].into_iter().enumerate() {
+        let (half_c, half_s) = half_angles(c, s);
+        for (k, base) in [half_c, half_s].into_iter().enumerate() {
             let pw = &mut self.powers[k];
             pw[0] = 1.0;
             for j in 1..pw.len() {
@@ -155,19 +124,80 @@ impl Wigner {
 
     /// `d^{n}_{m'm}` at `n = max(|m|, |m'|)`, in closed form from the angle's powers.
     fn edge(&self, n: usize, mp: isize, m: isize) -> f64 {
-        if mp.unsigned_abs() < m.unsigned_abs() {
-            // d_{m'm} = (−1)^{m−m'} d_{mm'}.
-            return sign((m - mp).unsigned_abs()) * self.edge(n, m, mp);
+        let (coef, cos_power, sin_power) = edge_form(&self.binom, self.p, n, mp, m);
+        let [cos, sin] = &self.powers;
+        coef * cos[cos_power] * sin[sin_power]
+    }
+}
+
+/// `√C(2n, n + m)` at `n (2p + 1) + m + p`, for n ≤ p.
+pub(super) fn binomials(p: usize) -> Vec<f64> {
+    let mut ln_fact = vec![0.0; 2 * p + 2];
+    for k in 1..ln_fact.len() {
+        ln_fact[k] = ln_fact[k - 1] + (k as f64).ln();
+    }
+    let w = 2 * p + 1;
+    let mut binom = vec![0.0; (p + 1) * w];
+    for n in 0..=p {
+        for m in 0..=2 * n {
+            // m here is n + (the order).
+            binom[n * w + m + p - n] =
+                (0.5 * (ln_fact[2 * n] - ln_fact[m] - ln_fact[2 * n - m])).exp();
         }
-        let nf = n as isize;
-        let (plus, minus) = ((nf + m) as usize, (nf - m) as usize);
-        let binom = self.binom[n * (2 * self.p + 1) + (m + self.p as isize) as usize];
-        let [cos, neg_sin, sin] = &self.powers;
-        if mp >= 0 {
-            binom * cos[plus] * neg_sin[minus]
-        } else {
-            binom * cos[minus] * sin[plus]
-        }
+    }
+    binom
+}
+
+/// `cos(β/2)` and `sin(β/2)` from `cos β = c` and `sin β = s ≥ 0`, without cancellation near
+/// either end.
+#[inline(always)]
+pub(super) fn half_angles(c: f64, s: f64) -> (f64, f64) {
+    let half_c = ((1.0 + c) / 2.0).max(0.0).sqrt();
+    let half_s = if half_c > 0.5 {
+        s / (2.0 * half_c)
+    } else {
+        ((1.0 - c) / 2.0).max(0.0).sqrt()
+    };
+    (half_c, half_s)
+}
+
+/// The recurrence's `(α, β, γ)` of `d^n_{m'm}` from the degrees below, `n > max(|m|, |m'|)`.
+pub(super) fn step(n: usize, mp: isize, m: isize) -> [f64; 3] {
+    if n == 1 {
+        // n0 = 0: m = m' = 0, d^1_00 = cos β.
+        return [1.0, 0.0, 0.0];
+    }
+    let nf = n as f64;
+    let (mf, mpf) = (m as f64, mp as f64);
+    let norm = ((nf * nf - mf * mf) * (nf * nf - mpf * mpf)).sqrt();
+    let n1 = nf - 1.0;
+    let a = nf * (2.0 * nf - 1.0) / norm;
+    let b = nf * ((n1 * n1 - mf * mf) * (n1 * n1 - mpf * mpf)).sqrt() / (n1 * norm);
+    [a, -a * mf * mpf / (nf * n1), b]
+}
+
+/// `d^n_{m'm}` at `n = max(|m|, |m'|)` as `coef · cos(β/2)^a · sin(β/2)^b`: `(coef, a, b)`,
+/// with `binom` the table of [`Wigner`] for order `p`.
+pub(super) fn edge_form(
+    binom: &[f64],
+    p: usize,
+    n: usize,
+    mp: isize,
+    m: isize,
+) -> (f64, usize, usize) {
+    if mp.unsigned_abs() < m.unsigned_abs() {
+        // d_{m'm} = (−1)^{m−m'} d_{mm'}.
+        let (coef, a, b) = edge_form(binom, p, n, m, mp);
+        return (sign((m - mp).unsigned_abs()) * coef, a, b);
+    }
+    let nf = n as isize;
+    let (plus, minus) = ((nf + m) as usize, (nf - m) as usize);
+    let coef = binom[n * (2 * p + 1) + (m + p as isize) as usize];
+    if mp >= 0 {
+        // cos^{n+m} (−sin)^{n−m}.
+        (coef * sign(minus), plus, minus)
+    } else {
+        (coef, minus, plus)
     }
 }
 

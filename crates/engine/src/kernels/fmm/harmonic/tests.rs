@@ -400,3 +400,66 @@ fn a_multipole_potential_matches_the_direct_sum_far_away() {
         "{psi} against {want}"
     );
 }
+
+#[test]
+fn the_batched_m2l_is_the_one_at_a_time() {
+    use super::batch::{Batch, far};
+    use super::solid::complex;
+    use crate::kernels::lanes::{Isa, isas_here};
+    let mut rng = rng();
+    for p in 1..=MAX_HARMONIC_ORDER {
+        let h = Harmonic::new(p);
+        let mut scratch = h.scratch();
+        let z = [0.1, -0.2, 0.3];
+        // Partners all round, along both poles of the axis too, more than a batch of any width.
+        let mut centres: Vec<[f64; 3]> = (0..19).map(|_| point(&mut rng, 4.0)).collect();
+        centres.push([z[0], z[1], z[2] + 2.5]);
+        centres.push([z[0], z[1], z[2] - 3.0]);
+        let multipoles: Vec<f64> = centres
+            .iter()
+            .flat_map(|&c| {
+                let src = sources(&mut rng, c, 6);
+                let m = multipole(&h, c, &src);
+                m.into_iter().flat_map(|v| [v.re, v.im])
+            })
+            .collect();
+        let partners: Vec<u32> = (0..centres.len() as u32).collect();
+        let kappa = -0.7;
+        let mut want = vec![C::ZERO; count(p)];
+        for &b in &partners {
+            let b = b as usize;
+            let len = 2 * count(p);
+            let m = complex(&multipoles[b * len..(b + 1) * len]);
+            h.m2l(sub(z, centres[b]), kappa, m, &mut want, &mut scratch);
+        }
+        let scale = want.iter().map(|v| v.abs()).fold(0.0, f64::max);
+        let isas: Vec<Option<Isa>> = std::iter::once(None)
+            .chain(isas_here().into_iter().map(Some))
+            .collect();
+        for isa in isas {
+            let mut batch = Batch::new(&h.plan);
+            let mut local = vec![f64::NAN; 2 * count(p)];
+            far(
+                &h.plan,
+                kappa,
+                isa,
+                z,
+                &partners,
+                &centres,
+                &multipoles,
+                &mut local,
+                &mut batch,
+            );
+            let got = complex(&local);
+            for n in 0..=p {
+                for m in 0..=n {
+                    let (g, w) = (got[at(n, m)], want[at(n, m)]);
+                    assert!(
+                        close(g, w, scale, 1e-12),
+                        "order {p}, {isa:?}: L_{n}^{m} {g:?} against {w:?}"
+                    );
+                }
+            }
+        }
+    }
+}
