@@ -17,7 +17,7 @@ pub(crate) const EQUAL_ERROR: f64 = 1e-3;
 
 /// Tighter errors also compared at, where the other code's settings reach them (a fast
 /// multipole code's higher orders do; a θ sweep of a tree code usually does not).
-const TIGHTER_ERRORS: [f64; 2] = [1e-4, 1e-6];
+const TIGHTER_ERRORS: [f64; 3] = [1e-4, 1e-6, 1e-8];
 
 /// The seed of the ratio bootstraps: the same results give the same intervals.
 const SEED: u64 = 0x9EE2;

@@ -118,12 +118,13 @@ impl ResolvedAxis {
 
     /// The label of a major tick at `value`, or a freshly formatted one for any other value.
     pub(crate) fn label(&self, value: f64) -> String {
-        let tolerance = 1e-9 * (self.hi - self.lo).abs();
-        match self
-            .major
-            .iter()
-            .find(|(v, _)| (v - value).abs() <= tolerance)
-        {
+        // On a log axis, relative to the tick: an absolute tolerance from the range would take
+        // every tick decades below the top for the first one.
+        let near = |v: f64| match self.scale {
+            Scale::Log => (v - value).abs() <= 1e-9 * v.abs(),
+            Scale::Linear => (v - value).abs() <= 1e-9 * (self.hi - self.lo).abs(),
+        };
+        match self.major.iter().find(|(v, _)| near(*v)) {
             Some((_, label)) => label.clone(),
             None => format::value_label(value, self.unit),
         }
@@ -418,5 +419,16 @@ mod tests {
         assert_eq!(labels(&r), ["naive", "octree"]);
         assert_eq!(r.label(1.0), "octree");
         assert!((r.fraction(0.0) - 0.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn each_tick_of_a_log_axis_over_many_decades_keeps_its_own_label() {
+        let r = ResolvedAxis::resolve(&Axis::log("y"), [1e-15, 0.1]);
+        for (v, l) in &r.major {
+            assert_eq!(&r.label(*v), l, "{:?}", labels(&r));
+        }
+        let distinct: std::collections::HashSet<String> =
+            r.major.iter().map(|(v, _)| r.label(*v)).collect();
+        assert_eq!(distinct.len(), r.major.len(), "{:?}", labels(&r));
     }
 }
