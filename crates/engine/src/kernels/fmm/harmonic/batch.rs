@@ -77,7 +77,8 @@ struct Chain {
 }
 
 impl Plan {
-    pub fn new(p: usize) -> Plan {
+    /// The plan of order `p`, with `norm` the harmonics' scales (`Harmonic`'s table).
+    pub fn new(p: usize, norm: &[f64]) -> Plan {
         let (mut row, mut size) = (vec![0; count(p)], 0);
         for n in 0..=p {
             for mp in 0..=n {
@@ -134,16 +135,6 @@ impl Plan {
                 });
             }
         }
-        let mut norm = vec![0.0; count(p)];
-        let mut fact = vec![1.0; 2 * p + 2];
-        for k in 1..fact.len() {
-            fact[k] = fact[k - 1] * k as f64;
-        }
-        for n in 0..=p {
-            for m in 0..=n {
-                norm[at(n, m)] = (fact[n + m] * fact[n - m]).sqrt();
-            }
-        }
         let inv_norm = norm.iter().map(|x| 1.0 / x).collect();
         Plan {
             p,
@@ -151,7 +142,7 @@ impl Plan {
             size,
             quads,
             quad_steps,
-            norm,
+            norm: norm.to_vec(),
             inv_norm,
         }
     }

@@ -117,8 +117,8 @@ impl Harmonic {
         Harmonic {
             p,
             len: count(p),
+            plan: batch::Plan::new(p, &norm),
             norm,
-            plan: batch::Plan::new(p),
         }
     }
 
